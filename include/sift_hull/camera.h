@@ -1,0 +1,74 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace sift_hull {
+
+using Matrix34d = Eigen::Matrix<double, 3, 4>;
+
+/// A pinhole camera in the Middlebury convention x ~ K [R | t] X: R and t take world points into the
+/// camera frame (z forward, x right, y down), K maps the camera frame to pixels. Pixel (u, v) is the
+/// centre of the pixel in column u and row v, origin at the top-left pixel's centre.
+class PinholeCamera {
+ public:
+  PinholeCamera() = default;
+  /// Throws std::invalid_argument when K is singular or not upper triangular with K(2,2) != 0, or
+  /// when R is not a rotation (orthonormal with det +1, to 1e-4).
+  PinholeCamera(const Eigen::Matrix3d& K, const Eigen::Matrix3d& R, const Eigen::Vector3d& t);
+
+  /// The paper's form u ~ K [R | -R c] U, with c the camera centre in world coordinates.
+  static PinholeCamera fromCentre(const Eigen::Matrix3d& K, const Eigen::Matrix3d& R,
+                                  const Eigen::Vector3d& centre);
+  /// Decomposes P = K [R | t] (any non-zero scale) by RQ decomposition into a K with positive focal
+  /// lengths and K(2,2) = 1, and a rotation with det R = +1. Throws std::invalid_argument when the
+  /// left 3x3 block of P is singular.
+  static PinholeCamera fromProjection(const Matrix34d& P);
+
+  const Eigen::Matrix3d& K() const { return K_; }
+  const Eigen::Matrix3d& R() const { return R_; }
+  const Eigen::Vector3d& t() const { return t_; }
+  Eigen::Vector3d centre() const { return -R_.transpose() * t_; }
+  /// Unit vector of the optical axis (camera z) in world coordinates.
+  Eigen::Vector3d opticalAxis() const { return R_.row(2).transpose(); }
+  Matrix34d projectionMatrix() const;
+
+  /// World point into the camera frame.
+  Eigen::Vector3d toCamera(const Eigen::Vector3d& X_W) const { return R_ * X_W + t_; }
+  /// Depth of a world point along the optical axis (positive in front of the camera).
+  double depth(const Eigen::Vector3d& X_W) const { return toCamera(X_W).z(); }
+  /// Pixel of a world point; meaningful only where depth(X_W) > 0.
+  Eigen::Vector2d project(const Eigen::Vector3d& X_W) const;
+  /// Unit direction, in world coordinates, of the ray from the centre through pixel (u, v).
+  Eigen::Vector3d rayDirection(const Eigen::Vector2d& pixel) const;
+  /// The world point seen at a pixel at the given depth along the optical axis.
+  Eigen::Vector3d backProject(const Eigen::Vector2d& pixel, double depth) const;
+
+ private:
+  Eigen::Matrix3d K_ = Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d R_ = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d t_ = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d K_inv_ = Eigen::Matrix3d::Identity();
+};
+
+/// Cross-product matrix [v]x, so that [v]x w = v x w.
+Eigen::Matrix3d skew(const Eigen::Vector3d& v);
+
+/// Fundamental matrix F with x_b^T F x_a = 0 for every scene point seen at x_a in view a and x_b in
+/// view b (pixels, homogeneous). The paper's eq. 10, F = A_r^-T [t]x R A_l^-1, with the relative pose
+/// R = R_b R_a^T and t = t_b - R t_a taking camera-a coordinates into camera b.
+Eigen::Matrix3d fundamentalMatrix(const PinholeCamera& a, const PinholeCamera& b);
+
+/// Distances in pixels of each point of a match to the epipolar line of the other.
+struct EpipolarDistances {
+  double in_a_px;  ///< distance of x_a to the line F^T x_b in image a
+  double in_b_px;  ///< distance of x_b to the line F x_a in image b
+  double max() const { return in_a_px > in_b_px ? in_a_px : in_b_px; }
+};
+
+/// Symmetric point-to-epipolar-line distance of a match (x_a, x_b) under F (x_b^T F x_a = 0).
+/// A degenerate line (a point at an epipole) gives infinite distance.
+EpipolarDistances epipolarDistances(const Eigen::Matrix3d& F, const Eigen::Vector2d& x_a,
+                                    const Eigen::Vector2d& x_b);
+
+}  // namespace sift_hull

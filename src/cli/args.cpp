@@ -1,0 +1,121 @@
+#include "args.h"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <iostream>
+#include <sstream>
+
+namespace sift_hull {
+namespace cli {
+
+ArgParser::ArgParser(std::string command, std::string summary)
+    : command_(std::move(command)), summary_(std::move(summary)) {}
+
+void ArgParser::addFlag(const std::string& name, const std::string& help) {
+  order_.push_back(name);
+  specs_[name] = {"", help, ""};
+}
+
+void ArgParser::addOption(const std::string& name, const std::string& value_name,
+                          const std::string& help, const std::string& default_value) {
+  order_.push_back(name);
+  specs_[name] = {value_name, help, default_value};
+}
+
+void ArgParser::addPositional(const std::string& name, const std::string& help) {
+  positionals_.emplace_back(name, help);
+}
+
+bool ArgParser::parse(const std::vector<std::string>& args) {
+  for (const std::string& arg : args) {
+    if (arg == "--help" || arg == "-h") {
+      std::cout << help();
+      return false;
+    }
+  }
+  size_t next_positional = 0;
+  for (size_t i = 0; i < args.size(); ++i) {
+    const std::string& arg = args[i];
+    if (arg.rfind("--", 0) != 0) {
+      if (next_positional >= positionals_.size()) throw UsageError("unexpected argument '" + arg + "'");
+      values_[positionals_[next_positional++].first] = arg;
+      continue;
+    }
+    const size_t equals = arg.find('=');
+    const std::string name = arg.substr(2, equals == std::string::npos ? std::string::npos : equals - 2);
+    const auto spec = specs_.find(name);
+    if (spec == specs_.end()) throw UsageError("unknown option --" + name);
+    if (spec->second.value_name.empty()) {
+      if (equals != std::string::npos) throw UsageError("--" + name + " takes no value");
+      values_[name] = "1";
+    } else if (equals != std::string::npos) {
+      values_[name] = arg.substr(equals + 1);
+    } else if (i + 1 < args.size()) {
+      values_[name] = args[++i];
+    } else {
+      throw UsageError("--" + name + " needs a value (" + spec->second.value_name + ")");
+    }
+  }
+  if (next_positional < positionals_.size()) {
+    throw UsageError("missing argument " + positionals_[next_positional].first);
+  }
+  return true;
+}
+
+std::string ArgParser::help() const {
+  std::ostringstream out;
+  out << "usage: sift_hull " << command_;
+  for (const auto& positional : positionals_) out << ' ' << positional.first;
+  out << " [options]\n\n" << summary_ << "\n";
+  for (const auto& positional : positionals_) {
+    out << "\n  " << positional.first << "\n      " << positional.second;
+  }
+  for (const std::string& name : order_) {
+    const Spec& spec = specs_.at(name);
+    out << "\n  --" << name << (spec.value_name.empty() ? "" : " " + spec.value_name) << "\n      "
+        << spec.help;
+    if (!spec.default_value.empty()) out << " (default: " << spec.default_value << ")";
+  }
+  out << "\n  --help\n      show this text\n";
+  return out.str();
+}
+
+bool ArgParser::flag(const std::string& name) const { return values_.count(name) > 0; }
+
+bool ArgParser::has(const std::string& name) const {
+  return values_.count(name) > 0 ||
+         (specs_.count(name) > 0 && !specs_.at(name).default_value.empty());
+}
+
+std::string ArgParser::get(const std::string& name) const {
+  const auto value = values_.find(name);
+  if (value != values_.end()) return value->second;
+  const auto spec = specs_.find(name);
+  if (spec != specs_.end() && !spec->second.default_value.empty()) return spec->second.default_value;
+  throw UsageError("missing required option --" + name);
+}
+
+int ArgParser::getInt(const std::string& name) const {
+  const std::string text = get(name);
+  errno = 0;
+  char* end = nullptr;
+  const long value = std::strtol(text.c_str(), &end, 10);
+  if (text.empty() || *end != '\0' || errno == ERANGE || value < -2147483647L || value > 2147483647L) {
+    throw UsageError("--" + name + " expects an integer, got '" + text + "'");
+  }
+  return static_cast<int>(value);
+}
+
+double ArgParser::getDouble(const std::string& name) const {
+  const std::string text = get(name);
+  char* end = nullptr;
+  const double value = std::strtod(text.c_str(), &end);
+  if (text.empty() || *end != '\0' || !std::isfinite(value)) {
+    throw UsageError("--" + name + " expects a number, got '" + text + "'");
+  }
+  return value;
+}
+
+}  // namespace cli
+}  // namespace sift_hull

@@ -1,0 +1,53 @@
+#pragma once
+
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace sift_hull {
+namespace cli {
+
+/// A command line the user got wrong; main prints it with the command's usage and exits 2.
+class UsageError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Parses "--name value", "--name=value", flags and positional arguments of one subcommand.
+class ArgParser {
+ public:
+  ArgParser(std::string command, std::string summary);
+
+  void addFlag(const std::string& name, const std::string& help);
+  void addOption(const std::string& name, const std::string& value_name, const std::string& help,
+                 const std::string& default_value = "");
+  void addPositional(const std::string& name, const std::string& help);
+
+  /// Returns false, after printing the help text on stdout, when --help is among the arguments.
+  /// Throws UsageError for unknown options, missing values or missing positionals.
+  bool parse(const std::vector<std::string>& args);
+  std::string help() const;
+
+  bool flag(const std::string& name) const;
+  bool has(const std::string& name) const;
+  /// Throws UsageError when the option was neither given nor has a default.
+  std::string get(const std::string& name) const;
+  int getInt(const std::string& name) const;
+  double getDouble(const std::string& name) const;
+
+ private:
+  struct Spec {
+    std::string value_name;  // empty for a flag
+    std::string help;
+    std::string default_value;
+  };
+  std::string command_, summary_;
+  std::vector<std::string> order_;
+  std::map<std::string, Spec> specs_;
+  std::vector<std::pair<std::string, std::string>> positionals_;
+  std::map<std::string, std::string> values_;
+};
+
+}  // namespace cli
+}  // namespace sift_hull

@@ -1,0 +1,98 @@
+#include <sstream>
+
+#include "args.h"
+#include "commands.h"
+#include "sift_hull/dataset.h"
+
+namespace sift_hull {
+namespace cli {
+namespace {
+
+nlohmann::json vectorJson(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+
+/// Size shared by all the views' images; throws when they differ or one is missing.
+cv::Size commonImageSize(const std::string& directory, const std::vector<CalibratedView>& views) {
+  cv::Size size;
+  for (const CalibratedView& view : views) {
+    const cv::Size this_size = loadViewImage(directory, view).size();
+    if (size.area() > 0 && this_size != size) {
+      throw std::runtime_error(directory + "/" + view.name + ": image size differs from the others");
+    }
+    size = this_size;
+  }
+  return size;
+}
+
+bool projectsInside(const std::vector<CalibratedView>& views, const Eigen::Vector3d& X_W,
+                    cv::Size size) {
+  for (const CalibratedView& view : views) {
+    const Eigen::Vector2d pixel = view.camera.project(X_W);
+    if (pixel.x() < -0.5 || pixel.y() < -0.5 || pixel.x() > size.width - 0.5 ||
+        pixel.y() > size.height - 0.5) {
+      return false;
+    }
+  }
+  return true;
+}
+
+nlohmann::json commonPointJson(const std::vector<CalibratedView>& views, cv::Size size) {
+  const CommonPoint common = opticalAxesMeetingPoint(views);
+  if (!common.well_defined) return {{"looks_at_common_point", false}, {"point", nullptr}};
+  const bool inside = projectsInside(views, common.point_W, size);
+  return {{"point", vectorJson(common.point_W)},
+          {"max_axis_distance", common.max_axis_distance},
+          {"in_front_of_all", common.in_front_of_all},
+          {"projects_inside_all", inside},
+          {"looks_at_common_point", common.in_front_of_all && inside}};
+}
+
+std::string describe(const nlohmann::json& info) {
+  std::ostringstream text;
+  text << info["views"].get<int>() << " views, images " << info["image_size"][0] << "x"
+       << info["image_size"][1] << "\n";
+  for (const auto& view : info["cameras"]) {
+    text << "  " << view["name"].get<std::string>() << "  centre " << view["centre"].dump() << "\n";
+  }
+  const auto& common = info["common_point"];
+  text << "cameras look at a common point: "
+       << (common["looks_at_common_point"].get<bool>() ? "yes" : "no");
+  if (!common["point"].is_null()) {
+    text << " (" << common["point"].dump() << ", farthest optical axis "
+         << common["max_axis_distance"].get<double>() << " away)";
+  }
+  text << "\n";
+  return text.str();
+}
+
+}  // namespace
+
+int runDatasetInfo(const std::vector<std::string>& args) {
+  ArgParser parser("dataset-info",
+                   "Reads a calibration file and the images it names and reports the number of\n"
+                   "views, the image size, the camera centres and whether the cameras look at a\n"
+                   "common point (where their optical axes come closest, in front of every camera\n"
+                   "and inside every image).");
+  parser.addOption("calib", "FILE", "Middlebury *_par.txt or a list of 3x4 projection matrices");
+  parser.addOption("images", "DIR", "directory of the images (default: the calibration's)");
+  parser.addFlag("json", "print the result as one JSON object");
+  if (!parser.parse(args)) return 0;
+  const std::string calib = parser.get("calib");
+  const std::string images = parser.has("images") ? parser.get("images") : parentDirectory(calib);
+
+  const std::vector<CalibratedView> views = readCalibration(calib);
+  const cv::Size size = commonImageSize(images, views);
+  nlohmann::json cameras = nlohmann::json::array();
+  for (const CalibratedView& view : views) {
+    cameras.push_back({{"name", view.name}, {"centre", vectorJson(view.camera.centre())}});
+  }
+  const nlohmann::json info = {{"calib", calib},
+                               {"views", views.size()},
+                               {"image_size", {size.width, size.height}},
+                               {"cameras", cameras},
+                               {"common_point", commonPointJson(views, size)}};
+  printResult(parser.flag("json"), info, describe(info));
+  return 0;
+}
+
+}  // namespace cli
+}  // namespace sift_hull

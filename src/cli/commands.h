@@ -1,0 +1,31 @@
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+namespace sift_hull {
+namespace cli {
+
+/// One subcommand of the sift_hull program. `run` gets the arguments after the command's name and
+/// returns the exit code; it throws UsageError for a bad command line and std::exception for bad
+/// input, which main reports on stderr.
+struct Command {
+  const char* name;
+  const char* summary;
+  int (*run)(const std::vector<std::string>& args);
+};
+
+const std::vector<Command>& commands();
+
+/// Prints a command's result: the JSON object on stdout with --json, else the human text.
+void printResult(bool as_json, const nlohmann::json& result, const std::string& text);
+
+int runDatasetInfo(const std::vector<std::string>& args);
+int runScene(const std::vector<std::string>& args);
+
+/// Parses the command line and runs the chosen command.
+int runMain(int argc, char** argv);
+
+}  // namespace cli
+}  // namespace sift_hull

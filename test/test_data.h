@@ -1,0 +1,47 @@
+#pragma once
+
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+
+#include <cstdlib>
+#include <string>
+
+namespace sift_hull {
+namespace test {
+
+/// Root of the real data sets: $SIFT_HULL_DATA, else ../shared/data beside the repository when it
+/// exists, else empty.
+inline std::string dataRoot() {
+  if (const char* env = std::getenv("SIFT_HULL_DATA")) return env;
+  const std::string beside_repo = std::string(SIFT_HULL_SOURCE_DIR) + "/../shared/data";
+  struct stat info;
+  return stat(beside_repo.c_str(), &info) == 0 ? beside_repo : std::string();
+}
+
+/// Path of a data set's directory, or empty when it is absent.
+inline std::string dataSet(const std::string& name) {
+  const std::string root = dataRoot();
+  if (root.empty()) return "";
+  const std::string path = root + "/" + name;
+  struct stat info;
+  return stat(path.c_str(), &info) == 0 ? path : std::string();
+}
+
+/// A fresh directory under the system's temporary directory (never the working directory).
+inline std::string temporaryDirectory() {
+  const char* base = std::getenv("TMPDIR");
+  std::string pattern = std::string(base ? base : "/tmp") + "/sift_hull_test_XXXXXX";
+  if (mkdtemp(pattern.data()) == nullptr) throw std::runtime_error("mkdtemp failed");
+  return pattern;
+}
+
+}  // namespace test
+}  // namespace sift_hull
+
+/// Skips the current test, saying why, when a real data set is not available.
+#define SIFT_HULL_REQUIRE_DATA(dir_variable, name)                                          \
+  const std::string dir_variable = ::sift_hull::test::dataSet(name);                        \
+  if (dir_variable.empty()) {                                                               \
+    GTEST_SKIP() << "data set '" << name << "' not found: set SIFT_HULL_DATA or put it in " \
+                 << "../shared/data";                                                       \
+  }

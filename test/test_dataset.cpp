@@ -1,0 +1,215 @@
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "sift_hull/dataset.h"
+#include "test_data.h"
+
+namespace sift_hull {
+namespace {
+
+const char* kDino = "middlebury_mvs_dinoSparseRing";
+const char* kTemple = "middlebury_mvs_templeSparseRing";
+
+// A valid par line: K, identity R, t putting the origin 2 m in front of the camera.
+const char* kGoodLine =
+    "view.png 500 0 320 0 500 240 0 0 1  1 0 0 0 1 0 0 0 1  0 0 2";
+
+class MalformedFile : public ::testing::Test {
+ protected:
+  void SetUp() override { dir_ = test::temporaryDirectory(); }
+  std::string write(const std::string& text) {
+    const std::string path = dir_ + "/calib.txt";
+    std::ofstream(path) << text;
+    return path;
+  }
+  /// The ParseError message of reading `text` with `reader`, or "no error".
+  template <typename Reader>
+  std::string errorOf(const std::string& text, Reader reader) {
+    const std::string path = write(text);
+    try {
+      reader(path);
+    } catch (const ParseError& e) {
+      return e.what();
+    }
+    return "no error";
+  }
+  std::string dir_;
+};
+
+TEST_F(MalformedFile, WellFormedParFileLoads) {
+  const auto views = readMiddleburyPar(write(std::string("2\n") + kGoodLine + "\n" + kGoodLine + "\n"));
+  ASSERT_EQ(views.size(), 2u);
+  EXPECT_EQ(views[0].name, "view.png");
+  EXPECT_NEAR(views[1].camera.project(Eigen::Vector3d(0, 0, 0)).x(), 320.0, 1e-12);
+}
+
+TEST_F(MalformedFile, ParErrorsNameFileAndLine) {
+  const std::string path = dir_ + "/calib.txt";
+  const std::string good = kGoodLine;
+  EXPECT_EQ(errorOf("2\n" + good + "\nview2.png 1 2 3\n", readMiddleburyPar),
+            path + ":3: expected 22 fields (name, K, R, t), found 4");
+  EXPECT_EQ(errorOf("1\nv.png 500 0 320 0 abc 240 0 0 1 1 0 0 0 1 0 0 0 1 0 0 2\n",
+                    readMiddleburyPar),
+            path + ":2: 'abc' is not a number");
+  EXPECT_EQ(errorOf("1\nv.png 500 0 320 0 500 240 0 0 1 1 0 0 0 1 0 0 0 1 0 nan 2\n",
+                    readMiddleburyPar),
+            path + ":2: 'nan' is not finite");
+  EXPECT_EQ(errorOf("1\nv.png 500 0 320 0 0 240 0 0 1 1 0 0 0 1 0 0 0 1 0 0 2\n", readMiddleburyPar),
+            path + ":2: K is singular");
+  EXPECT_EQ(errorOf("1\nv.png 500 0 320 0 500 240 0 0 1 1 0 0 0 1 0 0 0 2 0 0 2\n",
+                    readMiddleburyPar),
+            path + ":2: R is not orthonormal (max |R^T R - I| = 3.000000)");
+  EXPECT_EQ(errorOf("3\n" + good + "\n" + good + "\n", readMiddleburyPar),
+            path + ":1: count line says 3 views but the file has 2");
+  EXPECT_EQ(errorOf("two\n" + good + "\n", readMiddleburyPar),
+            path + ":1: expected a count line with the number of views");
+  EXPECT_EQ(errorOf("", readMiddleburyPar), path + ": empty file, expected a count line");
+  EXPECT_EQ(errorOf("x", [](const std::string&) { readMiddleburyPar("/nonexistent/par.txt"); }),
+            "/nonexistent/par.txt: cannot open file");
+}
+
+TEST_F(MalformedFile, ProjectionListErrorsNameFileAndLine) {
+  const std::string path = dir_ + "/calib.txt";
+  EXPECT_EQ(errorOf("# comment\n500 0 320 0  0 500 240 0  0 0 1\n", readProjectionList),
+            path + ":2: expected 12 numbers of a 3x4 matrix, optionally after a name; found 11 fields");
+  EXPECT_EQ(errorOf("a.png 1 0 0 0  1 0 0 0  0 0 0 1\n", readProjectionList),
+            path + ":1: the left 3x3 block of P is singular");
+  EXPECT_EQ(errorOf("a.png 1 0 0 0  0 1 0 0  0 0 1 inf\n", readProjectionList),
+            path + ":1: 'inf' is not finite");
+}
+
+TEST_F(MalformedFile, ProjectionListMatchesParFile) {
+  const PinholeCamera camera = readMiddleburyPar(write(std::string("1\n") + kGoodLine))[0].camera;
+  std::ostringstream line;
+  line.precision(17);
+  line << "view.png";
+  const Matrix34d P = 3.0 * camera.projectionMatrix();
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 4; ++c) line << ' ' << P(r, c);
+  }
+  const auto views = readCalibration(write(line.str() + "\n"));
+  ASSERT_EQ(views.size(), 1u);
+  EXPECT_EQ(views[0].name, "view.png");
+  EXPECT_LT((views[0].camera.K() - camera.K()).norm(), 1e-9);
+  EXPECT_LT((views[0].camera.t() - camera.t()).norm(), 1e-9);
+}
+
+TEST_F(MalformedFile, MissingImageIsNamed) {
+  const auto views = readMiddleburyPar(write(std::string("1\n") + kGoodLine));
+  try {
+    loadViewImage(dir_, views[0]);
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), dir_ + "/view.png: image missing or unreadable");
+  }
+}
+
+TEST_F(MalformedFile, WriteThenReadParIsExact) {
+  const auto views = readMiddleburyPar(write(std::string("1\n") + kGoodLine));
+  const std::string path = dir_ + "/copy_par.txt";
+  writeMiddleburyPar(path, views);
+  const auto again = readMiddleburyPar(path);
+  ASSERT_EQ(again.size(), 1u);
+  EXPECT_EQ(again[0].camera.projectionMatrix(), views[0].camera.projectionMatrix());
+}
+
+TEST(Silhouette, MiddleburyRecipeFillsShadowsAndGrowsByThreeClosingPixels) {
+  cv::Mat image(200, 200, CV_8UC3, cv::Scalar::all(0));
+  cv::circle(image, {100, 100}, 50, cv::Scalar::all(200), cv::FILLED);
+  cv::circle(image, {100, 100}, 3, cv::Scalar::all(20), cv::FILLED);  // a dark shadow inside
+  const cv::Mat mask = silhouetteFromImage(image, SilhouetteConfig{});
+  EXPECT_EQ(mask.at<uint8_t>(100, 100), 255);             // the shadow is closed
+  EXPECT_EQ(mask.at<uint8_t>(100, 100 + 52), 255);        // dilate 10 then erode 7 grows ~3 px
+  EXPECT_EQ(mask.at<uint8_t>(100, 100 + 55), 0);
+  const double area = cv::countNonZero(mask);
+  EXPECT_NEAR(area, CV_PI * 53 * 53, 0.03 * CV_PI * 53 * 53);
+  SilhouetteConfig raw;
+  raw.dilate_px = raw.erode_px = 0;
+  EXPECT_EQ(silhouetteFromImage(image, raw).at<uint8_t>(100, 100), 0);
+}
+
+TEST(Silhouette, LoadMaskMakesBinary) {
+  const std::string dir = test::temporaryDirectory();
+  cv::Mat raw(10, 10, CV_8UC1, cv::Scalar(0));
+  raw.at<uint8_t>(2, 3) = 1;
+  cv::imwrite(dir + "/m.png", raw);
+  const cv::Mat mask = loadMask(dir + "/m.png");
+  EXPECT_EQ(mask.at<uint8_t>(2, 3), 255);
+  EXPECT_EQ(cv::countNonZero(mask), 1);
+  EXPECT_THROW(loadMask(dir + "/absent.png"), std::runtime_error);
+}
+
+/// Loads a Middlebury ring and checks the centre of its known bounding box projects into every image.
+void checkRing(const std::string& dir, const std::string& par, const Eigen::Vector3d& lo,
+               const Eigen::Vector3d& hi) {
+  const auto views = readMiddleburyPar(dir + "/" + par);
+  ASSERT_EQ(views.size(), 16u);
+  const Eigen::Vector3d centre = 0.5 * (lo + hi);
+  for (const CalibratedView& view : views) {
+    const cv::Mat image = loadViewImage(dir, view);
+    ASSERT_EQ(image.size(), cv::Size(640, 480)) << view.name;
+    EXPECT_GT(view.camera.depth(centre), 0.0) << view.name;
+    const Eigen::Vector2d pixel = view.camera.project(centre);
+    EXPECT_TRUE(pixel.x() > 0 && pixel.x() < 640 && pixel.y() > 0 && pixel.y() < 480)
+        << view.name << " sees the box centre at " << pixel.transpose();
+  }
+  const CommonPoint common = opticalAxesMeetingPoint(views);
+  EXPECT_TRUE(common.well_defined && common.in_front_of_all);
+  // The ring's axes meet near the object: within twice the box's half diagonal of its centre.
+  EXPECT_LT((common.point_W - centre).norm(), (hi - lo).norm());
+}
+
+TEST(MiddleburyData, DinoRingLoads) {
+  SIFT_HULL_REQUIRE_DATA(dir, kDino);
+  checkRing(dir, "dinoSR_par.txt", {-0.061897, -0.018874, -0.057845},
+            {0.010897, 0.068227, 0.015495});
+}
+
+TEST(MiddleburyData, TempleRingLoads) {
+  SIFT_HULL_REQUIRE_DATA(dir, kTemple);
+  checkRing(dir, "templeSR_par.txt", {-0.073568, 0.021728, -0.012445},
+            {0.028855, 0.181892, 0.062736});
+}
+
+/// Runs the sift_hull program; returns its exit code and stdout, stderr into `err`.
+int runProgram(const std::string& arguments, std::string* out, std::string* err) {
+  const std::string dir = test::temporaryDirectory();
+  const std::string command = std::string(SIFT_HULL_EXECUTABLE) + " " + arguments + " >" + dir +
+                              "/out 2>" + dir + "/err";
+  const int status = std::system(command.c_str());
+  const auto slurp = [](const std::string& path) {
+    std::ifstream in(path);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  *out = slurp(dir + "/out");
+  *err = slurp(dir + "/err");
+  return WEXITSTATUS(status);
+}
+
+TEST(DatasetInfoCommand, ReportsDinoAsJson) {
+  SIFT_HULL_REQUIRE_DATA(dir, kDino);
+  std::string out, err;
+  ASSERT_EQ(runProgram("dataset-info --calib " + dir + "/dinoSR_par.txt --json", &out, &err), 0)
+      << err;
+  EXPECT_NE(out.find("\"views\": 16"), std::string::npos) << out;
+  EXPECT_NE(out.find("\"image_size\": [\n    640,\n    480\n  ]"), std::string::npos) << out;
+  EXPECT_NE(out.find("\"looks_at_common_point\": true"), std::string::npos) << out;
+}
+
+TEST(DatasetInfoCommand, MalformedFileGivesLocatedErrorAndExitCode) {
+  const std::string dir = test::temporaryDirectory();
+  std::ofstream(dir + "/bad_par.txt") << "1\nview.png 1 2 3\n";
+  std::string out, err;
+  EXPECT_EQ(runProgram("dataset-info --calib " + dir + "/bad_par.txt", &out, &err), 1);
+  EXPECT_NE(err.find(dir + "/bad_par.txt:2: expected 22 fields"), std::string::npos) << err;
+  EXPECT_TRUE(out.empty());
+  EXPECT_EQ(runProgram("dataset-info --no-such-option", &out, &err), 2);
+  EXPECT_NE(err.find("unknown option --no-such-option"), std::string::npos) << err;
+}
+
+}  // namespace
+}  // namespace sift_hull
