@@ -107,6 +107,9 @@ int parseCount(const Line& line, const std::string& path) {
   return static_cast<int>(count);
 }
 
+/// Checked before cv::imread, which logs its own warning for a missing file.
+bool isReadableFile(const std::string& path) { return std::ifstream(path).good(); }
+
 bool looksLikeCountLine(const Line& line) {
   if (line.fields.size() != 1) return false;
   const std::string& word = line.fields[0];
@@ -174,6 +177,7 @@ std::string parentDirectory(const std::string& path) {
 cv::Mat loadViewImage(const std::string& directory, const CalibratedView& view) {
   if (view.name.empty()) throw std::runtime_error("the calibration names no image for a view");
   const std::string path = directory + "/" + view.name;
+  if (!isReadableFile(path)) throw std::runtime_error(path + ": image missing or unreadable");
   cv::Mat image = cv::imread(path, cv::IMREAD_COLOR);
   if (image.empty()) throw std::runtime_error(path + ": image missing or unreadable");
   return image;
@@ -196,6 +200,7 @@ cv::Mat silhouetteFromImage(const cv::Mat& image, const SilhouetteConfig& config
 }
 
 cv::Mat loadMask(const std::string& path) {
+  if (!isReadableFile(path)) throw std::runtime_error(path + ": mask missing or unreadable");
   const cv::Mat raw = cv::imread(path, cv::IMREAD_GRAYSCALE);
   if (raw.empty()) throw std::runtime_error(path + ": mask missing or unreadable");
   cv::Mat mask;
