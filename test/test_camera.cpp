@@ -69,7 +69,8 @@ TEST(Camera, ProjectionMatrixDecompositionRecoversKRt) {
   for (int trial = 0; trial < 100; ++trial) {
     const PinholeCamera camera = randomCamera(&rng);
     const double scale = (trial % 2 ? -1.0 : 1.0) * (0.01 + trial);  // any non-zero scale
-    const PinholeCamera decomposed = PinholeCamera::fromProjection(scale * camera.projectionMatrix());
+    const PinholeCamera decomposed =
+        PinholeCamera::fromProjection(scale * camera.projectionMatrix());
     EXPECT_LT((decomposed.K() - camera.K()).norm(), 1e-9 * camera.K().norm());
     EXPECT_LT((decomposed.R() - camera.R()).norm(), 1e-9);
     EXPECT_LT((decomposed.t() - camera.t()).norm(), 1e-9);

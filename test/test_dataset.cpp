@@ -15,8 +15,7 @@ const char* kDino = "middlebury_mvs_dinoSparseRing";
 const char* kTemple = "middlebury_mvs_templeSparseRing";
 
 // A valid par line: K, identity R, t putting the origin 2 m in front of the camera.
-const char* kGoodLine =
-    "view.png 500 0 320 0 500 240 0 0 1  1 0 0 0 1 0 0 0 1  0 0 2";
+const char* kGoodLine = "view.png 500 0 320 0 500 240 0 0 1  1 0 0 0 1 0 0 0 1  0 0 2";
 
 class MalformedFile : public ::testing::Test {
  protected:
@@ -41,7 +40,8 @@ class MalformedFile : public ::testing::Test {
 };
 
 TEST_F(MalformedFile, WellFormedParFileLoads) {
-  const auto views = readMiddleburyPar(write(std::string("2\n") + kGoodLine + "\n" + kGoodLine + "\n"));
+  const auto views =
+      readMiddleburyPar(write(std::string("2\n") + kGoodLine + "\n" + kGoodLine + "\n"));
   ASSERT_EQ(views.size(), 2u);
   EXPECT_EQ(views[0].name, "view.png");
   EXPECT_NEAR(views[1].camera.project(Eigen::Vector3d(0, 0, 0)).x(), 320.0, 1e-12);
@@ -52,17 +52,18 @@ TEST_F(MalformedFile, ParErrorsNameFileAndLine) {
   const std::string good = kGoodLine;
   EXPECT_EQ(errorOf("2\n" + good + "\nview2.png 1 2 3\n", readMiddleburyPar),
             path + ":3: expected 22 fields (name, K, R, t), found 4");
-  EXPECT_EQ(errorOf("1\nv.png 500 0 320 0 abc 240 0 0 1 1 0 0 0 1 0 0 0 1 0 0 2\n",
-                    readMiddleburyPar),
-            path + ":2: 'abc' is not a number");
-  EXPECT_EQ(errorOf("1\nv.png 500 0 320 0 500 240 0 0 1 1 0 0 0 1 0 0 0 1 0 nan 2\n",
-                    readMiddleburyPar),
-            path + ":2: 'nan' is not finite");
-  EXPECT_EQ(errorOf("1\nv.png 500 0 320 0 0 240 0 0 1 1 0 0 0 1 0 0 0 1 0 0 2\n", readMiddleburyPar),
-            path + ":2: K is singular");
-  EXPECT_EQ(errorOf("1\nv.png 500 0 320 0 500 240 0 0 1 1 0 0 0 1 0 0 0 2 0 0 2\n",
-                    readMiddleburyPar),
-            path + ":2: R is not orthonormal (max |R^T R - I| = 3.000000)");
+  EXPECT_EQ(
+      errorOf("1\nv.png 500 0 320 0 abc 240 0 0 1 1 0 0 0 1 0 0 0 1 0 0 2\n", readMiddleburyPar),
+      path + ":2: 'abc' is not a number");
+  EXPECT_EQ(
+      errorOf("1\nv.png 500 0 320 0 500 240 0 0 1 1 0 0 0 1 0 0 0 1 0 nan 2\n", readMiddleburyPar),
+      path + ":2: 'nan' is not finite");
+  EXPECT_EQ(
+      errorOf("1\nv.png 500 0 320 0 0 240 0 0 1 1 0 0 0 1 0 0 0 1 0 0 2\n", readMiddleburyPar),
+      path + ":2: K is singular");
+  EXPECT_EQ(
+      errorOf("1\nv.png 500 0 320 0 500 240 0 0 1 1 0 0 0 1 0 0 0 2 0 0 2\n", readMiddleburyPar),
+      path + ":2: R is not orthonormal (max |R^T R - I| = 3.000000)");
   EXPECT_EQ(errorOf("3\n" + good + "\n" + good + "\n", readMiddleburyPar),
             path + ":1: count line says 3 views but the file has 2");
   EXPECT_EQ(errorOf("two\n" + good + "\n", readMiddleburyPar),
@@ -74,8 +75,9 @@ TEST_F(MalformedFile, ParErrorsNameFileAndLine) {
 
 TEST_F(MalformedFile, ProjectionListErrorsNameFileAndLine) {
   const std::string path = dir_ + "/calib.txt";
-  EXPECT_EQ(errorOf("# comment\n500 0 320 0  0 500 240 0  0 0 1\n", readProjectionList),
-            path + ":2: expected 12 numbers of a 3x4 matrix, optionally after a name; found 11 fields");
+  EXPECT_EQ(
+      errorOf("# comment\n500 0 320 0  0 500 240 0  0 0 1\n", readProjectionList),
+      path + ":2: expected 12 numbers of a 3x4 matrix, optionally after a name; found 11 fields");
   EXPECT_EQ(errorOf("a.png 1 0 0 0  1 0 0 0  0 0 0 1\n", readProjectionList),
             path + ":1: the left 3x3 block of P is singular");
   EXPECT_EQ(errorOf("a.png 1 0 0 0  0 1 0 0  0 0 1 inf\n", readProjectionList),
@@ -122,8 +124,8 @@ TEST(Silhouette, MiddleburyRecipeFillsShadowsAndGrowsByThreeClosingPixels) {
   cv::circle(image, {100, 100}, 50, cv::Scalar::all(200), cv::FILLED);
   cv::circle(image, {100, 100}, 3, cv::Scalar::all(20), cv::FILLED);  // a dark shadow inside
   const cv::Mat mask = silhouetteFromImage(image, SilhouetteConfig{});
-  EXPECT_EQ(mask.at<uint8_t>(100, 100), 255);             // the shadow is closed
-  EXPECT_EQ(mask.at<uint8_t>(100, 100 + 52), 255);        // dilate 10 then erode 7 grows ~3 px
+  EXPECT_EQ(mask.at<uint8_t>(100, 100), 255);       // the shadow is closed
+  EXPECT_EQ(mask.at<uint8_t>(100, 100 + 52), 255);  // dilate 10 then erode 7 grows ~3 px
   EXPECT_EQ(mask.at<uint8_t>(100, 100 + 55), 0);
   const double area = cv::countNonZero(mask);
   EXPECT_NEAR(area, CV_PI * 53 * 53, 0.03 * CV_PI * 53 * 53);
@@ -143,7 +145,8 @@ TEST(Silhouette, LoadMaskMakesBinary) {
   EXPECT_THROW(loadMask(dir + "/absent.png"), std::runtime_error);
 }
 
-/// Loads a Middlebury ring and checks the centre of its known bounding box projects into every image.
+/// Loads a Middlebury ring and checks the centre of its known bounding box projects into every
+/// image.
 void checkRing(const std::string& dir, const std::string& par, const Eigen::Vector3d& lo,
                const Eigen::Vector3d& hi) {
   const auto views = readMiddleburyPar(dir + "/" + par);
@@ -178,8 +181,8 @@ TEST(MiddleburyData, TempleRingLoads) {
 /// Runs the sift_hull program; returns its exit code and stdout, stderr into `err`.
 int runProgram(const std::string& arguments, std::string* out, std::string* err) {
   const std::string dir = test::temporaryDirectory();
-  const std::string command = std::string(SIFT_HULL_EXECUTABLE) + " " + arguments + " >" + dir +
-                              "/out 2>" + dir + "/err";
+  const std::string command =
+      std::string(SIFT_HULL_EXECUTABLE) + " " + arguments + " >" + dir + "/out 2>" + dir + "/err";
   const int status = std::system(command.c_str());
   const auto slurp = [](const std::string& path) {
     std::ifstream in(path);

@@ -87,7 +87,8 @@ TEST(Shape, BoundingBoxIsTight) {
     Eigen::Vector3d seen_lo = hi, seen_hi = lo;
     std::uniform_real_distribution<double> unit(0.0, 1.0);
     for (int i = 0; i < 400000; ++i) {
-      const Eigen::Vector3d X = lo + (hi - lo).cwiseProduct(Eigen::Vector3d(unit(rng), unit(rng), unit(rng)));
+      const Eigen::Vector3d X =
+          lo + (hi - lo).cwiseProduct(Eigen::Vector3d(unit(rng), unit(rng), unit(rng)));
       if (!shape.contains(X)) continue;
       seen_lo = seen_lo.cwiseMin(X);
       seen_hi = seen_hi.cwiseMax(X);
@@ -123,7 +124,8 @@ TEST_F(WrittenScene, ReadsBackExactly) {
   EXPECT_EQ(scene.config.shape, config_.shape);
   ASSERT_EQ(scene.views.size(), rendered_.size());
   for (size_t i = 0; i < rendered_.size(); ++i) {
-    EXPECT_EQ(scene.views[i].camera.projectionMatrix(), rendered_[i].view.camera.projectionMatrix());
+    EXPECT_EQ(scene.views[i].camera.projectionMatrix(),
+              rendered_[i].view.camera.projectionMatrix());
     EXPECT_EQ(cv::norm(scene.depths[i], rendered_[i].depth, cv::NORM_INF), 0.0);
     const cv::Mat image = cv::imread(directory_ + "/" + scene.views[i].name);
     EXPECT_EQ(cv::norm(image, rendered_[i].image, cv::NORM_INF), 0.0);
@@ -218,7 +220,8 @@ TEST_F(WrittenScene, DepthCorrespondencesAgreeWithProjectedPoints) {
         }
         continue;
       }
-      if (truth.visibility == Visibility::kBackground) continue;  // sub-pixel at the silhouette edge
+      if (truth.visibility == Visibility::kBackground)
+        continue;  // sub-pixel at the silhouette edge
       const Eigen::Vector3d X = origin + hit.distance * direction;
       bool ambiguous;
       const Visibility expected = analyticVisibility(shape, b.camera, X, size, &ambiguous);

@@ -7,9 +7,9 @@ namespace sift_hull {
 
 using Matrix34d = Eigen::Matrix<double, 3, 4>;
 
-/// A pinhole camera in the Middlebury convention x ~ K [R | t] X: R and t take world points into the
-/// camera frame (z forward, x right, y down), K maps the camera frame to pixels. Pixel (u, v) is the
-/// centre of the pixel in column u and row v, origin at the top-left pixel's centre.
+/// A pinhole camera in the Middlebury convention x ~ K [R | t] X: R and t take world points into
+/// the camera frame (z forward, x right, y down), K maps the camera frame to pixels. Pixel (u, v)
+/// is the centre of the pixel in column u and row v, origin at the top-left pixel's centre.
 class PinholeCamera {
  public:
   PinholeCamera() = default;
@@ -55,8 +55,8 @@ class PinholeCamera {
 Eigen::Matrix3d skew(const Eigen::Vector3d& v);
 
 /// Fundamental matrix F with x_b^T F x_a = 0 for every scene point seen at x_a in view a and x_b in
-/// view b (pixels, homogeneous). The paper's eq. 10, F = A_r^-T [t]x R A_l^-1, with the relative pose
-/// R = R_b R_a^T and t = t_b - R t_a taking camera-a coordinates into camera b.
+/// view b (pixels, homogeneous). The paper's eq. 10, F = A_r^-T [t]x R A_l^-1, with the relative
+/// pose R = R_b R_a^T and t = t_b - R t_a taking camera-a coordinates into camera b.
 Eigen::Matrix3d fundamentalMatrix(const PinholeCamera& a, const PinholeCamera& b);
 
 /// Distances in pixels of each point of a match to the epipolar line of the other.

@@ -26,9 +26,9 @@ struct TrueCorrespondence {
   Eigen::Vector3d X_W = Eigen::Vector3d::Zero();      ///< the scene point, set unless kBackground
 };
 
-/// Depth at a sub-pixel position: bilinear between the four nearest pixel centres where they all see
-/// the same surface (spread under 1 %), else the nearest pixel's. False outside the image or on the
-/// background.
+/// Depth at a sub-pixel position: bilinear between the four nearest pixel centres where they all
+/// see the same surface (spread under 1 %), else the nearest pixel's. False outside the image or on
+/// the background.
 bool sampleDepth(const cv::Mat& depth, const Eigen::Vector2d& pixel, double* value);
 
 /// True position in view b of what pixel_a of view a sees. A point counts as visible in b when b's

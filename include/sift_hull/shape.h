@@ -23,7 +23,7 @@ struct Primitive {
 
 /// Where a ray first enters a solid.
 struct RayHit {
-  double distance = 0.0;                             ///< along the unit ray direction
+  double distance = 0.0;                               ///< along the unit ray direction
   Eigen::Vector3d normal_W = Eigen::Vector3d::Zero();  ///< outward unit normal at the hit
 };
 
@@ -42,8 +42,8 @@ class Shape {
 
   const std::vector<Primitive>& parts() const { return parts_; }
   bool contains(const Eigen::Vector3d& X_W) const;
-  /// First entry of the ray origin + s * direction (s > 0, direction of unit length) into the solid;
-  /// false when it misses. The origin must lie outside the solid.
+  /// First entry of the ray origin + s * direction (s > 0, direction of unit length) into the
+  /// solid; false when it misses. The origin must lie outside the solid.
   bool firstHit(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, RayHit* hit) const;
   /// A sphere holding the whole shape.
   const Eigen::Vector3d& boundingCentre() const { return bounding_centre_; }

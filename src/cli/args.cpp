@@ -38,12 +38,14 @@ bool ArgParser::parse(const std::vector<std::string>& args) {
   for (size_t i = 0; i < args.size(); ++i) {
     const std::string& arg = args[i];
     if (arg.rfind("--", 0) != 0) {
-      if (next_positional >= positionals_.size()) throw UsageError("unexpected argument '" + arg + "'");
+      if (next_positional >= positionals_.size())
+        throw UsageError("unexpected argument '" + arg + "'");
       values_[positionals_[next_positional++].first] = arg;
       continue;
     }
     const size_t equals = arg.find('=');
-    const std::string name = arg.substr(2, equals == std::string::npos ? std::string::npos : equals - 2);
+    const std::string name =
+        arg.substr(2, equals == std::string::npos ? std::string::npos : equals - 2);
     const auto spec = specs_.find(name);
     if (spec == specs_.end()) throw UsageError("unknown option --" + name);
     if (spec->second.value_name.empty()) {
@@ -92,7 +94,8 @@ std::string ArgParser::get(const std::string& name) const {
   const auto value = values_.find(name);
   if (value != values_.end()) return value->second;
   const auto spec = specs_.find(name);
-  if (spec != specs_.end() && !spec->second.default_value.empty()) return spec->second.default_value;
+  if (spec != specs_.end() && !spec->second.default_value.empty())
+    return spec->second.default_value;
   throw UsageError("missing required option --" + name);
 }
 
@@ -101,7 +104,8 @@ int ArgParser::getInt(const std::string& name) const {
   errno = 0;
   char* end = nullptr;
   const long value = std::strtol(text.c_str(), &end, 10);
-  if (text.empty() || *end != '\0' || errno == ERANGE || value < -2147483647L || value > 2147483647L) {
+  if (text.empty() || *end != '\0' || errno == ERANGE || value < -2147483647L ||
+      value > 2147483647L) {
     throw UsageError("--" + name + " expects an integer, got '" + text + "'");
   }
   return static_cast<int>(value);

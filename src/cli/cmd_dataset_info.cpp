@@ -16,7 +16,8 @@ cv::Size commonImageSize(const std::string& directory, const std::vector<Calibra
   for (const CalibratedView& view : views) {
     const cv::Size this_size = loadViewImage(directory, view).size();
     if (size.area() > 0 && this_size != size) {
-      throw std::runtime_error(directory + "/" + view.name + ": image size differs from the others");
+      throw std::runtime_error(directory + "/" + view.name +
+                               ": image size differs from the others");
     }
     size = this_size;
   }

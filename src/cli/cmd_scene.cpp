@@ -11,7 +11,8 @@ namespace cli {
 namespace {
 
 double millisecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
 }
 
 cv::Size parseSize(const std::string& text) {
@@ -57,9 +58,10 @@ SceneConfig configFromArgs(const ArgParser& parser) {
 
 int runScene(const std::vector<std::string>& args) {
   const SceneConfig defaults;
-  ArgParser parser("scene",
-                   "Ray-casts a textured object made of analytic primitives, seen by N cameras, and\n"
-                   "writes images, silhouettes, depth maps (PFM) and a Middlebury par file.");
+  ArgParser parser(
+      "scene",
+      "Ray-casts a textured object made of analytic primitives, seen by N cameras, and\n"
+      "writes images, silhouettes, depth maps (PFM) and a Middlebury par file.");
   parser.addOption("out", "DIR", "output directory (created when missing)");
   parser.addOption("views", "N", "number of cameras", std::to_string(defaults.views));
   parser.addOption("size", "WxH", "image size in pixels",

@@ -29,10 +29,11 @@ void checkIntrinsics(const Eigen::Matrix3d& K) {
 
 void checkRotation(const Eigen::Matrix3d& R) {
   if (!R.allFinite()) throw std::invalid_argument("R has a non-finite entry");
-  const double orthogonality = (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+  const double orthogonality =
+      (R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
   if (orthogonality > kRotationTolerance) {
-    throw std::invalid_argument("R is not orthonormal (max |R^T R - I| = " +
-                                std::to_string(orthogonality) + ")");
+    throw std::invalid_argument(
+        "R is not orthonormal (max |R^T R - I| = " + std::to_string(orthogonality) + ")");
   }
   if (R.determinant() < 0.0) throw std::invalid_argument("R has det -1 (a reflection)");
 }

@@ -45,7 +45,8 @@ TrueCorrespondence trueCorrespondence(const DepthView& a, const DepthView& b,
   }
   double seen_depth;
   const bool seen = sampleDepth(b.depth, result.pixel_b, &seen_depth);
-  const bool agrees = seen && std::abs(seen_depth - depth_in_b) <= relative_depth_tolerance * depth_in_b;
+  const bool agrees =
+      seen && std::abs(seen_depth - depth_in_b) <= relative_depth_tolerance * depth_in_b;
   result.visibility = agrees ? Visibility::kVisible : Visibility::kOccluded;
   return result;
 }

@@ -74,9 +74,9 @@ CalibratedView makeView(const std::string& name, const Line& line, const std::st
 CalibratedView parseParLine(const Line& line, const std::string& path) {
   constexpr size_t kFields = 1 + 9 + 9 + 3;
   if (line.fields.size() != kFields) {
-    throw ParseError(path, line.number,
-                     "expected 22 fields (name, K, R, t), found " +
-                         std::to_string(line.fields.size()));
+    throw ParseError(
+        path, line.number,
+        "expected 22 fields (name, K, R, t), found " + std::to_string(line.fields.size()));
   }
   const Eigen::Matrix3d K = parseMatrix<3, 3>(line, 1, path);
   const Eigen::Matrix3d R = parseMatrix<3, 3>(line, 10, path);

@@ -42,7 +42,8 @@ Eigen::Vector3d viewDirection(const SceneConfig& config, int i, std::mt19937* rn
           std::sin(elevation)};
 }
 
-/// Rotation (rows: camera x right, y down, z forward) of a camera looking from `centre` at `target`.
+/// Rotation (rows: camera x right, y down, z forward) of a camera looking from `centre` at
+/// `target`.
 Eigen::Matrix3d lookAt(const Eigen::Vector3d& centre, const Eigen::Vector3d& target) {
   const Eigen::Vector3d z = (target - centre).normalized();
   const Eigen::Vector3d x = z.cross(Eigen::Vector3d::UnitZ()).normalized();
@@ -54,8 +55,8 @@ Eigen::Matrix3d lookAt(const Eigen::Vector3d& centre, const Eigen::Vector3d& tar
 
 Eigen::Matrix3d intrinsics(const SceneConfig& config, const Shape& shape) {
   const double half_angle = std::asin(shape.boundingRadius() / config.camera_distance_m);
-  const double focal_px =
-      0.5 * config.fill_fraction * std::min(config.width_px, config.height_px) / std::tan(half_angle);
+  const double focal_px = 0.5 * config.fill_fraction * std::min(config.width_px, config.height_px) /
+                          std::tan(half_angle);
   Eigen::Matrix3d K;
   K << focal_px, 0.0, 0.5 * (config.width_px - 1), 0.0, focal_px, 0.5 * (config.height_px - 1), 0.0,
       0.0, 1.0;
@@ -77,7 +78,8 @@ void shadePixel(const Shape& shape, const PinholeCamera& camera, const Eigen::Ve
   const Eigen::Vector3d X_W = origin + hit.distance * direction;
   const double shading = 0.35 + 0.65 * std::max(0.0, hit.normal_W.dot(light_W));
   const cv::Vec3f albedo = solidTexture(X_W, seed);
-  for (int c = 0; c < 3; ++c) (*colour)[c] = cv::saturate_cast<uint8_t>(255.0 * shading * albedo[c]);
+  for (int c = 0; c < 3; ++c)
+    (*colour)[c] = cv::saturate_cast<uint8_t>(255.0 * shading * albedo[c]);
   *inside = 255;
   *depth = static_cast<float>(camera.depth(X_W));
 }
@@ -148,9 +150,10 @@ std::vector<CalibratedView> sceneCameras(const SceneConfig& config, const Shape&
   std::vector<CalibratedView> views;
   for (int i = 0; i < config.views; ++i) {
     const Eigen::Vector3d target = shape.boundingCentre();
-    const Eigen::Vector3d centre = target + config.camera_distance_m * viewDirection(config, i, &rng);
-    views.push_back({numbered("view", i, "png"),
-                     PinholeCamera::fromCentre(K, lookAt(centre, target), centre)});
+    const Eigen::Vector3d centre =
+        target + config.camera_distance_m * viewDirection(config, i, &rng);
+    views.push_back(
+        {numbered("view", i, "png"), PinholeCamera::fromCentre(K, lookAt(centre, target), centre)});
   }
   return views;
 }
