@@ -6,3 +6,4 @@ workspace="${SIFT_HULL_WORKSPACE:-$repo_root/.catkin_ws}"
 export PATH="/usr/bin:/bin:$PATH"
 unset PYTHONHOME PYTHONPATH VIRTUAL_ENV
 export PYENV_VERSION=system
+mkdir -p "$workspace"

@@ -8,7 +8,7 @@ source "$here/common.sh"
 
 bash "$here/setup.sh"
 bash "$here/build.sh" 2>"$workspace/build.log" >/dev/null || {
-  tail -n 60 "$workspace/build.log" >&2
+  tail -n 60 "$workspace/build.log" >&2 || true
   echo "0 passed, 1 failed (the build failed)"
   exit 1
 }
@@ -16,7 +16,7 @@ cd "$workspace"
 rm -rf build/test_results
 log="$workspace/run_tests.log"
 if ! catkin_make run_tests -j"$(nproc)" >"$log" 2>&1; then
-  tail -n 60 "$log" >&2
+  tail -n 60 "$log" >&2 || true
   echo "0 passed, 1 failed (building or running the tests failed)"
   exit 1
 fi
