@@ -13,14 +13,15 @@ sift_hull="$(bash "$here/build.sh" 2>"$workspace/build.log" | tail -n 1)"
 mkdir -p "$out"
 echo "rendering the synthetic scene ..."
 "$sift_hull" scene --out "$out/scene" --views 16 --size 640x480
-"$sift_hull" dataset-info --calib "$out/scene/scene_par.txt" --json >"$out/scene_info.json"
-"$sift_hull" dataset-info --calib "$out/scene/scene_par.txt" | tail -n 1
+info=(dataset-info --calib "$out/scene/scene_par.txt" --silhouettes "$out/scene/masks")
+"$sift_hull" "${info[@]}" --json >"$out/scene_info.json"
+"$sift_hull" "${info[@]}" | tail -n 1
 
 cat <<SUMMARY
 
 sift_hull demo done.
   program        $sift_hull
-  scene          $out/scene  (view_*.png images, mask_*.png silhouettes,
-                 depth_*.pfm depth maps, scene_par.txt cameras, scene.json settings)
+  scene          $out/scene  (view_*.png images, masks/ silhouettes, depth/ depth maps,
+                 scene_par.txt cameras, scene.json settings)
   scene summary  $out/scene_info.json
 SUMMARY

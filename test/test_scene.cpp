@@ -129,8 +129,33 @@ TEST_F(WrittenScene, ReadsBackExactly) {
     EXPECT_EQ(cv::norm(scene.depths[i], rendered_[i].depth, cv::NORM_INF), 0.0);
     const cv::Mat image = cv::imread(directory_ + "/" + scene.views[i].name);
     EXPECT_EQ(cv::norm(image, rendered_[i].image, cv::NORM_INF), 0.0);
-    const cv::Mat mask = cv::imread(directory_ + "/" + maskName(i), cv::IMREAD_GRAYSCALE);
+    const cv::Mat mask =
+        cv::imread(directory_ + "/masks/" + scene.views[i].name, cv::IMREAD_GRAYSCALE);
     EXPECT_EQ(cv::norm(mask, rendered_[i].mask, cv::NORM_INF), 0.0);
+  }
+}
+
+TEST_F(WrittenScene, SilhouettesLoadFromMasksAndFromImages) {
+  const SceneData scene = readScene(directory_);
+  const std::vector<cv::Mat> from_masks =
+      loadSilhouettes(scene.views, directory_, directory_ + "/" + kMaskDirectory, {});
+  SilhouetteConfig dark_background;  // the scene's background is black: a low threshold suffices
+  dark_background.threshold = 0.02;
+  dark_background.dilate_px = dark_background.erode_px = 1;
+  const std::vector<cv::Mat> from_images =
+      loadSilhouettes(scene.views, directory_, "", dark_background);
+  ASSERT_EQ(from_masks.size(), rendered_.size());
+  for (size_t i = 0; i < rendered_.size(); ++i) {
+    EXPECT_EQ(cv::norm(from_masks[i], rendered_[i].mask, cv::NORM_INF), 0.0);
+    EXPECT_GT(intersectionOverUnion(from_images[i], rendered_[i].mask), 0.99);
+  }
+  const std::string other = test::temporaryDirectory();
+  cv::imwrite(other + "/" + scene.views[0].name, cv::Mat(10, 10, CV_8UC1, cv::Scalar(255)));
+  try {
+    loadSilhouettes({scene.views[0]}, directory_, other, {});
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), other + "/view_0000.png: mask size differs from the image's");
   }
 }
 

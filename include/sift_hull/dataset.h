@@ -68,6 +68,15 @@ cv::Mat silhouetteFromImage(const cv::Mat& image, const SilhouetteConfig& config
 /// Throws std::runtime_error naming the file when it is missing or unreadable.
 cv::Mat loadMask(const std::string& path);
 
+/// Silhouettes of all views, in view order: the mask file of each view's name in `mask_directory`
+/// when that is not empty, else extracted from the view's image in `image_directory` by `recipe`.
+/// Throws std::runtime_error naming a missing or unreadable file, or a mask whose size differs from
+/// its image's.
+std::vector<cv::Mat> loadSilhouettes(const std::vector<CalibratedView>& views,
+                                     const std::string& image_directory,
+                                     const std::string& mask_directory,
+                                     const SilhouetteConfig& recipe);
+
 /// Where the views' optical axes come closest to meeting (least squares over the axes).
 struct CommonPoint {
   Eigen::Vector3d point_W = Eigen::Vector3d::Zero();

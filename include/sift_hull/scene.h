@@ -42,8 +42,13 @@ RenderedView renderView(const Shape& shape, const CalibratedView& view, cv::Size
 
 std::vector<RenderedView> renderScene(const SceneConfig& config);
 
-/// Writes view_NNNN.png, mask_NNNN.png, depth_NNNN.pfm, scene_par.txt (Middlebury format) and
-/// scene.json (the config) into `directory`, which is created when missing.
+/// Sub-directories of a scene directory holding, under each view's name, its mask (PNG) and its
+/// depth map (the name with the extension .pfm).
+inline constexpr const char* kMaskDirectory = "masks";
+inline constexpr const char* kDepthDirectory = "depth";
+
+/// Writes into `directory` (created when missing) the images view_NNNN.png, masks/view_NNNN.png,
+/// depth/view_NNNN.pfm, scene_par.txt (Middlebury format) and scene.json (the config).
 void writeScene(const std::string& directory, const SceneConfig& config,
                 const std::vector<RenderedView>& views);
 
@@ -57,7 +62,7 @@ struct SceneData {
 /// Throws ParseError / std::runtime_error naming the file at fault.
 SceneData readScene(const std::string& directory);
 
-std::string maskName(size_t index);
-std::string depthName(size_t index);
+/// "view_0003.png" -> "view_0003.pfm".
+std::string depthFileName(const std::string& view_name);
 
 }  // namespace sift_hull

@@ -1,8 +1,10 @@
+#include <opencv2/core.hpp>
 #include <sstream>
 
 #include "args.h"
 #include "commands.h"
 #include "sift_hull/dataset.h"
+#include "silhouette_options.h"
 
 namespace sift_hull {
 namespace cli {
@@ -52,7 +54,8 @@ std::string describe(const nlohmann::json& info) {
   text << info["views"].get<int>() << " views, images " << info["image_size"][0] << "x"
        << info["image_size"][1] << "\n";
   for (const auto& view : info["cameras"]) {
-    text << "  " << view["name"].get<std::string>() << "  centre " << view["centre"].dump() << "\n";
+    text << "  " << view["name"].get<std::string>() << "  centre " << view["centre"].dump()
+         << "  silhouette " << 100.0 * view["silhouette_fraction"].get<double>() << " %\n";
   }
   const auto& common = info["common_point"];
   text << "cameras look at a common point: "
@@ -72,9 +75,10 @@ int runDatasetInfo(const std::vector<std::string>& args) {
                    "Reads a calibration file and the images it names and reports the number of\n"
                    "views, the image size, the camera centres and whether the cameras look at a\n"
                    "common point (where their optical axes come closest, in front of every camera\n"
-                   "and inside every image).");
+                   "and inside every image), and the share of each image its silhouette covers.");
   parser.addOption("calib", "FILE", "Middlebury *_par.txt or a list of 3x4 projection matrices");
   parser.addOption("images", "DIR", "directory of the images (default: the calibration's)");
+  addSilhouetteOptions(&parser);
   parser.addFlag("json", "print the result as one JSON object");
   if (!parser.parse(args)) return 0;
   const std::string calib = parser.get("calib");
@@ -82,9 +86,15 @@ int runDatasetInfo(const std::vector<std::string>& args) {
 
   const std::vector<CalibratedView> views = readCalibration(calib);
   const cv::Size size = commonImageSize(images, views);
+  const std::vector<cv::Mat> silhouettes =
+      loadSilhouettes(views, images, parser.has("silhouettes") ? parser.get("silhouettes") : "",
+                      silhouetteConfigFromArgs(parser));
   nlohmann::json cameras = nlohmann::json::array();
-  for (const CalibratedView& view : views) {
-    cameras.push_back({{"name", view.name}, {"centre", vectorJson(view.camera.centre())}});
+  for (size_t i = 0; i < views.size(); ++i) {
+    const double fraction = cv::countNonZero(silhouettes[i]) / static_cast<double>(size.area());
+    cameras.push_back({{"name", views[i].name},
+                       {"centre", vectorJson(views[i].camera.centre())},
+                       {"silhouette_fraction", fraction}});
   }
   const nlohmann::json info = {{"calib", calib},
                                {"views", views.size()},

@@ -208,6 +208,26 @@ cv::Mat loadMask(const std::string& path) {
   return mask;
 }
 
+std::vector<cv::Mat> loadSilhouettes(const std::vector<CalibratedView>& views,
+                                     const std::string& image_directory,
+                                     const std::string& mask_directory,
+                                     const SilhouetteConfig& recipe) {
+  std::vector<cv::Mat> silhouettes;
+  for (const CalibratedView& view : views) {
+    const cv::Mat image = loadViewImage(image_directory, view);
+    if (mask_directory.empty()) {
+      silhouettes.push_back(silhouetteFromImage(image, recipe));
+      continue;
+    }
+    const std::string path = mask_directory + "/" + view.name;
+    silhouettes.push_back(loadMask(path));
+    if (silhouettes.back().size() != image.size()) {
+      throw std::runtime_error(path + ": mask size differs from the image's");
+    }
+  }
+  return silhouettes;
+}
+
 CommonPoint opticalAxesMeetingPoint(const std::vector<CalibratedView>& views) {
   // Minimises sum_i |(I - a_i a_i^T)(X - c_i)|^2 over X, a_i the unit axis and c_i the centre.
   Eigen::Matrix3d A = Eigen::Matrix3d::Zero();

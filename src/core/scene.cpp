@@ -122,8 +122,10 @@ SceneConfig configFromJson(const nlohmann::json& j) {
 
 }  // namespace
 
-std::string maskName(size_t index) { return numbered("mask", index, "png"); }
-std::string depthName(size_t index) { return numbered("depth", index, "pfm"); }
+std::string depthFileName(const std::string& view_name) {
+  const size_t dot = view_name.find_last_of('.');
+  return view_name.substr(0, dot) + ".pfm";
+}
 
 void validate(const SceneConfig& config) {
   const auto require = [](bool ok, const std::string& message) {
@@ -185,6 +187,8 @@ std::vector<RenderedView> renderScene(const SceneConfig& config) {
 void writeScene(const std::string& directory, const SceneConfig& config,
                 const std::vector<RenderedView>& views) {
   makeDirectory(directory);
+  makeDirectory(directory + "/" + kMaskDirectory);
+  makeDirectory(directory + "/" + kDepthDirectory);
   std::vector<CalibratedView> cameras;
   for (const RenderedView& view : views) cameras.push_back(view.view);
   writeMiddleburyPar(directory + "/scene_par.txt", cameras);
@@ -192,8 +196,9 @@ void writeScene(const std::string& directory, const SceneConfig& config,
   cv::parallel_for_(cv::Range(0, static_cast<int>(views.size())), [&](const cv::Range& range) {
     for (int i = range.start; i < range.end; ++i) {
       writeImage(directory + "/" + views[i].view.name, views[i].image);
-      writeImage(directory + "/" + maskName(i), views[i].mask);
-      writePfm(directory + "/" + depthName(i), views[i].depth);
+      const std::string& name = views[i].view.name;
+      writeImage(directory + "/" + kMaskDirectory + "/" + name, views[i].mask);
+      writePfm(directory + "/" + kDepthDirectory + "/" + depthFileName(name), views[i].depth);
     }
   });
 }
@@ -209,8 +214,9 @@ SceneData readScene(const std::string& directory) {
     throw ParseError(json_path, 0, e.what());
   }
   scene.views = readMiddleburyPar(directory + "/scene_par.txt");
-  for (size_t i = 0; i < scene.views.size(); ++i) {
-    scene.depths.push_back(readPfm(directory + "/" + depthName(i)));
+  for (const CalibratedView& view : scene.views) {
+    scene.depths.push_back(
+        readPfm(directory + "/" + kDepthDirectory + "/" + depthFileName(view.name)));
   }
   return scene;
 }

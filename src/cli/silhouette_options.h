@@ -1,0 +1,15 @@
+#pragma once
+
+#include "args.h"
+#include "sift_hull/dataset.h"
+
+namespace sift_hull {
+namespace cli {
+
+/// --silhouettes DIR, or --threshold / --dilate / --erode for the Middlebury recipe, with the
+/// defaults of SilhouetteConfig.
+void addSilhouetteOptions(ArgParser* parser);
+SilhouetteConfig silhouetteConfigFromArgs(const ArgParser& parser);
+
+}  // namespace cli
+}  // namespace sift_hull
