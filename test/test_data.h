@@ -4,6 +4,8 @@
 #include <sys/stat.h>
 
 #include <cstdlib>
+#include <fstream>
+#include <iterator>
 #include <string>
 
 namespace sift_hull {
@@ -33,6 +35,22 @@ inline std::string temporaryDirectory() {
   std::string pattern = std::string(base ? base : "/tmp") + "/sift_hull_test_XXXXXX";
   if (mkdtemp(pattern.data()) == nullptr) throw std::runtime_error("mkdtemp failed");
   return pattern;
+}
+
+/// Runs the sift_hull program with `arguments` (shell words); returns its exit code, its stdout in
+/// `out` and its stderr in `err`.
+inline int runProgram(const std::string& arguments, std::string* out, std::string* err) {
+  const std::string dir = temporaryDirectory();
+  const std::string command =
+      std::string(SIFT_HULL_EXECUTABLE) + " " + arguments + " >" + dir + "/out 2>" + dir + "/err";
+  const int status = std::system(command.c_str());
+  const auto slurp = [](const std::string& path) {
+    std::ifstream in(path);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  *out = slurp(dir + "/out");
+  *err = slurp(dir + "/err");
+  return WEXITSTATUS(status);
 }
 
 }  // namespace test

@@ -178,25 +178,11 @@ TEST(MiddleburyData, TempleRingLoads) {
             {0.028855, 0.181892, 0.062736});
 }
 
-/// Runs the sift_hull program; returns its exit code and stdout, stderr into `err`.
-int runProgram(const std::string& arguments, std::string* out, std::string* err) {
-  const std::string dir = test::temporaryDirectory();
-  const std::string command =
-      std::string(SIFT_HULL_EXECUTABLE) + " " + arguments + " >" + dir + "/out 2>" + dir + "/err";
-  const int status = std::system(command.c_str());
-  const auto slurp = [](const std::string& path) {
-    std::ifstream in(path);
-    return std::string(std::istreambuf_iterator<char>(in), {});
-  };
-  *out = slurp(dir + "/out");
-  *err = slurp(dir + "/err");
-  return WEXITSTATUS(status);
-}
-
 TEST(DatasetInfoCommand, ReportsDinoAsJson) {
   SIFT_HULL_REQUIRE_DATA(dir, kDino);
   std::string out, err;
-  ASSERT_EQ(runProgram("dataset-info --calib " + dir + "/dinoSR_par.txt --json", &out, &err), 0)
+  ASSERT_EQ(test::runProgram("dataset-info --calib " + dir + "/dinoSR_par.txt --json", &out, &err),
+            0)
       << err;
   EXPECT_NE(out.find("\"views\": 16"), std::string::npos) << out;
   EXPECT_NE(out.find("\"image_size\": [\n    640,\n    480\n  ]"), std::string::npos) << out;
@@ -207,10 +193,10 @@ TEST(DatasetInfoCommand, MalformedFileGivesLocatedErrorAndExitCode) {
   const std::string dir = test::temporaryDirectory();
   std::ofstream(dir + "/bad_par.txt") << "1\nview.png 1 2 3\n";
   std::string out, err;
-  EXPECT_EQ(runProgram("dataset-info --calib " + dir + "/bad_par.txt", &out, &err), 1);
+  EXPECT_EQ(test::runProgram("dataset-info --calib " + dir + "/bad_par.txt", &out, &err), 1);
   EXPECT_NE(err.find(dir + "/bad_par.txt:2: expected 22 fields"), std::string::npos) << err;
   EXPECT_TRUE(out.empty());
-  EXPECT_EQ(runProgram("dataset-info --no-such-option", &out, &err), 2);
+  EXPECT_EQ(test::runProgram("dataset-info --no-such-option", &out, &err), 2);
   EXPECT_NE(err.find("unknown option --no-such-option"), std::string::npos) << err;
 }
 
