@@ -322,6 +322,22 @@ TEST(SceneCommand, RejectsBadArgumentsWithUsageErrors) {
   EXPECT_NE(out.find("usage: sift_hull scene"), std::string::npos);
 }
 
+TEST(Correspondence, DegenerateInputsGiveDefinedAnswers) {
+  const PinholeCamera camera =
+      PinholeCamera::fromCentre((Eigen::Matrix3d() << 100, 0, 0, 0, 100, 0, 0, 0, 1).finished(),
+                                Eigen::Matrix3d::Identity(), Eigen::Vector3d(0, 0, -2));
+  const DepthView one_pixel{camera, cv::Mat(1, 1, CV_32FC1, cv::Scalar(2.0f))};
+  double depth;
+  EXPECT_TRUE(sampleDepth(one_pixel.depth, {0.2, -0.3}, &depth));
+  EXPECT_EQ(depth, 2.0);
+  EXPECT_FALSE(sampleDepth(one_pixel.depth, {NAN, 0.0}, &depth));
+  EXPECT_EQ(trueCorrespondence(one_pixel, one_pixel, {NAN, NAN}).visibility,
+            Visibility::kBackground);
+  EXPECT_EQ(trueCorrespondence(one_pixel, one_pixel, {0.0, 0.0}).visibility, Visibility::kVisible);
+  EXPECT_EQ(trueCorrespondence(one_pixel, one_pixel, {5.0, 0.0}).visibility,
+            Visibility::kBackground);
+}
+
 TEST(DepthIo, PfmRoundTripKeepsInfinityAndOrientation) {
   cv::Mat depth(3, 4, CV_32FC1);
   for (int i = 0; i < 12; ++i) depth.at<float>(i / 4, i % 4) = 0.5f * i;
@@ -334,9 +350,13 @@ TEST(DepthIo, PfmRoundTripKeepsInfinityAndOrientation) {
   EXPECT_TRUE(std::isinf(back.at<float>(0, 1)));
 }
 
-TEST(DepthIo, TruncatedPfmIsRejected) {
+TEST(DepthIo, TruncatedOrOversizedPfmIsRejected) {
   const std::string path = test::temporaryDirectory() + "/short.pfm";
   std::ofstream(path) << "Pf\n4 3\n-1\n1234";
+  EXPECT_THROW(readPfm(path), ParseError);
+  std::ofstream(path) << "Pf\n400000 300000\n-1\n";
+  EXPECT_THROW(readPfm(path), ParseError);
+  std::ofstream(path) << "PF\n4 3\n-1\n";
   EXPECT_THROW(readPfm(path), ParseError);
 }
 

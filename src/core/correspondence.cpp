@@ -11,10 +11,17 @@ bool insideImage(const cv::Mat& image, const Eigen::Vector2d& pixel) {
          pixel.y() < image.rows - 0.5;
 }
 
+bool nearestDepth(const cv::Mat& depth, const Eigen::Vector2d& pixel, double* value) {
+  *value = depth.at<float>(static_cast<int>(std::lround(pixel.y())),
+                           static_cast<int>(std::lround(pixel.x())));
+  return std::isfinite(*value);
+}
+
 }  // namespace
 
 bool sampleDepth(const cv::Mat& depth, const Eigen::Vector2d& pixel, double* value) {
   if (!insideImage(depth, pixel)) return false;
+  if (depth.cols < 2 || depth.rows < 2) return nearestDepth(depth, pixel, value);
   const int u0 = std::clamp(static_cast<int>(std::floor(pixel.x())), 0, depth.cols - 2);
   const int v0 = std::clamp(static_cast<int>(std::floor(pixel.y())), 0, depth.rows - 2);
   const double a = depth.at<float>(v0, u0), b = depth.at<float>(v0, u0 + 1);
@@ -25,9 +32,7 @@ bool sampleDepth(const cv::Mat& depth, const Eigen::Vector2d& pixel, double* val
     *value = (1 - t) * ((1 - s) * a + s * b) + t * ((1 - s) * c + s * d);
     return true;
   }
-  *value = depth.at<float>(static_cast<int>(std::lround(pixel.y())),
-                           static_cast<int>(std::lround(pixel.x())));
-  return std::isfinite(*value);
+  return nearestDepth(depth, pixel, value);
 }
 
 TrueCorrespondence trueCorrespondence(const DepthView& a, const DepthView& b,

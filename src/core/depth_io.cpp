@@ -51,7 +51,8 @@ cv::Mat readPfm(const std::string& path) {
   double scale = 0.0;
   in >> magic >> width >> height >> scale;
   if (!in || magic != "Pf") throw ParseError(path, 1, "not a one-channel PFM (expected 'Pf')");
-  if (width <= 0 || height <= 0 || scale == 0.0) {
+  constexpr int kMaxSide = 1 << 15;
+  if (width <= 0 || height <= 0 || width > kMaxSide || height > kMaxSide || scale == 0.0) {
     throw ParseError(path, 2, "bad PFM size or scale");
   }
   in.get();  // the single white-space character ending the header
