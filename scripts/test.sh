@@ -9,7 +9,8 @@ source "$here/common.sh"
 bash "$here/setup.sh"
 bash "$here/build.sh" 2>"$workspace/build.log" >/dev/null || {
   tail -n 60 "$workspace/build.log" >&2 || true
-  echo "0 passed, 1 failed (the build failed)"
+  echo "the build failed"
+  echo "0 passed, 1 failed"
   exit 1
 }
 cd "$workspace"
@@ -17,7 +18,8 @@ rm -rf build/test_results
 log="$workspace/run_tests.log"
 if ! catkin_make run_tests -j"$(nproc)" >"$log" 2>&1; then
   tail -n 60 "$log" >&2 || true
-  echo "0 passed, 1 failed (building or running the tests failed)"
+  echo "building or running the tests failed"
+  echo "0 passed, 1 failed"
   exit 1
 fi
 /usr/bin/python3 "$here/count_tests.py" build/test_results

@@ -21,7 +21,16 @@ Eigen::Matrix3d randomRotation(std::mt19937* rng) {
       .toRotationMatrix();
 }
 
-/// A camera at distance 3..5 from the origin looking roughly at it.
+/// Focal lengths 300..3000 px, a small skew and a principal point anywhere in a 640x480 image.
+Eigen::Matrix3d randomK(std::mt19937* rng) {
+  std::uniform_real_distribution<double> focal(300.0, 3000.0), unit(0.0, 1.0);
+  Eigen::Matrix3d K;
+  K << focal(*rng), unit(*rng) - 0.5, 640.0 * unit(*rng), 0.0, focal(*rng), 480.0 * unit(*rng), 0.0,
+      0.0, 1.0;
+  return K;
+}
+
+/// A camera with a random K at distance 3..5 from the origin looking roughly at it.
 PinholeCamera randomCamera(std::mt19937* rng) {
   std::uniform_real_distribution<double> angle(-0.2, 0.2);
   const Eigen::Matrix3d R = randomRotation(rng);
@@ -30,7 +39,7 @@ PinholeCamera randomCamera(std::mt19937* rng) {
                                    .toRotationMatrix();
   const double distance = std::uniform_real_distribution<double>(3.0, 5.0)(*rng);
   const Eigen::Vector3d centre = -distance * R.row(2).transpose();
-  return PinholeCamera::fromCentre(exampleK(), tilt * R, centre);
+  return PinholeCamera::fromCentre(randomK(rng), tilt * R, centre);
 }
 
 Eigen::Vector3d randomPoint(std::mt19937* rng) {

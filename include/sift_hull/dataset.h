@@ -26,21 +26,23 @@ class ParseError : public std::runtime_error {
 struct CalibratedView {
   std::string name;  ///< image file name as written in the calibration file (may be empty)
   PinholeCamera camera;
+  std::string source;  ///< "FILE:LINE" the view was read from; empty when made in code
 };
 
 /// Reads a Middlebury `*_par.txt`: a count line, then one line per view
 /// `name k11 k12 k13 k21 k22 k23 k31 k32 k33 r11 r12 r13 r21 r22 r23 r31 r32 r33 t1 t2 t3`.
-/// Throws ParseError naming the file and line on a wrong field count, a non-number, NaN or
-/// infinity, a singular K, an R that is not a rotation, or a count line that disagrees with the
-/// lines.
+/// Throws ParseError naming the file and line on a missing or malformed count line, a count outside
+/// 1..1000000, a wrong field count, a non-number, NaN or infinity, a singular K, an R that is not a
+/// rotation, or a count line that disagrees with the lines.
 std::vector<CalibratedView> readMiddleburyPar(const std::string& path);
 
 /// Reads a list of 3x4 projection matrices, one per line as 12 row-major numbers, each optionally
-/// preceded by an image name. Blank lines and lines starting with '#' are skipped. Throws
-/// ParseError.
+/// preceded by an image name (which must not be a number). Blank lines and lines starting with '#'
+/// are skipped. Throws ParseError naming the file and line.
 std::vector<CalibratedView> readProjectionList(const std::string& path);
 
-/// Reads either format: a first line holding a single integer means a Middlebury par file.
+/// Reads either format: a first line holding a single integer means a Middlebury par file. A first
+/// line shaped like a par line (a name and 21 numbers) is reported as a missing count line.
 std::vector<CalibratedView> readCalibration(const std::string& path);
 
 /// Writes views as a Middlebury par file (17 significant digits, so reading it back is exact).
@@ -49,8 +51,9 @@ void writeMiddleburyPar(const std::string& path, const std::vector<CalibratedVie
 /// Directory of a file path ("." when it has none).
 std::string parentDirectory(const std::string& path);
 
-/// Reads the image a view names, from `directory`. Throws std::runtime_error naming the file when
-/// it is missing or cannot be decoded. Colour images come back as BGR, 8 bits per channel.
+/// Reads the image a view names, from `directory`. Throws std::runtime_error naming the image and
+/// the calibration line that names it when the view has no image name or the image is missing or
+/// cannot be decoded. Colour images come back as BGR, 8 bits per channel.
 cv::Mat loadViewImage(const std::string& directory, const CalibratedView& view);
 
 /// Silhouette extraction by the Middlebury recipe: grey intensity above `threshold` (on [0, 1]),
@@ -80,7 +83,7 @@ std::vector<cv::Mat> loadSilhouettes(const std::vector<CalibratedView>& views,
 /// Where the views' optical axes come closest to meeting (least squares over the axes).
 struct CommonPoint {
   Eigen::Vector3d point_W = Eigen::Vector3d::Zero();
-  double max_axis_distance =
+  double max_axis_distance_m =
       0.0;  ///< largest distance of the point from an optical axis (world units)
   bool in_front_of_all = false;  ///< the point has positive depth in every view
   bool well_defined = false;     ///< the axes are not all parallel (needs two views or more)

@@ -14,7 +14,7 @@ struct Primitive {
   Eigen::Matrix3d R_W_P = Eigen::Matrix3d::Identity();  ///< primitive axes in world coordinates
   /// Sphere: radius in x. Box: half extents. Torus (axis = local z): major radius in x, tube radius
   /// in y.
-  Eigen::Vector3d size = Eigen::Vector3d::Ones();
+  Eigen::Vector3d size_m = Eigen::Vector3d::Ones();
 
   bool contains(const Eigen::Vector3d& X_W) const;
   /// Radius of a sphere about centre_W holding the primitive.
@@ -23,7 +23,7 @@ struct Primitive {
 
 /// Where a ray first enters a solid.
 struct RayHit {
-  double distance = 0.0;                               ///< along the unit ray direction
+  double distance_m = 0.0;                             ///< along the unit ray direction
   Eigen::Vector3d normal_W = Eigen::Vector3d::Zero();  ///< outward unit normal at the hit
 };
 

@@ -12,18 +12,16 @@ namespace {
 
 nlohmann::json vectorJson(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 
-/// Size shared by all the views' images; throws when they differ or one is missing.
-cv::Size commonImageSize(const std::string& directory, const std::vector<CalibratedView>& views) {
-  cv::Size size;
-  for (const CalibratedView& view : views) {
-    const cv::Size this_size = loadViewImage(directory, view).size();
-    if (size.area() > 0 && this_size != size) {
-      throw std::runtime_error(directory + "/" + view.name +
-                               ": image size differs from the others");
+/// Size shared by all the views' silhouettes (each the size of its image); throws when they differ.
+cv::Size commonImageSize(const std::string& directory, const std::vector<CalibratedView>& views,
+                         const std::vector<cv::Mat>& silhouettes) {
+  for (size_t i = 1; i < views.size(); ++i) {
+    if (silhouettes[i].size() != silhouettes[0].size()) {
+      throw std::runtime_error(directory + "/" + views[i].name + ": image size differs from " +
+                               views[0].name + "'s");
     }
-    size = this_size;
   }
-  return size;
+  return silhouettes.front().size();
 }
 
 bool projectsInside(const std::vector<CalibratedView>& views, const Eigen::Vector3d& X_W,
@@ -43,7 +41,7 @@ nlohmann::json commonPointJson(const std::vector<CalibratedView>& views, cv::Siz
   if (!common.well_defined) return {{"looks_at_common_point", false}, {"point", nullptr}};
   const bool inside = projectsInside(views, common.point_W, size);
   return {{"point", vectorJson(common.point_W)},
-          {"max_axis_distance", common.max_axis_distance},
+          {"max_axis_distance_m", common.max_axis_distance_m},
           {"in_front_of_all", common.in_front_of_all},
           {"projects_inside_all", inside},
           {"looks_at_common_point", common.in_front_of_all && inside}};
@@ -62,7 +60,7 @@ std::string describe(const nlohmann::json& info) {
        << (common["looks_at_common_point"].get<bool>() ? "yes" : "no");
   if (!common["point"].is_null()) {
     text << " (" << common["point"].dump() << ", farthest optical axis "
-         << common["max_axis_distance"].get<double>() << " away)";
+         << common["max_axis_distance_m"].get<double>() << " away)";
   }
   text << "\n";
   return text.str();
@@ -85,10 +83,10 @@ int runDatasetInfo(const std::vector<std::string>& args) {
   const std::string images = parser.has("images") ? parser.get("images") : parentDirectory(calib);
 
   const std::vector<CalibratedView> views = readCalibration(calib);
-  const cv::Size size = commonImageSize(images, views);
   const std::vector<cv::Mat> silhouettes =
       loadSilhouettes(views, images, parser.has("silhouettes") ? parser.get("silhouettes") : "",
                       silhouetteConfigFromArgs(parser));
+  const cv::Size size = commonImageSize(images, views, silhouettes);
   nlohmann::json cameras = nlohmann::json::array();
   for (size_t i = 0; i < views.size(); ++i) {
     const double fraction = cv::countNonZero(silhouettes[i]) / static_cast<double>(size.area());

@@ -1,6 +1,7 @@
 #include "sift_hull/dataset.h"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -37,13 +38,15 @@ std::vector<Line> readFields(const std::string& path) {
   return lines;
 }
 
-double parseNumber(const std::string& word, const std::string& path, int line) {
-  errno = 0;
+bool isNumber(const std::string& word) {
   char* end = nullptr;
-  const double value = std::strtod(word.c_str(), &end);
-  if (end == word.c_str() || *end != '\0' || errno == ERANGE) {
-    throw ParseError(path, line, "'" + word + "' is not a number");
-  }
+  std::strtod(word.c_str(), &end);
+  return end != word.c_str() && *end == '\0';
+}
+
+double parseNumber(const std::string& word, const std::string& path, int line) {
+  if (!isNumber(word)) throw ParseError(path, line, "'" + word + "' is not a number");
+  const double value = std::strtod(word.c_str(), nullptr);  // underflow to 0 or a subnormal is fine
   if (!std::isfinite(value)) throw ParseError(path, line, "'" + word + "' is not finite");
   return value;
 }
@@ -65,7 +68,7 @@ template <typename MakeCamera>
 CalibratedView makeView(const std::string& name, const Line& line, const std::string& path,
                         MakeCamera make_camera) {
   try {
-    return CalibratedView{name, make_camera()};
+    return CalibratedView{name, make_camera(), location(path, line.number)};
   } catch (const std::invalid_argument& e) {
     throw ParseError(path, line.number, e.what());
   }
@@ -92,23 +95,39 @@ CalibratedView parseProjectionLine(const Line& line, const std::string& path) {
                          std::to_string(n) + " fields");
   }
   const size_t first = n - 12;
+  if (first == 1 && isNumber(line.fields[0])) {
+    throw ParseError(
+        path, line.number,
+        "expected an image name before the 12 numbers, found '" + line.fields[0] + "'");
+  }
   const Matrix34d P = parseMatrix<3, 4>(line, first, path);
   const std::string name = first == 1 ? line.fields[0] : std::string();
   return makeView(name, line, path, [&] { return PinholeCamera::fromProjection(P); });
 }
 
 int parseCount(const Line& line, const std::string& path) {
+  constexpr long kMaxViews = 1000000;
   const std::string& word = line.fields[0];
+  errno = 0;
   char* end = nullptr;
   const long count = std::strtol(word.c_str(), &end, 10);
-  if (line.fields.size() != 1 || *end != '\0' || count < 0) {
+  if (line.fields.size() != 1 || end == word.c_str() || *end != '\0') {
     throw ParseError(path, line.number, "expected a count line with the number of views");
+  }
+  if (count < 1 || count > kMaxViews || errno == ERANGE) {
+    throw ParseError(path, line.number,
+                     "the count line must give between 1 and 1000000 views, not " + word);
   }
   return static_cast<int>(count);
 }
 
 /// Checked before cv::imread, which logs its own warning for a missing file.
 bool isReadableFile(const std::string& path) { return std::ifstream(path).good(); }
+
+/// A line of a par file (22 fields, a name first) where a projection list was expected.
+bool looksLikeParLine(const Line& line) {
+  return line.fields.size() == 22 && !isNumber(line.fields[0]);
+}
 
 bool looksLikeCountLine(const Line& line) {
   if (line.fields.size() != 1) return false;
@@ -146,6 +165,10 @@ std::vector<CalibratedView> readProjectionList(const std::string& path) {
 std::vector<CalibratedView> readCalibration(const std::string& path) {
   const std::vector<Line> lines = readFields(path);
   if (!lines.empty() && looksLikeCountLine(lines.front())) return readMiddleburyPar(path);
+  if (!lines.empty() && looksLikeParLine(lines.front())) {
+    throw ParseError(path, lines.front().number,
+                     "a Middlebury par line, but the file has no count line before it");
+  }
   return readProjectionList(path);
 }
 
@@ -175,11 +198,15 @@ std::string parentDirectory(const std::string& path) {
 }
 
 cv::Mat loadViewImage(const std::string& directory, const CalibratedView& view) {
-  if (view.name.empty()) throw std::runtime_error("the calibration names no image for a view");
+  const std::string named_at = view.source.empty() ? "" : " (named at " + view.source + ")";
+  if (view.name.empty()) {
+    throw std::runtime_error((view.source.empty() ? "a view" : view.source) +
+                             ": no image name for this view; put one before its numbers");
+  }
   const std::string path = directory + "/" + view.name;
-  if (!isReadableFile(path)) throw std::runtime_error(path + ": image missing or unreadable");
-  cv::Mat image = cv::imread(path, cv::IMREAD_COLOR);
-  if (image.empty()) throw std::runtime_error(path + ": image missing or unreadable");
+  cv::Mat image;
+  if (isReadableFile(path)) image = cv::imread(path, cv::IMREAD_COLOR);
+  if (image.empty()) throw std::runtime_error(path + ": image missing or unreadable" + named_at);
   return image;
 }
 
@@ -248,7 +275,7 @@ CommonPoint opticalAxesMeetingPoint(const std::vector<CalibratedView>& views) {
     const Eigen::Vector3d axis = view.camera.opticalAxis();
     const Eigen::Vector3d offset = result.point_W - view.camera.centre();
     const double distance = (offset - axis * axis.dot(offset)).norm();
-    result.max_axis_distance = std::max(result.max_axis_distance, distance);
+    result.max_axis_distance_m = std::max(result.max_axis_distance_m, distance);
     result.in_front_of_all &= view.camera.depth(result.point_W) > 0.0;
   }
   return result;

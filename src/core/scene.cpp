@@ -1,9 +1,8 @@
 #include "sift_hull/scene.h"
 
-#include <sys/stat.h>
-
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <nlohmann/json.hpp>
@@ -75,7 +74,7 @@ void shadePixel(const Shape& shape, const PinholeCamera& camera, const Eigen::Ve
     *depth = std::numeric_limits<float>::infinity();
     return;
   }
-  const Eigen::Vector3d X_W = origin + hit.distance * direction;
+  const Eigen::Vector3d X_W = origin + hit.distance_m * direction;
   const double shading = 0.35 + 0.65 * std::max(0.0, hit.normal_W.dot(light_W));
   const cv::Vec3f albedo = solidTexture(X_W, seed);
   for (int c = 0; c < 3; ++c)
@@ -85,9 +84,9 @@ void shadePixel(const Shape& shape, const PinholeCamera& camera, const Eigen::Ve
 }
 
 void makeDirectory(const std::string& directory) {
-  if (mkdir(directory.c_str(), 0755) != 0 && errno != EEXIST) {
-    throw std::runtime_error(directory + ": cannot create directory");
-  }
+  std::error_code error;
+  std::filesystem::create_directories(directory, error);
+  if (error) throw std::runtime_error(directory + ": cannot create directory: " + error.message());
 }
 
 void writeImage(const std::string& path, const cv::Mat& image) {
@@ -154,8 +153,8 @@ std::vector<CalibratedView> sceneCameras(const SceneConfig& config, const Shape&
     const Eigen::Vector3d target = shape.boundingCentre();
     const Eigen::Vector3d centre =
         target + config.camera_distance_m * viewDirection(config, i, &rng);
-    views.push_back(
-        {numbered("view", i, "png"), PinholeCamera::fromCentre(K, lookAt(centre, target), centre)});
+    views.push_back({numbered("view", i, "png"),
+                     PinholeCamera::fromCentre(K, lookAt(centre, target), centre), ""});
   }
   return views;
 }
@@ -192,7 +191,10 @@ void writeScene(const std::string& directory, const SceneConfig& config,
   std::vector<CalibratedView> cameras;
   for (const RenderedView& view : views) cameras.push_back(view.view);
   writeMiddleburyPar(directory + "/scene_par.txt", cameras);
-  std::ofstream(directory + "/scene.json") << toJson(config).dump(2) << '\n';
+  const std::string json_path = directory + "/scene.json";
+  std::ofstream json_file(json_path);
+  json_file << toJson(config).dump(2) << '\n';
+  if (!json_file) throw std::runtime_error(json_path + ": cannot write file");
   cv::parallel_for_(cv::Range(0, static_cast<int>(views.size())), [&](const cv::Range& range) {
     for (int i = range.start; i < range.end; ++i) {
       writeImage(directory + "/" + views[i].view.name, views[i].image);

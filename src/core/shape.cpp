@@ -95,13 +95,13 @@ bool hitPrimitive(const Primitive& part, const Eigen::Vector3d& origin,
   bool found = false;
   switch (part.type) {
     case Primitive::Type::kSphere:
-      found = hitSphere(ray, part.size.x(), &hit->distance, &normal_P);
+      found = hitSphere(ray, part.size_m.x(), &hit->distance_m, &normal_P);
       break;
     case Primitive::Type::kBox:
-      found = hitBox(ray, part.size, &hit->distance, &normal_P);
+      found = hitBox(ray, part.size_m, &hit->distance_m, &normal_P);
       break;
     case Primitive::Type::kTorus:
-      found = hitTorus(ray, part.size.x(), part.size.y(), &hit->distance, &normal_P);
+      found = hitTorus(ray, part.size_m.x(), part.size_m.y(), &hit->distance_m, &normal_P);
       break;
   }
   if (found) hit->normal_W = part.R_W_P * normal_P;
@@ -112,13 +112,13 @@ bool hitPrimitive(const Primitive& part, const Eigen::Vector3d& origin,
 Eigen::Vector3d halfExtents(const Primitive& p) {
   switch (p.type) {
     case Primitive::Type::kSphere:
-      return Eigen::Vector3d::Constant(p.size.x());
+      return Eigen::Vector3d::Constant(p.size_m.x());
     case Primitive::Type::kBox:
-      return p.R_W_P.cwiseAbs() * p.size;
+      return p.R_W_P.cwiseAbs() * p.size_m;
     case Primitive::Type::kTorus: {
       const Eigen::Vector3d axis = p.R_W_P.col(2);
       const Eigen::Vector3d in_plane = (1.0 - axis.array().square()).max(0.0).sqrt();
-      return p.size.x() * in_plane + Eigen::Vector3d::Constant(p.size.y());
+      return p.size_m.x() * in_plane + Eigen::Vector3d::Constant(p.size_m.y());
     }
   }
   return Eigen::Vector3d::Zero();
@@ -130,19 +130,19 @@ double farthestDistance(const Primitive& p, const Eigen::Vector3d& X_W) {
   double farthest = 0.0;
   for (int corner = 0; corner < 8; ++corner) {
     const Eigen::Vector3d sign(corner & 1 ? 1 : -1, corner & 2 ? 1 : -1, corner & 4 ? 1 : -1);
-    const Eigen::Vector3d corner_W = p.centre_W + p.R_W_P * sign.cwiseProduct(p.size);
+    const Eigen::Vector3d corner_W = p.centre_W + p.R_W_P * sign.cwiseProduct(p.size_m);
     farthest = std::max(farthest, (corner_W - X_W).norm());
   }
   return farthest;
 }
 
 Primitive makePrimitive(Primitive::Type type, const Eigen::Vector3d& centre,
-                        const Eigen::Vector3d& size,
+                        const Eigen::Vector3d& size_m,
                         const Eigen::Matrix3d& R = Eigen::Matrix3d::Identity()) {
   Primitive p;
   p.type = type;
   p.centre_W = centre;
-  p.size = size;
+  p.size_m = size_m;
   p.R_W_P = R;
   return p;
 }
@@ -157,11 +157,11 @@ bool Primitive::contains(const Eigen::Vector3d& X_W) const {
   const Eigen::Vector3d p = R_W_P.transpose() * (X_W - centre_W);
   switch (type) {
     case Type::kSphere:
-      return p.squaredNorm() < size.x() * size.x();
+      return p.squaredNorm() < size_m.x() * size_m.x();
     case Type::kBox:
-      return (p.cwiseAbs().array() < size.array()).all();
+      return (p.cwiseAbs().array() < size_m.array()).all();
     case Type::kTorus:
-      return torusDistance(p, size.x(), size.y()) < 0.0;
+      return torusDistance(p, size_m.x(), size_m.y()) < 0.0;
   }
   return false;
 }
@@ -169,11 +169,11 @@ bool Primitive::contains(const Eigen::Vector3d& X_W) const {
 double Primitive::boundingRadius() const {
   switch (type) {
     case Type::kSphere:
-      return size.x();
+      return size_m.x();
     case Type::kBox:
-      return size.norm();
+      return size_m.norm();
     case Type::kTorus:
-      return size.x() + size.y();
+      return size_m.x() + size_m.y();
   }
   return 0.0;
 }
@@ -227,7 +227,7 @@ bool Shape::firstHit(const Eigen::Vector3d& origin, const Eigen::Vector3d& direc
   for (const Primitive& part : parts_) {
     RayHit candidate;
     if (hitPrimitive(part, origin, direction, &candidate) &&
-        (!found || candidate.distance < hit->distance)) {
+        (!found || candidate.distance_m < hit->distance_m)) {
       *hit = candidate;
       found = true;
     }
