@@ -83,8 +83,8 @@ std::vector<cv::Mat> loadSilhouettes(const std::vector<CalibratedView>& views,
 /// Where the views' optical axes come closest to meeting (least squares over the axes).
 struct CommonPoint {
   Eigen::Vector3d point_W = Eigen::Vector3d::Zero();
-  double max_axis_distance_m =
-      0.0;  ///< largest distance of the point from an optical axis (world units)
+  /// Largest distance of the point from an optical axis, in world units (metres for scenes).
+  double max_axis_distance_m = 0.0;
   bool in_front_of_all = false;  ///< the point has positive depth in every view
   bool well_defined = false;     ///< the axes are not all parallel (needs two views or more)
 };

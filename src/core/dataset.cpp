@@ -38,15 +38,21 @@ std::vector<Line> readFields(const std::string& path) {
   return lines;
 }
 
-bool isNumber(const std::string& word) {
+/// True when the whole word is a number; an underflow to 0 or a subnormal counts as one.
+bool readDouble(const std::string& word, double* value) {
   char* end = nullptr;
-  std::strtod(word.c_str(), &end);
+  *value = std::strtod(word.c_str(), &end);
   return end != word.c_str() && *end == '\0';
 }
 
+bool isNumber(const std::string& word) {
+  double ignored;
+  return readDouble(word, &ignored);
+}
+
 double parseNumber(const std::string& word, const std::string& path, int line) {
-  if (!isNumber(word)) throw ParseError(path, line, "'" + word + "' is not a number");
-  const double value = std::strtod(word.c_str(), nullptr);  // underflow to 0 or a subnormal is fine
+  double value;
+  if (!readDouble(word, &value)) throw ParseError(path, line, "'" + word + "' is not a number");
   if (!std::isfinite(value)) throw ParseError(path, line, "'" + word + "' is not finite");
   return value;
 }
@@ -121,8 +127,11 @@ int parseCount(const Line& line, const std::string& path) {
   return static_cast<int>(count);
 }
 
-/// Checked before cv::imread, which logs its own warning for a missing file.
-bool isReadableFile(const std::string& path) { return std::ifstream(path).good(); }
+/// cv::imread of a file, or an empty Mat when it is missing or undecodable. Existence is checked
+/// first because cv::imread logs its own warning for a missing file.
+cv::Mat readImageFile(const std::string& path, int flags) {
+  return std::ifstream(path).good() ? cv::imread(path, flags) : cv::Mat();
+}
 
 /// A line of a par file (22 fields, a name first) where a projection list was expected.
 bool looksLikeParLine(const Line& line) {
@@ -204,8 +213,7 @@ cv::Mat loadViewImage(const std::string& directory, const CalibratedView& view) 
                              ": no image name for this view; put one before its numbers");
   }
   const std::string path = directory + "/" + view.name;
-  cv::Mat image;
-  if (isReadableFile(path)) image = cv::imread(path, cv::IMREAD_COLOR);
+  cv::Mat image = readImageFile(path, cv::IMREAD_COLOR);
   if (image.empty()) throw std::runtime_error(path + ": image missing or unreadable" + named_at);
   return image;
 }
@@ -227,8 +235,7 @@ cv::Mat silhouetteFromImage(const cv::Mat& image, const SilhouetteConfig& config
 }
 
 cv::Mat loadMask(const std::string& path) {
-  if (!isReadableFile(path)) throw std::runtime_error(path + ": mask missing or unreadable");
-  const cv::Mat raw = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  const cv::Mat raw = readImageFile(path, cv::IMREAD_GRAYSCALE);
   if (raw.empty()) throw std::runtime_error(path + ": mask missing or unreadable");
   cv::Mat mask;
   cv::compare(raw, 0, mask, cv::CMP_GT);

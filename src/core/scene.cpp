@@ -134,9 +134,8 @@ void validate(const SceneConfig& config) {
   require(config.width_px >= 8 && config.height_px >= 8 && config.width_px <= 8192 &&
               config.height_px <= 8192,
           "image size must be between 8x8 and 8192x8192");
-  Shape::byName(config.shape);  // throws on an unknown name
+  const double radius = Shape::byName(config.shape).boundingRadius();  // throws on an unknown name
   require(config.layout == "ring" || config.layout == "sphere", "layout must be ring or sphere");
-  const double radius = Shape::byName(config.shape).boundingRadius();
   require(config.camera_distance_m > 1.05 * radius,
           "camera distance must exceed the shape's bounding radius");
   require(std::abs(config.ring_elevation_deg) < 85.0, "ring elevation must lie in (-85, 85) deg");
@@ -197,8 +196,8 @@ void writeScene(const std::string& directory, const SceneConfig& config,
   if (!json_file) throw std::runtime_error(json_path + ": cannot write file");
   cv::parallel_for_(cv::Range(0, static_cast<int>(views.size())), [&](const cv::Range& range) {
     for (int i = range.start; i < range.end; ++i) {
-      writeImage(directory + "/" + views[i].view.name, views[i].image);
       const std::string& name = views[i].view.name;
+      writeImage(directory + "/" + name, views[i].image);
       writeImage(directory + "/" + kMaskDirectory + "/" + name, views[i].mask);
       writePfm(directory + "/" + kDepthDirectory + "/" + depthFileName(name), views[i].depth);
     }
