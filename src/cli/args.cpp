@@ -50,11 +50,11 @@ bool ArgParser::parse(const std::vector<std::string>& args) {
     if (spec == specs_.end()) throw UsageError("unknown option --" + name);
     if (spec->second.value_name.empty()) {
       if (equals != std::string::npos) throw UsageError("--" + name + " takes no value");
-      values_[name] = "1";
+      store(name, "1");
     } else if (equals != std::string::npos) {
-      values_[name] = arg.substr(equals + 1);
+      store(name, arg.substr(equals + 1));
     } else if (i + 1 < args.size()) {
-      values_[name] = args[++i];
+      store(name, args[++i]);
     } else {
       throw UsageError("--" + name + " needs a value (" + spec->second.value_name + ")");
     }
@@ -81,6 +81,18 @@ std::string ArgParser::help() const {
   }
   out << "\n  --help\n      show this text\n";
   return out.str();
+}
+
+void ArgParser::store(const std::string& name, const std::string& value) {
+  values_[name] = value;
+  repeated_values_[name].push_back(value);
+}
+
+std::vector<std::string> ArgParser::getAll(const std::string& name) const {
+  const auto given = repeated_values_.find(name);
+  if (given != repeated_values_.end()) return given->second;
+  if (has(name)) return {get(name)};
+  return {};
 }
 
 bool ArgParser::flag(const std::string& name) const { return values_.count(name) > 0; }

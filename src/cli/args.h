@@ -33,6 +33,8 @@ class ArgParser {
   bool has(const std::string& name) const;
   /// Throws UsageError when the option was neither given nor has a default.
   std::string get(const std::string& name) const;
+  /// Every value of an option given several times, in order; else its default, if any.
+  std::vector<std::string> getAll(const std::string& name) const;
   int getInt(const std::string& name) const;
   double getDouble(const std::string& name) const;
 
@@ -46,7 +48,10 @@ class ArgParser {
   std::vector<std::string> order_;
   std::map<std::string, Spec> specs_;
   std::vector<std::pair<std::string, std::string>> positionals_;
-  std::map<std::string, std::string> values_;
+  void store(const std::string& name, const std::string& value);
+
+  std::map<std::string, std::string> values_;  ///< the last value of each option
+  std::map<std::string, std::vector<std::string>> repeated_values_;
 };
 
 }  // namespace cli

@@ -33,6 +33,7 @@ const std::vector<Command>& commands() {
       {"dataset-info", "summarise a calibrated view set (Middlebury par or projection list)",
        runDatasetInfo},
       {"scene", "render a synthetic scene with exact ground truth", runScene},
+      {"match", "match SIFT features of two images and filter them (epipolar, gsc, ...)", runMatch},
   };
   return all;
 }

@@ -1,0 +1,30 @@
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <vector>
+
+namespace sift_hull {
+
+/// Parameters of OpenCV's SIFT detector (cv::SIFT::create), with OpenCV's defaults.
+struct SiftConfig {
+  int max_features = 0;              ///< keep the strongest this many; 0 keeps all
+  int octave_layers = 3;             ///< scales per octave
+  double contrast_threshold = 0.04;  ///< on DoG response (image values in [0, 1]), / octave_layers
+  double edge_threshold = 10.0;      ///< largest principal-curvature ratio kept
+  double sigma_px = 1.6;             ///< blur of the first octave's base image
+};
+
+/// Throws std::invalid_argument naming the first bad field.
+void validate(const SiftConfig& config);
+
+/// SIFT keypoints and their descriptors. KeyPoint::angle is the main orientation in degrees,
+/// measured in image coordinates (x right, y down), so it turns with the image content.
+struct Features {
+  std::vector<cv::KeyPoint> keypoints;
+  cv::Mat descriptors;  ///< CV_32FC1, one 128-D row per keypoint
+};
+
+/// Detects and describes SIFT features in a colour (BGR) or grey 8-bit image.
+Features detectSift(const cv::Mat& image, const SiftConfig& config = SiftConfig());
+
+}  // namespace sift_hull

@@ -1,0 +1,191 @@
+#include <opencv2/imgcodecs.hpp>
+#include <sstream>
+
+#include "args.h"
+#include "commands.h"
+#include "match_drawing.h"
+#include "match_eval.h"
+#include "match_options.h"
+#include "sift_hull/camera.h"
+#include "sift_hull/dataset.h"
+#include "sift_hull/scene.h"
+
+namespace sift_hull {
+namespace cli {
+namespace {
+
+std::string baseName(const std::string& path) {
+  const size_t slash = path.find_last_of('/');
+  return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
+cv::Mat readImage(const std::string& path) {
+  const cv::Mat image = cv::imread(path, cv::IMREAD_COLOR);
+  if (image.empty()) throw std::runtime_error(path + ": cannot read the image");
+  return image;
+}
+
+size_t viewIndex(const std::vector<CalibratedView>& views, const std::string& name,
+                 const std::string& source) {
+  for (size_t i = 0; i < views.size(); ++i) {
+    if (views[i].name == name) return i;
+  }
+  throw std::runtime_error(source + ": no view named '" + name + "'");
+}
+
+void addPairOptions(ArgParser* parser) {
+  parser->addOption("calib", "FILE", "calibration of the pair (Middlebury par or projections)");
+  parser->addOption("left-view", "NAME", "LEFT's name in --calib (default: its file name)");
+  parser->addOption("right-view", "NAME", "RIGHT's name in --calib (default: its file name)");
+  parser->addFlag("rectified", "the pair is rectified: epipolar lines are image rows");
+  parser->addOption("gt-disparity", "FILE", "ground truth: the left image's disparity map");
+  parser->addOption("disparity-scale", "S", "disparity = pixel value / S (Middlebury: 4)", "1");
+  parser->addOption("gt-homography", "FILE", "ground truth: 3x3 H with x_right ~ H x_left");
+  parser->addOption("gt-scene", "DIR", "ground truth: a scene directory (sift_hull scene)");
+}
+
+/// The fundamental matrix from --calib, --rectified or the scene's cameras, when any is given.
+std::optional<Eigen::Matrix3d> pairCalibration(const ArgParser& parser, const std::string& left,
+                                               const std::string& right) {
+  if (parser.flag("rectified")) return rectifiedFundamentalMatrix();
+  std::string calib;
+  if (parser.has("calib")) {
+    calib = parser.get("calib");
+  } else if (parser.has("gt-scene")) {
+    calib = parser.get("gt-scene") + "/scene_par.txt";
+  } else {
+    return std::nullopt;
+  }
+  const std::vector<CalibratedView> views = readCalibration(calib);
+  const std::string left_name = parser.has("left-view") ? parser.get("left-view") : baseName(left);
+  const std::string right_name =
+      parser.has("right-view") ? parser.get("right-view") : baseName(right);
+  return fundamentalMatrix(views[viewIndex(views, left_name, calib)].camera,
+                           views[viewIndex(views, right_name, calib)].camera);
+}
+
+std::optional<PairTruth> pairTruth(const ArgParser& parser, const std::string& left,
+                                   const std::string& right) {
+  const int given =
+      parser.has("gt-disparity") + parser.has("gt-homography") + parser.has("gt-scene");
+  if (given > 1)
+    throw UsageError("give at most one of --gt-disparity, --gt-homography, --gt-scene");
+  if (parser.has("gt-disparity")) {
+    return disparityTruth(parser.get("gt-disparity"), parser.getDouble("disparity-scale"));
+  }
+  if (parser.has("gt-homography")) return homographyTruth(parser.get("gt-homography"));
+  if (!parser.has("gt-scene")) return std::nullopt;
+  const SceneData scene = readScene(parser.get("gt-scene"));
+  const size_t a = viewIndex(scene.views, baseName(left), parser.get("gt-scene"));
+  const size_t b = viewIndex(scene.views, baseName(right), parser.get("gt-scene"));
+  return sceneTruth({scene.views[a].camera, scene.depths[a]},
+                    {scene.views[b].camera, scene.depths[b]});
+}
+
+/// The filters named with --filter, else every one the input allows.
+std::vector<std::string> chosenFilters(const ArgParser& parser, bool calibrated) {
+  std::vector<std::string> names = parser.getAll("filter");
+  if (!names.empty()) return names;
+  for (const std::string& name : filterNames()) {
+    if (name != "epipolar" || calibrated) names.push_back(name);
+  }
+  return names;
+}
+
+std::string describe(const nlohmann::json& result) {
+  std::ostringstream text;
+  text << result["putative"] << " putative matches";
+  if (result.contains("ground_truth")) {
+    const auto& truth = result["ground_truth"];
+    text << " (" << truth["correct"] << " correct, " << truth["wrong"] << " wrong, "
+         << truth["unknown"] << " without ground truth)";
+  }
+  text << "\n";
+  for (const auto& [name, run] : result["filters"].items()) {
+    text << "  " << name << ": kept " << run["kept"] << " in " << run["time_ms"] << " ms";
+    if (!run["precision"].is_null()) {
+      text << ", precision " << run["precision"] << ", recall " << run["recall"] << ", F1 "
+           << run["f1"] << ", mismatches removed " << run["mismatches_removed"];
+    }
+    text << "\n";
+  }
+  return text.str();
+}
+
+/// The kept match with the median GSC distance and the removed one with the median distance
+/// (with ground truth: among the correct kept and the wrong removed ones).
+void writeHistogramFigure(const std::string& path, const PutativeMatches& input,
+                          const FilterConfigs& configs, const std::vector<MatchTruth>* truth) {
+  const FilterResult gsc = filterGsc(input, configs.gsc);
+  std::vector<std::pair<double, size_t>> kept, removed;
+  for (size_t m = 0; m < input.matches.size(); ++m) {
+    if (std::isnan(gsc.score[m])) continue;
+    const MatchTruth expected = gsc.keep[m] ? MatchTruth::kCorrect : MatchTruth::kWrong;
+    if (truth != nullptr && (*truth)[m] != expected) continue;
+    (gsc.keep[m] ? kept : removed).emplace_back(gsc.score[m], m);
+  }
+  if (kept.empty() || removed.empty()) {
+    throw std::runtime_error("--out-histograms: gsc kept or removed no match, nothing to draw");
+  }
+  std::sort(kept.begin(), kept.end());
+  std::sort(removed.begin(), removed.end());
+  const cv::Mat figure =
+      drawGscHistograms(gscHistograms(input, kept[kept.size() / 2].second),
+                        gscHistograms(input, removed[removed.size() / 2].second));
+  if (!cv::imwrite(path, figure)) throw std::runtime_error(path + ": cannot write the image");
+}
+
+}  // namespace
+
+int runMatch(const std::vector<std::string>& args) {
+  ArgParser parser("match",
+                   "Matches SIFT features of two images and filters the putative matches with\n"
+                   "each --filter (ratio, epipolar, gsc, ransac, magsac, gms, or a+b to keep what\n"
+                   "both keep; default: all that apply), scoring them against ground truth when\n"
+                   "one is given.");
+  parser.addPositional("LEFT", "left image");
+  parser.addPositional("RIGHT", "right image");
+  parser.addOption("filter", "NAME", "a filter to run; repeat for several");
+  addMatchOptions(&parser);
+  addPairOptions(&parser);
+  parser.addOption("out-image", "PNG", "draw the first filter's kept (green) and removed (red)");
+  parser.addOption("out-histograms", "PNG", "draw GSC histograms of a kept and a removed match");
+  parser.addFlag("json", "print the result as one JSON object");
+  if (!parser.parse(args)) return 0;
+  const MatchOptions options = matchOptionsFromArgs(parser);
+  const std::string left_path = parser.get("LEFT"), right_path = parser.get("RIGHT");
+  const cv::Mat left = readImage(left_path), right = readImage(right_path);
+
+  PutativeMatches input = matchImages(left, right, options.sift, options.matching);
+  input.F_right_left = pairCalibration(parser, left_path, right_path);
+  const std::optional<PairTruth> truth = pairTruth(parser, left_path, right_path);
+  std::vector<MatchTruth> judged;
+  if (truth) judged = truth->judge(input);
+  const std::vector<MatchTruth>* truth_or_null = truth ? &judged : nullptr;
+
+  nlohmann::json result = {{"putative", input.matches.size()},
+                           {"left_keypoints", input.left_keypoints.size()},
+                           {"right_keypoints", input.right_keypoints.size()},
+                           {"filters", nlohmann::json::object()}};
+  if (truth) result["ground_truth"] = truthJson(truth->kind, judged);
+  std::optional<FilterRun> first;
+  for (const std::string& name : chosenFilters(parser, input.F_right_left.has_value())) {
+    FilterRun run = timedRun(*makeFilter(name, options.filters), input);
+    result["filters"][run.name] = filterRunJson(run, truth_or_null);
+    if (!first) first = std::move(run);
+  }
+  if (parser.has("out-image") && first) {
+    const std::string path = parser.get("out-image");
+    if (!cv::imwrite(path, drawMatchDecisions(left, right, input, first->result))) {
+      throw std::runtime_error(path + ": cannot write the image");
+    }
+  }
+  if (parser.has("out-histograms")) {
+    writeHistogramFigure(parser.get("out-histograms"), input, options.filters, truth_or_null);
+  }
+  printResult(parser.flag("json"), result, describe(result));
+  return 0;
+}
+
+}  // namespace cli
+}  // namespace sift_hull

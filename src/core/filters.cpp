@@ -1,0 +1,214 @@
+#include "sift_hull/filters.h"
+
+#include <cmath>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
+#include <sstream>
+#include <stdexcept>
+
+#include "sift_hull/camera.h"
+
+namespace sift_hull {
+namespace {
+
+void require(bool condition, const std::string& message) {
+  if (!condition) throw std::invalid_argument("filter config: " + message);
+}
+
+Eigen::Vector2d position(const cv::KeyPoint& keypoint) { return {keypoint.pt.x, keypoint.pt.y}; }
+
+bool hasFinitePositions(const PutativeMatches& input, size_t m) {
+  return position(input.left(m)).allFinite() && position(input.right(m)).allFinite();
+}
+
+/// A result keeping nothing, with NaN scores, to be filled in for the valid matches.
+FilterResult emptyResult(const PutativeMatches& input) {
+  return {std::vector<uint8_t>(input.matches.size(), 0),
+          std::vector<double>(input.matches.size(), NAN)};
+}
+
+/// Keeps each valid match whose symmetric epipolar distance under F is at most max_px.
+FilterResult keepNearEpipolarLines(const PutativeMatches& input, const Eigen::Matrix3d& F,
+                                   double max_px) {
+  FilterResult result = emptyResult(input);
+  for (size_t m = 0; m < input.matches.size(); ++m) {
+    if (!hasFinitePositions(input, m)) continue;
+    const double distance =
+        epipolarDistances(F, position(input.left(m)), position(input.right(m))).max();
+    result.score[m] = distance;
+    result.keep[m] = distance <= max_px;
+  }
+  return result;
+}
+
+/// F estimated robustly by cv::findFundamentalMat with `method`; nothing kept when it fails.
+FilterResult fitFundamentalMatrix(const PutativeMatches& input, int method,
+                                  const RobustFitConfig& config) {
+  std::vector<cv::Point2f> left, right;
+  for (size_t m = 0; m < input.matches.size(); ++m) {
+    if (!hasFinitePositions(input, m)) continue;
+    left.push_back(input.left(m).pt);
+    right.push_back(input.right(m).pt);
+  }
+  if (left.size() < 8) return emptyResult(input);
+  const cv::Mat F = cv::findFundamentalMat(left, right, method, config.max_epipolar_px,
+                                           config.confidence, config.max_iterations);
+  if (F.rows < 3 || F.cols != 3) return emptyResult(input);
+  Eigen::Matrix3d F_right_left;
+  cv::cv2eigen(F.rowRange(0, 3), F_right_left);
+  return keepNearEpipolarLines(input, F_right_left, config.max_epipolar_px);
+}
+
+void validate(const RobustFitConfig& config, const std::string& name) {
+  require(config.max_epipolar_px > 0.0, name + ".max_epipolar_px must be > 0");
+  require(config.confidence > 0.0 && config.confidence < 1.0,
+          name + ".confidence must be in (0, 1)");
+  require(config.max_iterations >= 1, name + ".max_iterations must be >= 1");
+}
+
+/// A filter made of a function of the input and a config.
+template <typename Config>
+class FunctionFilter : public MatchFilter {
+ public:
+  using Function = FilterResult (*)(const PutativeMatches&, const Config&);
+  FunctionFilter(std::string name, Function function, Config config)
+      : name_(std::move(name)), function_(function), config_(config) {}
+  std::string name() const override { return name_; }
+  FilterResult apply(const PutativeMatches& input) const override {
+    return function_(input, config_);
+  }
+
+ private:
+  std::string name_;
+  Function function_;
+  Config config_;
+};
+
+/// Keeps what all its parts keep; score: how many parts rejected the match.
+class CompositeFilter : public MatchFilter {
+ public:
+  explicit CompositeFilter(std::vector<std::unique_ptr<MatchFilter>> parts)
+      : parts_(std::move(parts)) {}
+  std::string name() const override;
+  FilterResult apply(const PutativeMatches& input) const override;
+
+ private:
+  std::vector<std::unique_ptr<MatchFilter>> parts_;
+};
+
+std::string CompositeFilter::name() const {
+  std::string joined;
+  for (const auto& part : parts_) joined += (joined.empty() ? "" : "+") + part->name();
+  return joined;
+}
+
+FilterResult CompositeFilter::apply(const PutativeMatches& input) const {
+  FilterResult result{std::vector<uint8_t>(input.matches.size(), 1),
+                      std::vector<double>(input.matches.size(), 0.0)};
+  for (const auto& part : parts_) {
+    const FilterResult partial = part->apply(input);
+    for (size_t m = 0; m < input.matches.size(); ++m) {
+      result.keep[m] = result.keep[m] && partial.keep[m];
+      result.score[m] += partial.keep[m] ? 0.0 : 1.0;
+    }
+  }
+  for (size_t m = 0; m < input.matches.size(); ++m) {
+    if (!hasFinitePositions(input, m)) result.score[m] = NAN;
+  }
+  return result;
+}
+
+FilterResult ratioWithConfig(const PutativeMatches& input, const int&) {
+  return filterRatio(input);
+}
+
+std::unique_ptr<MatchFilter> makeSingleFilter(const std::string& name,
+                                              const FilterConfigs& configs) {
+  if (name == "ratio") return std::make_unique<FunctionFilter<int>>(name, ratioWithConfig, 0);
+  if (name == "epipolar") {
+    return std::make_unique<FunctionFilter<EpipolarConfig>>(name, filterEpipolar, configs.epipolar);
+  }
+  if (name == "gsc") {
+    return std::make_unique<FunctionFilter<GscConfig>>(name, filterGsc, configs.gsc);
+  }
+  if (name == "ransac") {
+    return std::make_unique<FunctionFilter<RobustFitConfig>>(name, filterRansac, configs.ransac);
+  }
+  if (name == "magsac") {
+    return std::make_unique<FunctionFilter<RobustFitConfig>>(name, filterMagsac, configs.magsac);
+  }
+  if (name == "gms") {
+    return std::make_unique<FunctionFilter<GmsConfig>>(name, filterGms, configs.gms);
+  }
+  std::ostringstream known;
+  for (const std::string& each : filterNames()) known << " " << each;
+  throw std::invalid_argument("unknown filter '" + name + "' (known:" + known.str() + ")");
+}
+
+}  // namespace
+
+size_t FilterResult::keptCount() const {
+  size_t count = 0;
+  for (uint8_t flag : keep) count += flag ? 1 : 0;
+  return count;
+}
+
+void validate(const FilterConfigs& configs) {
+  require(configs.epipolar.max_epipolar_px > 0.0, "epipolar.max_epipolar_px must be > 0");
+  require(configs.gsc.max_histogram_distance >= 0.0, "gsc.max_histogram_distance must be >= 0");
+  require(configs.gsc.threads >= 0, "gsc.threads must be >= 0 (0: all)");
+  validate(configs.ransac, "ransac");
+  validate(configs.magsac, "magsac");
+  require(configs.gms.grid_cells >= 3, "gms.grid_cells must be >= 3");
+  require(configs.gms.threshold_factor > 0.0, "gms.threshold_factor must be > 0");
+}
+
+const std::vector<std::string>& filterNames() {
+  static const std::vector<std::string> names = {"ratio",  "epipolar", "gsc",
+                                                 "ransac", "magsac",   "gms"};
+  return names;
+}
+
+std::unique_ptr<MatchFilter> makeFilter(const std::string& spec, const FilterConfigs& configs) {
+  validate(configs);
+  std::vector<std::unique_ptr<MatchFilter>> parts;
+  size_t start = 0;
+  for (;;) {
+    const size_t plus = spec.find('+', start);
+    const std::string name = spec.substr(start, plus == std::string::npos ? plus : plus - start);
+    if (name.empty()) throw std::invalid_argument("empty filter name in '" + spec + "'");
+    parts.push_back(makeSingleFilter(name, configs));
+    if (plus == std::string::npos) break;
+    start = plus + 1;
+  }
+  if (parts.size() == 1) return std::move(parts.front());
+  return std::make_unique<CompositeFilter>(std::move(parts));
+}
+
+FilterResult filterRatio(const PutativeMatches& input) {
+  FilterResult result = emptyResult(input);
+  for (size_t m = 0; m < input.matches.size(); ++m) {
+    if (!hasFinitePositions(input, m)) continue;
+    result.keep[m] = 1;
+    result.score[m] = input.matches[m].distance;
+  }
+  return result;
+}
+
+FilterResult filterEpipolar(const PutativeMatches& input, const EpipolarConfig& config) {
+  if (!input.F_right_left) {
+    throw std::invalid_argument(
+        "the epipolar filter needs calibration (a fundamental matrix for the pair)");
+  }
+  return keepNearEpipolarLines(input, *input.F_right_left, config.max_epipolar_px);
+}
+
+FilterResult filterRansac(const PutativeMatches& input, const RobustFitConfig& config) {
+  return fitFundamentalMatrix(input, cv::FM_RANSAC, config);
+}
+
+FilterResult filterMagsac(const PutativeMatches& input, const RobustFitConfig& config) {
+  return fitFundamentalMatrix(input, cv::USAC_MAGSAC, config);
+}
+
+}  // namespace sift_hull
