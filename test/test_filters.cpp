@@ -341,5 +341,54 @@ TEST(DegenerateInput, NanCoordinatesAreNeverKeptAndIgnoredByOthers) {
   for (size_t m = 0; m < 4; ++m) EXPECT_EQ(with_nan.score[m], without.score[m]);
 }
 
+// ---- synthetic match generators -----------------------------------------------------------------
+
+TEST(SyntheticMatches, InliersFollowTheSimilarityAndOutliersMakeTheirShare) {
+  SyntheticMatchConfig config;
+  config.inliers = 200;
+  config.position_noise_px = 0.0;
+  config.angle_noise_deg = 0.0;
+  const LabelledMatches matches = syntheticMatches(config);
+  ASSERT_EQ(matches.truth.size(), 286u);  // 200 / 0.7
+  const double turn = config.rotation_deg * M_PI / 180.0;
+  const cv::Point2f centre(320.f, 240.f);
+  for (size_t m = 0; m < 200; ++m) {
+    ASSERT_EQ(matches.truth[m], MatchTruth::kCorrect);
+    const cv::Point2f d = matches.putative.left(m).pt - centre;
+    const cv::Point2f expected(
+        static_cast<float>(config.scale * (std::cos(turn) * d.x - std::sin(turn) * d.y)),
+        static_cast<float>(config.scale * (std::sin(turn) * d.x + std::cos(turn) * d.y)));
+    const cv::Point2f shift(15.f, 15.f);
+    EXPECT_LT(cv::norm(matches.putative.right(m).pt - (centre + expected + shift)), 1e-3);
+    const double turned = matches.putative.right(m).angle - matches.putative.left(m).angle;
+    EXPECT_NEAR(std::remainder(turned - config.rotation_deg, 360.0), 0.0, 1e-3);
+  }
+  for (size_t m = 200; m < matches.truth.size(); ++m)
+    EXPECT_EQ(matches.truth[m], MatchTruth::kWrong);
+}
+
+TEST(SyntheticMatches, MismatchesIndexTheirOwnKeypointsWhenKeypointsOutnumberMatches) {
+  LabelledMatches matches = rectifiedPair(10, 5.0, 1);
+  matches.putative.matches.resize(4);  // 10 keypoints per image, 4 matches
+  matches.truth.resize(4);
+  injectMismatches(&matches, 0.5, 2);
+  ASSERT_EQ(matches.putative.matches.size(), 8u);
+  for (size_t m = 4; m < 8; ++m) {
+    EXPECT_EQ(matches.putative.matches[m].queryIdx, static_cast<int>(10 + m - 4));
+    EXPECT_EQ(matches.putative.matches[m].trainIdx, static_cast<int>(10 + m - 4));
+    EXPECT_EQ(matches.truth[m], MatchTruth::kWrong);
+  }
+}
+
+TEST(SyntheticMatches, TilingKeepsARectifiedPairRectified) {
+  const LabelledMatches matches = rectifiedPair(50, 12.0, 3);
+  const LabelledMatches tiled = tileMatches(matches, 3, 2);
+  ASSERT_EQ(tiled.truth.size(), 300u);
+  EXPECT_EQ(tiled.putative.left_image_size, cv::Size(1920, 960));
+  const FilterResult epipolar = filterEpipolar(tiled.putative, EpipolarConfig{0.01});
+  EXPECT_EQ(epipolar.keptCount(), 300u);
+  EXPECT_THROW(tileMatches(matches, 0, 1), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace sift_hull

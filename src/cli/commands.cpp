@@ -34,6 +34,10 @@ const std::vector<Command>& commands() {
        runDatasetInfo},
       {"scene", "render a synthetic scene with exact ground truth", runScene},
       {"match", "match SIFT features of two images and filter them (epipolar, gsc, ...)", runMatch},
+      {"bench-filters", "time every match filter (the paper's Table 1 and an N sweep)",
+       runBenchFilters},
+      {"evaluate-filters", "precision and recall of every filter on Teddy and graf",
+       runEvaluateFilters},
   };
   return all;
 }

@@ -24,6 +24,8 @@ void printResult(bool as_json, const nlohmann::json& result, const std::string& 
 int runDatasetInfo(const std::vector<std::string>& args);
 int runScene(const std::vector<std::string>& args);
 int runMatch(const std::vector<std::string>& args);
+int runBenchFilters(const std::vector<std::string>& args);
+int runEvaluateFilters(const std::vector<std::string>& args);
 
 /// Parses the command line and runs the chosen command.
 int runMain(int argc, char** argv);

@@ -45,10 +45,10 @@ cv::KeyPoint keypointAt(const Eigen::Vector2d& x, double angle_deg, double size_
 void append(LabelledMatches* matches, const cv::KeyPoint& left, const cv::KeyPoint& right,
             MatchTruth truth) {
   PutativeMatches& putative = matches->putative;
-  const int index = static_cast<int>(putative.matches.size());
+  putative.matches.emplace_back(static_cast<int>(putative.left_keypoints.size()),
+                                static_cast<int>(putative.right_keypoints.size()), 0.f);
   putative.left_keypoints.push_back(left);
   putative.right_keypoints.push_back(right);
-  putative.matches.emplace_back(index, index, 0.f);
   matches->truth.push_back(truth);
 }
 

@@ -1,0 +1,85 @@
+#include "pair_data.h"
+
+#include <sys/stat.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+#include <sstream>
+
+namespace sift_hull {
+namespace cli {
+namespace {
+
+bool exists(const std::string& path) {
+  struct stat info;
+  return stat(path.c_str(), &info) == 0;
+}
+
+/// The directory of a data set, or empty (with the reason) when it is absent.
+std::string dataSet(const std::string& root, const std::string& name, std::string* why_not) {
+  const std::string path = root + "/" + name;
+  if (!root.empty() && exists(path)) return path;
+  *why_not = "data set '" + name + "' not found (set SIFT_HULL_DATA or use --data)";
+  return "";
+}
+
+cv::Mat readImage(const std::string& path) {
+  const cv::Mat image = cv::imread(path, cv::IMREAD_COLOR);
+  if (image.empty()) throw std::runtime_error(path + ": cannot read the image");
+  return image;
+}
+
+}  // namespace
+
+std::string defaultDataRoot() {
+  if (const char* env = std::getenv("SIFT_HULL_DATA")) return env;
+  return exists("../shared/data") ? "../shared/data" : "";
+}
+
+std::optional<EvaluationPair> teddyPair(const std::string& data_root, const MatchOptions& options,
+                                        std::string* why_not) {
+  const std::string dir = dataSet(data_root, "middlebury_stereo2003_teddy", why_not);
+  if (dir.empty()) return std::nullopt;
+  EvaluationPair pair;
+  pair.name = "teddy";
+  pair.input = matchImages(readImage(dir + "/im2.png"), readImage(dir + "/im6.png"), options.sift,
+                           options.matching);
+  pair.input.F_right_left = rectifiedFundamentalMatrix();
+  pair.truth = judgeByDisparity(pair.input, readDisparity(dir + "/disp2.pgm", 4.0));
+  return pair;
+}
+
+std::optional<EvaluationPair> grafPair(const std::string& data_root, int n,
+                                       const MatchOptions& options, std::string* why_not) {
+  const std::string dir = dataSet(data_root, "oxford_affine_graf", why_not);
+  if (dir.empty()) return std::nullopt;
+  const std::string index = std::to_string(n);
+  EvaluationPair pair;
+  pair.name = "graf 1-" + index;
+  pair.input = matchImages(readImage(dir + "/img1.png"), readImage(dir + "/img" + index + ".png"),
+                           options.sift, options.matching);
+  pair.truth = judgeByHomography(pair.input, readHomography(dir + "/H1to" + index + "p"));
+  return pair;
+}
+
+void replaceMarkedSection(const std::string& path, const std::string& name,
+                          const std::string& content) {
+  std::ifstream in(path);
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  std::string text = buffer.str();
+  const std::string begin = "<!-- begin " + name + " -->\n", end = "<!-- end " + name + " -->\n";
+  const size_t first = text.find(begin), last = text.find(end);
+  const std::string section = begin + content + end;
+  if (first == std::string::npos || last == std::string::npos || last < first) {
+    text += (text.empty() || text.back() == '\n' ? "\n" : "\n\n") + section;
+  } else {
+    text.replace(first, last + end.size() - first, section);
+  }
+  std::ofstream out(path);
+  if (!(out << text)) throw std::runtime_error(path + ": cannot write");
+}
+
+}  // namespace cli
+}  // namespace sift_hull

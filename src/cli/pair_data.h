@@ -1,0 +1,38 @@
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "match_options.h"
+#include "sift_hull/evaluation.h"
+
+namespace sift_hull {
+namespace cli {
+
+/// The real data root: $SIFT_HULL_DATA, else ../shared/data when it exists, else empty.
+std::string defaultDataRoot();
+
+/// A real image pair, its putative matches and their ground truth.
+struct EvaluationPair {
+  std::string name;
+  PutativeMatches input;
+  std::vector<MatchTruth> truth;
+};
+
+/// Middlebury Teddy (rectified; F of a rectified pair; disparity ground truth). Empty, with
+/// `why_not` set, when the data set is absent.
+std::optional<EvaluationPair> teddyPair(const std::string& data_root, const MatchOptions& options,
+                                        std::string* why_not);
+
+/// Oxford graf 1-N (homography ground truth, no calibration).
+std::optional<EvaluationPair> grafPair(const std::string& data_root, int n,
+                                       const MatchOptions& options, std::string* why_not);
+
+/// Replaces the text between the lines "<!-- begin NAME -->" and "<!-- end NAME -->" of a
+/// Markdown file (appending the marked section when missing).
+void replaceMarkedSection(const std::string& path, const std::string& name,
+                          const std::string& content);
+
+}  // namespace cli
+}  // namespace sift_hull
