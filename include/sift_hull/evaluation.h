@@ -40,7 +40,8 @@ Eigen::Matrix3d readHomography(const std::string& path);
 std::vector<MatchTruth> judgeByDisparity(const PutativeMatches& input, const cv::Mat& disparity_px,
                                          const TruthTolerances& tolerances = {});
 
-/// Planar scene: correct when the right point is within max_homography_error_px of H x_left.
+/// Planar scene: correct when the right point is within max_homography_error_px of H x_left (H
+/// up to scale and sign).
 std::vector<MatchTruth> judgeByHomography(const PutativeMatches& input,
                                           const Eigen::Matrix3d& H_right_left,
                                           const TruthTolerances& tolerances = {});

@@ -91,7 +91,8 @@ std::vector<MatchTruth> judgeByHomography(const PutativeMatches& input,
                                           const TruthTolerances& tolerances) {
   return judgeEach(input, [&](const Eigen::Vector2d& left, const Eigen::Vector2d& right) {
     const Eigen::Vector3d mapped = H_right_left * left.homogeneous();
-    if (!(mapped.z() > 0.0)) return MatchTruth::kWrong;
+    // H is defined up to scale (and sign): only a point mapped to infinity has no image.
+    if (!(std::abs(mapped.z()) > 1e-12)) return MatchTruth::kWrong;
     const double error = (mapped.hnormalized() - right).norm();
     return error <= tolerances.max_homography_error_px ? MatchTruth::kCorrect : MatchTruth::kWrong;
   });
