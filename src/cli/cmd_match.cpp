@@ -25,6 +25,10 @@ cv::Mat readImage(const std::string& path) {
   return image;
 }
 
+void writeImage(const std::string& path, const cv::Mat& image) {
+  if (!cv::imwrite(path, image)) throw std::runtime_error(path + ": cannot write the image");
+}
+
 size_t viewIndex(const std::vector<CalibratedView>& views, const std::string& name,
                  const std::string& source) {
   for (size_t i = 0; i < views.size(); ++i) {
@@ -132,7 +136,31 @@ void writeHistogramFigure(const std::string& path, const PutativeMatches& input,
   const cv::Mat figure =
       drawGscHistograms(gscHistograms(input, kept[kept.size() / 2].second),
                         gscHistograms(input, removed[removed.size() / 2].second));
-  if (!cv::imwrite(path, figure)) throw std::runtime_error(path + ": cannot write the image");
+  writeImage(path, figure);
+}
+
+/// Runs each chosen filter; fills result["filters"] and returns the first filter's run.
+std::optional<FilterRun> runFilters(const ArgParser& parser, const PutativeMatches& input,
+                                    const FilterConfigs& configs,
+                                    const std::vector<MatchTruth>* truth, nlohmann::json* result) {
+  std::optional<FilterRun> first;
+  for (const std::string& name : chosenFilters(parser, input.F_right_left.has_value())) {
+    FilterRun run = timedRun(*makeFilter(name, configs), input);
+    (*result)["filters"][run.name] = filterRunJson(run, truth);
+    if (!first) first = std::move(run);
+  }
+  return first;
+}
+
+void addMatchCommandOptions(ArgParser* parser) {
+  parser->addPositional("LEFT", "left image");
+  parser->addPositional("RIGHT", "right image");
+  parser->addOption("filter", "NAME", "a filter to run; repeat for several");
+  addMatchOptions(parser);
+  addPairOptions(parser);
+  parser->addOption("out-image", "PNG", "draw the first filter's kept (green) and removed (red)");
+  parser->addOption("out-histograms", "PNG", "draw GSC histograms of a kept and a removed match");
+  parser->addFlag("json", "print the result as one JSON object");
 }
 
 }  // namespace
@@ -143,14 +171,7 @@ int runMatch(const std::vector<std::string>& args) {
                    "each --filter (ratio, epipolar, gsc, ransac, magsac, gms, or a+b to keep what\n"
                    "both keep; default: all that apply), scoring them against ground truth when\n"
                    "one is given.");
-  parser.addPositional("LEFT", "left image");
-  parser.addPositional("RIGHT", "right image");
-  parser.addOption("filter", "NAME", "a filter to run; repeat for several");
-  addMatchOptions(&parser);
-  addPairOptions(&parser);
-  parser.addOption("out-image", "PNG", "draw the first filter's kept (green) and removed (red)");
-  parser.addOption("out-histograms", "PNG", "draw GSC histograms of a kept and a removed match");
-  parser.addFlag("json", "print the result as one JSON object");
+  addMatchCommandOptions(&parser);
   if (!parser.parse(args)) return 0;
   const MatchOptions options = matchOptionsFromArgs(parser);
   const std::string left_path = parser.get("LEFT"), right_path = parser.get("RIGHT");
@@ -159,8 +180,7 @@ int runMatch(const std::vector<std::string>& args) {
   PutativeMatches input = matchImages(left, right, options.sift, options.matching);
   input.F_right_left = pairCalibration(parser, left_path, right_path);
   const std::optional<PairTruth> truth = pairTruth(parser, left_path, right_path);
-  std::vector<MatchTruth> judged;
-  if (truth) judged = truth->judge(input);
+  const std::vector<MatchTruth> judged = truth ? truth->judge(input) : std::vector<MatchTruth>();
   const std::vector<MatchTruth>* truth_or_null = truth ? &judged : nullptr;
 
   nlohmann::json result = {{"putative", input.matches.size()},
@@ -168,17 +188,10 @@ int runMatch(const std::vector<std::string>& args) {
                            {"right_keypoints", input.right_keypoints.size()},
                            {"filters", nlohmann::json::object()}};
   if (truth) result["ground_truth"] = truthJson(truth->kind, judged);
-  std::optional<FilterRun> first;
-  for (const std::string& name : chosenFilters(parser, input.F_right_left.has_value())) {
-    FilterRun run = timedRun(*makeFilter(name, options.filters), input);
-    result["filters"][run.name] = filterRunJson(run, truth_or_null);
-    if (!first) first = std::move(run);
-  }
+  const std::optional<FilterRun> first =
+      runFilters(parser, input, options.filters, truth_or_null, &result);
   if (parser.has("out-image") && first) {
-    const std::string path = parser.get("out-image");
-    if (!cv::imwrite(path, drawMatchDecisions(left, right, input, first->result))) {
-      throw std::runtime_error(path + ": cannot write the image");
-    }
+    writeImage(parser.get("out-image"), drawMatchDecisions(left, right, input, first->result));
   }
   if (parser.has("out-histograms")) {
     writeHistogramFigure(parser.get("out-histograms"), input, options.filters, truth_or_null);
