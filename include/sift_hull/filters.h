@@ -16,6 +16,8 @@ struct FilterResult {
   std::vector<double> score;  ///< the filter's own measure; see each config for its meaning
 
   size_t keptCount() const;
+  /// A result keeping none of `matches` matches, every score NaN: where each filter starts.
+  static FilterResult keepingNone(size_t matches);
 };
 
 /// Keeps a match when each point lies within max_epipolar_px of the other's epipolar line under

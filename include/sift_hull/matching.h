@@ -37,6 +37,8 @@ struct PutativeMatches {
 
   const cv::KeyPoint& left(size_t match) const { return left_keypoints[matches[match].queryIdx]; }
   const cv::KeyPoint& right(size_t match) const { return right_keypoints[matches[match].trainIdx]; }
+  /// False when either point of the match has a NaN or infinite coordinate.
+  bool hasFinitePositions(size_t match) const;
 };
 
 /// Nearest neighbours of each left descriptor among the right ones, filtered as `config` says.

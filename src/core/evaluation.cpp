@@ -13,16 +13,12 @@ namespace {
 
 Eigen::Vector2d position(const cv::KeyPoint& keypoint) { return {keypoint.pt.x, keypoint.pt.y}; }
 
-bool finitePositions(const PutativeMatches& input, size_t m) {
-  return position(input.left(m)).allFinite() && position(input.right(m)).allFinite();
-}
-
 /// Applies `judge` to every match with finite coordinates; the others are wrong.
 template <typename Judge>
 std::vector<MatchTruth> judgeEach(const PutativeMatches& input, Judge judge) {
   std::vector<MatchTruth> truth(input.matches.size(), MatchTruth::kWrong);
   for (size_t m = 0; m < input.matches.size(); ++m) {
-    if (finitePositions(input, m)) {
+    if (input.hasFinitePositions(m)) {
       truth[m] = judge(position(input.left(m)), position(input.right(m)));
     }
   }

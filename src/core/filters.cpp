@@ -17,22 +17,12 @@ void require(bool condition, const std::string& message) {
 
 Eigen::Vector2d position(const cv::KeyPoint& keypoint) { return {keypoint.pt.x, keypoint.pt.y}; }
 
-bool hasFinitePositions(const PutativeMatches& input, size_t m) {
-  return position(input.left(m)).allFinite() && position(input.right(m)).allFinite();
-}
-
-/// A result keeping nothing, with NaN scores, to be filled in for the valid matches.
-FilterResult emptyResult(const PutativeMatches& input) {
-  return {std::vector<uint8_t>(input.matches.size(), 0),
-          std::vector<double>(input.matches.size(), NAN)};
-}
-
 /// Keeps each valid match whose symmetric epipolar distance under F is at most max_px.
 FilterResult keepNearEpipolarLines(const PutativeMatches& input, const Eigen::Matrix3d& F,
                                    double max_px) {
-  FilterResult result = emptyResult(input);
+  FilterResult result = FilterResult::keepingNone(input.matches.size());
   for (size_t m = 0; m < input.matches.size(); ++m) {
-    if (!hasFinitePositions(input, m)) continue;
+    if (!input.hasFinitePositions(m)) continue;
     const double distance =
         epipolarDistances(F, position(input.left(m)), position(input.right(m))).max();
     result.score[m] = distance;
@@ -46,14 +36,14 @@ FilterResult fitFundamentalMatrix(const PutativeMatches& input, int method,
                                   const RobustFitConfig& config) {
   std::vector<cv::Point2f> left, right;
   for (size_t m = 0; m < input.matches.size(); ++m) {
-    if (!hasFinitePositions(input, m)) continue;
+    if (!input.hasFinitePositions(m)) continue;
     left.push_back(input.left(m).pt);
     right.push_back(input.right(m).pt);
   }
-  if (left.size() < 8) return emptyResult(input);
+  if (left.size() < 8) return FilterResult::keepingNone(input.matches.size());
   const cv::Mat F = cv::findFundamentalMat(left, right, method, config.max_epipolar_px,
                                            config.confidence, config.max_iterations);
-  if (F.rows < 3 || F.cols != 3) return emptyResult(input);
+  if (F.rows < 3 || F.cols != 3) return FilterResult::keepingNone(input.matches.size());
   Eigen::Matrix3d F_right_left;
   cv::cv2eigen(F.rowRange(0, 3), F_right_left);
   return keepNearEpipolarLines(input, F_right_left, config.max_epipolar_px);
@@ -113,7 +103,7 @@ FilterResult CompositeFilter::apply(const PutativeMatches& input) const {
     }
   }
   for (size_t m = 0; m < input.matches.size(); ++m) {
-    if (!hasFinitePositions(input, m)) result.score[m] = NAN;
+    if (!input.hasFinitePositions(m)) result.score[m] = NAN;
   }
   return result;
 }
@@ -146,6 +136,10 @@ std::unique_ptr<MatchFilter> makeSingleFilter(const std::string& name,
 }
 
 }  // namespace
+
+FilterResult FilterResult::keepingNone(size_t matches) {
+  return {std::vector<uint8_t>(matches, 0), std::vector<double>(matches, NAN)};
+}
 
 size_t FilterResult::keptCount() const {
   size_t count = 0;
@@ -186,9 +180,9 @@ std::unique_ptr<MatchFilter> makeFilter(const std::string& spec, const FilterCon
 }
 
 FilterResult filterRatio(const PutativeMatches& input) {
-  FilterResult result = emptyResult(input);
+  FilterResult result = FilterResult::keepingNone(input.matches.size());
   for (size_t m = 0; m < input.matches.size(); ++m) {
-    if (!hasFinitePositions(input, m)) continue;
+    if (!input.hasFinitePositions(m)) continue;
     result.keep[m] = 1;
     result.score[m] = input.matches[m].distance;
   }

@@ -78,8 +78,6 @@ struct NormalisedMatch {
   bool usable = false;
 };
 
-bool isFinite(const cv::Point2f& point) { return std::isfinite(point.x) && std::isfinite(point.y); }
-
 bool isInside(const cv::Point2d& normalised) {
   return normalised.x >= 0.0 && normalised.x < 1.0 && normalised.y >= 0.0 && normalised.y < 1.0;
 }
@@ -101,9 +99,9 @@ void checkKeypointIndices(const PutativeMatches& input) {
 std::vector<NormalisedMatch> normaliseMatches(const PutativeMatches& input) {
   std::vector<NormalisedMatch> normalised(input.matches.size());
   for (size_t i = 0; i < input.matches.size(); ++i) {
+    if (!input.hasFinitePositions(i)) continue;
     const cv::Point2f& left = input.left(i).pt;
     const cv::Point2f& right = input.right(i).pt;
-    if (!isFinite(left) || !isFinite(right)) continue;
     normalised[i].left = normalise(left, input.left_image_size);
     normalised[i].right = normalise(right, input.right_image_size);
     normalised[i].usable = isInside(normalised[i].left) && isInside(normalised[i].right);
@@ -297,7 +295,7 @@ FilterResult filterGms(const PutativeMatches& input, const GmsConfig& config) {
   result.score = bestScores(matches, config);
   result.keep.resize(matches.size());
   for (size_t i = 0; i < matches.size(); ++i) {
-    if (!isFinite(input.left(i).pt) || !isFinite(input.right(i).pt)) {
+    if (!input.hasFinitePositions(i)) {
       result.score[i] = std::numeric_limits<double>::quiet_NaN();
     }
     result.keep[i] = result.score[i] > 1.0;  // false for NaN

@@ -157,16 +157,13 @@ double histogramDistance(const GscHistogram& left, const GscHistogram& right) {
   return std::sqrt(sum);
 }
 
-bool isFinite(const cv::KeyPoint& keypoint) {
-  return std::isfinite(keypoint.pt.x) && std::isfinite(keypoint.pt.y) &&
-         std::isfinite(keypoint.angle);
-}
-
 /// Indices of the matches whose keypoints are all finite; only these take part.
 std::vector<size_t> validMatches(const PutativeMatches& input) {
   std::vector<size_t> valid;
   for (size_t m = 0; m < input.matches.size(); ++m) {
-    if (isFinite(input.left(m)) && isFinite(input.right(m))) valid.push_back(m);
+    const bool finite_angles =
+        std::isfinite(input.left(m).angle) && std::isfinite(input.right(m).angle);
+    if (input.hasFinitePositions(m) && finite_angles) valid.push_back(m);
   }
   return valid;
 }
@@ -213,9 +210,7 @@ std::vector<double> histogramDistances(const PolarPoints& left, const PolarPoint
 double GscHistograms::distance() const { return histogramDistance(left, right); }
 
 FilterResult filterGsc(const PutativeMatches& input, const GscConfig& config) {
-  FilterResult result;
-  result.keep.assign(input.matches.size(), 0);
-  result.score.assign(input.matches.size(), NAN);
+  FilterResult result = FilterResult::keepingNone(input.matches.size());
   const std::vector<size_t> valid = validMatches(input);
   const auto [left, right] = polarPointsOf(input, valid);
   const std::vector<double> distances =
