@@ -8,8 +8,19 @@
 #include <iterator>
 #include <string>
 
+#include "sift_hull/scene.h"
+
 namespace sift_hull {
 namespace test {
+
+/// The default scene on a ring of 12 views at 320x240: neighbouring views are 30 degrees apart.
+inline SceneConfig smallRing() {
+  SceneConfig config;
+  config.views = 12;
+  config.width_px = 320;
+  config.height_px = 240;
+  return config;
+}
 
 /// Root of the real data sets: $SIFT_HULL_DATA, else ../shared/data beside the repository when it
 /// exists, else empty.

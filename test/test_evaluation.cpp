@@ -167,15 +167,8 @@ TEST(JudgeByHomography, DividesByTheHomogeneousCoordinate) {
 class SceneDepthPair : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    SceneConfig config;
-    config.views = 12;
-    config.width_px = 320;
-    config.height_px = 240;
-    const Shape shape = Shape::byName(config.shape);
-    const std::vector<CalibratedView> cameras = sceneCameras(config, shape);
     for (int i = 0; i < 2; ++i) {
-      const RenderedView view =
-          renderView(shape, cameras[i], {config.width_px, config.height_px}, config.seed);
+      const RenderedView view = renderSceneView(test::smallRing(), i);
       views_[i] = {view.view.camera, view.depth};
     }
   }
@@ -272,53 +265,37 @@ struct Floor {
   double recall;
 };
 
-struct LabelledPair {
-  PutativeMatches input;
-  std::vector<MatchTruth> truth;
-};
-
 /// Teddy's putative matches (ratio 0.8), judged by the left disparity; empty without the data.
-const LabelledPair& teddy() {
-  static const LabelledPair pair = [] {
-    LabelledPair result;
+const LabelledMatches& teddy() {
+  static const LabelledMatches matches = [] {
     const std::string dir = test::dataSet("middlebury_stereo2003_teddy");
-    if (dir.empty()) return result;
     MatchConfig matching;
     matching.ratio = 0.8;
-    result.input = matchImages(cv::imread(dir + "/im2.png"), cv::imread(dir + "/im6.png"),
-                               SiftConfig(), matching);
-    result.input.F_right_left = rectifiedFundamentalMatrix();
-    result.truth = judgeByDisparity(result.input, readDisparity(dir + "/disp2.pgm", 4.0));
-    return result;
+    return dir.empty() ? LabelledMatches() : matchTeddy(dir, SiftConfig(), matching);
   }();
-  return pair;
+  return matches;
 }
 
 /// Graf 1-2's putative matches (ratio 0.8), judged by H1to2p; uncalibrated; empty without data.
-const LabelledPair& graf() {
-  static const LabelledPair pair = [] {
-    LabelledPair result;
+const LabelledMatches& graf() {
+  static const LabelledMatches matches = [] {
     const std::string dir = test::dataSet("oxford_affine_graf");
-    if (dir.empty()) return result;
     MatchConfig matching;
     matching.ratio = 0.8;
-    result.input = matchImages(cv::imread(dir + "/img1.png"), cv::imread(dir + "/img2.png"),
-                               SiftConfig(), matching);
-    result.truth = judgeByHomography(result.input, readHomography(dir + "/H1to2p"));
-    return result;
+    return dir.empty() ? LabelledMatches() : matchGraf(dir, 2, SiftConfig(), matching);
   }();
-  return pair;
+  return matches;
 }
 
-FilterScores scoreByName(const LabelledPair& pair, const std::string& filter) {
-  const FilterResult result = makeFilter(filter, FilterConfigs())->apply(pair.input);
+FilterScores scoreByName(const LabelledMatches& pair, const std::string& filter) {
+  const FilterResult result = makeFilter(filter, FilterConfigs())->apply(pair.putative);
   const FilterScores scores = scoreFilter(pair.truth, result);
   std::cout << filter << ": kept " << scores.kept << " of " << scores.putative << ", precision "
             << scores.precision() << ", recall " << scores.recall() << "\n";
   return scores;
 }
 
-void expectFloors(const LabelledPair& pair, const std::vector<Floor>& floors) {
+void expectFloors(const LabelledMatches& pair, const std::vector<Floor>& floors) {
   for (const Floor& floor : floors) {
     const FilterScores scores = scoreByName(pair, floor.filter);
     EXPECT_GE(scores.precision(), floor.precision) << floor.filter;
@@ -328,7 +305,7 @@ void expectFloors(const LabelledPair& pair, const std::vector<Floor>& floors) {
 
 TEST(RealData, TeddyPutativesHoldMismatchesToRemove) {
   SIFT_HULL_REQUIRE_DATA(dir, "middlebury_stereo2003_teddy");
-  const FilterScores all = scoreFilter(teddy().truth, filterRatio(teddy().input));
+  const FilterScores all = scoreFilter(teddy().truth, filterRatio(teddy().putative));
   EXPECT_EQ(all.kept, all.putative);
   EXPECT_GT(all.correct_putative, 250u);  // measured: 294 of 361
   EXPECT_GT(all.wrong_putative, 30u);     // measured: 54
@@ -356,7 +333,7 @@ TEST(RealData, TeddyFiltersMeetTheirFloors) {
 
 TEST(RealData, GrafFiltersMeetTheirFloors) {
   SIFT_HULL_REQUIRE_DATA(dir, "oxford_affine_graf");
-  const FilterScores all = scoreFilter(graf().truth, filterRatio(graf().input));
+  const FilterScores all = scoreFilter(graf().truth, filterRatio(graf().putative));
   EXPECT_GT(all.wrong_putative, 100u);  // measured: 137 of 1179
   expectFloors(graf(), {
                            {"ratio", 0.86, 0.98},   // measured: 0.884, 1.0

@@ -12,6 +12,7 @@
 #include "sift_hull/features.h"
 #include "sift_hull/matching.h"
 #include "sift_hull/scene.h"
+#include "test_data.h"
 
 namespace sift_hull {
 namespace {
@@ -29,15 +30,8 @@ MatchSet asSet(const std::vector<cv::DMatch>& matches) {
 class TwoViews : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    SceneConfig config;
-    config.views = 12;
-    config.width_px = 320;
-    config.height_px = 240;
-    const Shape shape = Shape::byName(config.shape);
-    const std::vector<CalibratedView> cameras = sceneCameras(config, shape);
     for (int i = 0; i < 2; ++i) {
-      images_[i] =
-          renderView(shape, cameras[i], {config.width_px, config.height_px}, config.seed).image;
+      images_[i] = renderSceneView(test::smallRing(), i).image;
       features_[i] = detectSift(images_[i]);
     }
   }

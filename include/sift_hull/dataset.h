@@ -51,6 +51,9 @@ void writeMiddleburyPar(const std::string& path, const std::vector<CalibratedVie
 /// Directory of a file path ("." when it has none).
 std::string parentDirectory(const std::string& path);
 
+/// Reads a colour image; throws std::runtime_error "PATH: image missing or unreadable".
+cv::Mat readImage(const std::string& path);
+
 /// Reads the image a view names, from `directory`. Throws std::runtime_error naming the image and
 /// the calibration line that names it when the view has no image name or the image is missing or
 /// cannot be decoded. Colour images come back as BGR, 8 bits per channel.

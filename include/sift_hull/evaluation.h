@@ -53,6 +53,22 @@ std::vector<MatchTruth> judgeBySceneDepth(const PutativeMatches& input, const De
                                           const DepthView& right,
                                           const TruthTolerances& tolerances = {});
 
+/// Putative matches with the ground truth's verdict on each.
+struct LabelledMatches {
+  PutativeMatches putative;
+  std::vector<MatchTruth> truth;
+};
+
+/// Middlebury 2003 Teddy (quarter size) in `directory`: matches of im2 (left) and im6 (right),
+/// with the F of a rectified pair, judged by disp2.pgm (disparity * 4). Throws when a file is
+/// missing.
+LabelledMatches matchTeddy(const std::string& directory, const SiftConfig& sift,
+                           const MatchConfig& matching);
+
+/// Oxford graf in `directory`: matches of img1 and imgN, judged by H1toNp; no calibration.
+LabelledMatches matchGraf(const std::string& directory, int n, const SiftConfig& sift,
+                          const MatchConfig& matching);
+
 /// A filter's result measured against the ground truth.
 struct FilterScores {
   size_t putative = 0, kept = 0;

@@ -42,6 +42,9 @@ RenderedView renderView(const Shape& shape, const CalibratedView& view, cv::Size
 
 std::vector<RenderedView> renderScene(const SceneConfig& config);
 
+/// One view of a scene (index into sceneCameras), rendered alone.
+RenderedView renderSceneView(const SceneConfig& config, size_t index);
+
 /// Sub-directories of a scene directory holding, under each view's name, its mask (PNG) and its
 /// depth map (the name with the extension .pfm).
 inline constexpr const char* kMaskDirectory = "masks";

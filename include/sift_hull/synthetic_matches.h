@@ -22,11 +22,6 @@ struct SyntheticMatchConfig {
   unsigned seed = 1;
 };
 
-struct LabelledMatches {
-  PutativeMatches putative;
-  std::vector<MatchTruth> truth;
-};
-
 /// Inliers first, then outliers; inlier right points that leave the image are drawn again.
 LabelledMatches syntheticMatches(const SyntheticMatchConfig& config);
 

@@ -96,7 +96,7 @@ nlohmann::json tableOne(const std::string& data_root, std::string* why_not) {
     options.matching.ratio = ratio;
     const std::optional<EvaluationPair> teddy = teddyPair(data_root, options, why_not);
     if (!teddy) return nullptr;
-    rows.push_back(tableOneRow(subset({teddy->input, teddy->truth}, 100, 1), ratio));
+    rows.push_back(tableOneRow(subset(teddy->matches, 100, 1), ratio));
   }
   return rows;
 }
@@ -254,8 +254,7 @@ int runBenchFilters(const std::vector<std::string>& args) {
   result["table1"] = tableOne(data_root, &why_not);
   if (result["table1"].is_null()) result["table1_skipped"] = why_not;
   const std::optional<EvaluationPair> teddy = teddyPair(data_root, MatchOptions(), &why_not);
-  const LabelledMatches base =
-      teddy ? LabelledMatches{teddy->input, teddy->truth} : syntheticBase();
+  const LabelledMatches base = teddy ? teddy->matches : syntheticBase();
   result["sweep_base"] =
       teddy ? "Teddy matches (ratio 0.8), tiled, plus 30 % random mismatches"
             : "synthetic rectified matches plus 30 % random mismatches (" + why_not + ")";

@@ -17,31 +17,28 @@ namespace {
 
 /// Two neighbouring views (22.5 degrees apart) of the default synthetic scene, 640x480.
 EvaluationPair scenePair(const MatchOptions& options) {
-  SceneConfig config;
-  config.views = 16;
-  const std::vector<CalibratedView> cameras = sceneCameras(config, Shape::byName(config.shape));
-  const cv::Size size(config.width_px, config.height_px);
-  const Shape shape = Shape::byName(config.shape);
-  const RenderedView left = renderView(shape, cameras[0], size, config.seed);
-  const RenderedView right = renderView(shape, cameras[1], size, config.seed);
+  const SceneConfig config;
+  const RenderedView left = renderSceneView(config, 0), right = renderSceneView(config, 1);
   EvaluationPair pair;
   pair.name = "synthetic scene, views 0-1";
-  pair.input = matchImages(left.image, right.image, options.sift, options.matching);
-  pair.input.F_right_left = fundamentalMatrix(left.view.camera, right.view.camera);
-  pair.truth = judgeBySceneDepth(pair.input, {left.view.camera, left.depth},
-                                 {right.view.camera, right.depth});
+  PutativeMatches& input = pair.matches.putative;
+  input = matchImages(left.image, right.image, options.sift, options.matching);
+  input.F_right_left = fundamentalMatrix(left.view.camera, right.view.camera);
+  pair.matches.truth =
+      judgeBySceneDepth(input, {left.view.camera, left.depth}, {right.view.camera, right.depth});
   return pair;
 }
 
 nlohmann::json evaluatePair(const EvaluationPair& pair, double ratio) {
-  nlohmann::json row = {{"pair", pair.name}, {"ratio", ratio}, {"putative", pair.truth.size()}};
-  row["ground_truth"] = truthJson("", pair.truth);
+  const LabelledMatches& matches = pair.matches;
+  nlohmann::json row = {{"pair", pair.name}, {"ratio", ratio}, {"putative", matches.truth.size()}};
+  row["ground_truth"] = truthJson("", matches.truth);
   row["ground_truth"].erase("kind");
   row["filters"] = nlohmann::json::object();
   for (const std::string& name : filterNames()) {
-    if (name == "epipolar" && !pair.input.F_right_left) continue;
-    const FilterRun run = timedRun(*makeFilter(name, FilterConfigs()), pair.input);
-    row["filters"][name] = filterRunJson(run, &pair.truth);
+    if (name == "epipolar" && !matches.putative.F_right_left) continue;
+    const FilterRun run = timedRun(*makeFilter(name, FilterConfigs()), matches.putative);
+    row["filters"][name] = filterRunJson(run, &matches.truth);
   }
   return row;
 }

@@ -19,12 +19,6 @@ std::string baseName(const std::string& path) {
   return slash == std::string::npos ? path : path.substr(slash + 1);
 }
 
-cv::Mat readImage(const std::string& path) {
-  const cv::Mat image = cv::imread(path, cv::IMREAD_COLOR);
-  if (image.empty()) throw std::runtime_error(path + ": cannot read the image");
-  return image;
-}
-
 void writeImage(const std::string& path, const cv::Mat& image) {
   if (!cv::imwrite(path, image)) throw std::runtime_error(path + ": cannot write the image");
 }

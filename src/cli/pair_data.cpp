@@ -4,7 +4,6 @@
 
 #include <cstdlib>
 #include <fstream>
-#include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
 namespace sift_hull {
@@ -24,12 +23,6 @@ std::string dataSet(const std::string& root, const std::string& name, std::strin
   return "";
 }
 
-cv::Mat readImage(const std::string& path) {
-  const cv::Mat image = cv::imread(path, cv::IMREAD_COLOR);
-  if (image.empty()) throw std::runtime_error(path + ": cannot read the image");
-  return image;
-}
-
 }  // namespace
 
 std::string defaultDataRoot() {
@@ -41,26 +34,15 @@ std::optional<EvaluationPair> teddyPair(const std::string& data_root, const Matc
                                         std::string* why_not) {
   const std::string dir = dataSet(data_root, "middlebury_stereo2003_teddy", why_not);
   if (dir.empty()) return std::nullopt;
-  EvaluationPair pair;
-  pair.name = "teddy";
-  pair.input = matchImages(readImage(dir + "/im2.png"), readImage(dir + "/im6.png"), options.sift,
-                           options.matching);
-  pair.input.F_right_left = rectifiedFundamentalMatrix();
-  pair.truth = judgeByDisparity(pair.input, readDisparity(dir + "/disp2.pgm", 4.0));
-  return pair;
+  return EvaluationPair{"teddy", matchTeddy(dir, options.sift, options.matching)};
 }
 
 std::optional<EvaluationPair> grafPair(const std::string& data_root, int n,
                                        const MatchOptions& options, std::string* why_not) {
   const std::string dir = dataSet(data_root, "oxford_affine_graf", why_not);
   if (dir.empty()) return std::nullopt;
-  const std::string index = std::to_string(n);
-  EvaluationPair pair;
-  pair.name = "graf 1-" + index;
-  pair.input = matchImages(readImage(dir + "/img1.png"), readImage(dir + "/img" + index + ".png"),
-                           options.sift, options.matching);
-  pair.truth = judgeByHomography(pair.input, readHomography(dir + "/H1to" + index + "p"));
-  return pair;
+  return EvaluationPair{"graf 1-" + std::to_string(n),
+                        matchGraf(dir, n, options.sift, options.matching)};
 }
 
 void replaceMarkedSection(const std::string& path, const std::string& name,

@@ -16,8 +16,7 @@ std::string defaultDataRoot();
 /// A real image pair, its putative matches and their ground truth.
 struct EvaluationPair {
   std::string name;
-  PutativeMatches input;
-  std::vector<MatchTruth> truth;
+  LabelledMatches matches;
 };
 
 /// Middlebury Teddy (rectified; F of a rectified pair; disparity ground truth). Empty, with

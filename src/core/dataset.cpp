@@ -206,6 +206,12 @@ std::string parentDirectory(const std::string& path) {
   return slash == 0 ? "/" : path.substr(0, slash);
 }
 
+cv::Mat readImage(const std::string& path) {
+  cv::Mat image = readImageFile(path, cv::IMREAD_COLOR);
+  if (image.empty()) throw std::runtime_error(path + ": image missing or unreadable");
+  return image;
+}
+
 cv::Mat loadViewImage(const std::string& directory, const CalibratedView& view) {
   const std::string named_at = view.source.empty() ? "" : " (named at " + view.source + ")";
   if (view.name.empty()) {

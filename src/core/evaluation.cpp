@@ -106,6 +106,27 @@ std::vector<MatchTruth> judgeBySceneDepth(const PutativeMatches& input, const De
   });
 }
 
+LabelledMatches matchTeddy(const std::string& directory, const SiftConfig& sift,
+                           const MatchConfig& matching) {
+  LabelledMatches result;
+  result.putative = matchImages(readImage(directory + "/im2.png"),
+                                readImage(directory + "/im6.png"), sift, matching);
+  result.putative.F_right_left = rectifiedFundamentalMatrix();
+  result.truth = judgeByDisparity(result.putative, readDisparity(directory + "/disp2.pgm", 4.0));
+  return result;
+}
+
+LabelledMatches matchGraf(const std::string& directory, int n, const SiftConfig& sift,
+                          const MatchConfig& matching) {
+  const std::string index = std::to_string(n);
+  LabelledMatches result;
+  result.putative = matchImages(readImage(directory + "/img1.png"),
+                                readImage(directory + "/img" + index + ".png"), sift, matching);
+  result.truth =
+      judgeByHomography(result.putative, readHomography(directory + "/H1to" + index + "p"));
+  return result;
+}
+
 double FilterScores::precision() const { return ratio(correct_kept, correct_kept + wrong_kept); }
 
 double FilterScores::recall() const { return ratio(correct_kept, correct_putative); }

@@ -182,6 +182,14 @@ std::vector<RenderedView> renderScene(const SceneConfig& config) {
   return rendered;
 }
 
+RenderedView renderSceneView(const SceneConfig& config, size_t index) {
+  const Shape shape = Shape::byName(config.shape);
+  const std::vector<CalibratedView> cameras = sceneCameras(config, shape);
+  if (index >= cameras.size()) throw std::out_of_range("renderSceneView: no such view");
+  return renderView(shape, cameras[index], cv::Size(config.width_px, config.height_px),
+                    config.seed);
+}
+
 void writeScene(const std::string& directory, const SceneConfig& config,
                 const std::vector<RenderedView>& views) {
   makeDirectory(directory);
