@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <ctime>
 #include <functional>
 #include <iomanip>
 #include <numeric>
@@ -203,10 +202,7 @@ std::string sweepMarkdown(const nlohmann::json& sweep) {
 
 std::string markdown(const nlohmann::json& result) {
   std::ostringstream md;
-  const std::time_t now = std::time(nullptr);
-  char date[32];
-  std::strftime(date, sizeof date, "%Y-%m-%d", std::gmtime(&now));
-  md << "Written by `sift_hull bench-filters --write docs/BENCHMARKS.md` on " << date << ", "
+  md << "Written by `sift_hull bench-filters --write docs/BENCHMARKS.md` on " << todayUtc() << ", "
      << std::thread::hardware_concurrency() << " hardware threads. Times are medians of "
      << "repeated runs (at least 3, up to 101 or about 1.5 s per cell).\n\n";
   if (result["table1"].is_null()) {

@@ -1,7 +1,6 @@
 // evaluate-filters: precision, recall and F1 of every filter on real pairs with ground truth
 // (Teddy at three ratios, graf 1-2, 1-3, 1-4) and on a synthetic scene pair.
 
-#include <ctime>
 #include <iomanip>
 #include <sstream>
 
@@ -51,11 +50,8 @@ std::string cell(const nlohmann::json& value) {
 }
 
 std::string markdown(const nlohmann::json& rows, const nlohmann::json& skipped) {
-  const std::time_t now = std::time(nullptr);
-  char date[32];
-  std::strftime(date, sizeof date, "%Y-%m-%d", std::gmtime(&now));
   std::ostringstream md;
-  md << "Written by `sift_hull evaluate-filters --write docs/EVALUATION.md` on " << date
+  md << "Written by `sift_hull evaluate-filters --write docs/EVALUATION.md` on " << todayUtc()
      << ". P = precision, R = recall of the correct putatives, F1; default thresholds.\n\n"
      << "| pair | ratio | putative (correct / wrong / unknown) | filter | kept | P | R | F1 | "
         "mismatches removed |\n| --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";

@@ -3,6 +3,7 @@
 #include <sys/stat.h>
 
 #include <cstdlib>
+#include <ctime>
 #include <fstream>
 #include <sstream>
 
@@ -43,6 +44,13 @@ std::optional<EvaluationPair> grafPair(const std::string& data_root, int n,
   if (dir.empty()) return std::nullopt;
   return EvaluationPair{"graf 1-" + std::to_string(n),
                         matchGraf(dir, n, options.sift, options.matching)};
+}
+
+std::string todayUtc() {
+  const std::time_t now = std::time(nullptr);
+  char date[32];
+  std::strftime(date, sizeof date, "%Y-%m-%d", std::gmtime(&now));
+  return date;
 }
 
 void replaceMarkedSection(const std::string& path, const std::string& name,
