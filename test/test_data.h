@@ -40,6 +40,11 @@ inline std::string dataSet(const std::string& name) {
   return stat(path.c_str(), &info) == 0 ? path : std::string();
 }
 
+inline bool fileExists(const std::string& path) {
+  struct stat info;
+  return stat(path.c_str(), &info) == 0;
+}
+
 /// A fresh directory under the system's temporary directory (never the working directory).
 inline std::string temporaryDirectory() {
   const char* base = std::getenv("TMPDIR");

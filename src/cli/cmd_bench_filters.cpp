@@ -12,6 +12,7 @@
 #include <thread>
 
 #include "args.h"
+#include "bench_timing.h"
 #include "commands.h"
 #include "match_eval.h"
 #include "pair_data.h"
@@ -24,21 +25,6 @@ namespace {
 // The paper's Table 1: seconds to verify 100 matches.
 constexpr double kPaperEpipolarMs = 194.3, kPaperGscMs = 9.8;
 const std::vector<size_t> kSweepSizes = {100, 1000, 2000, 10000};
-
-/// Median wall time of `run` over repeats: at least 3, more while under `budget_ms`, at most 101.
-double medianMs(const std::function<void()>& run, double budget_ms) {
-  std::vector<double> times;
-  double total = 0.0;
-  while (times.size() < 3 || (total < budget_ms && times.size() < 101)) {
-    const auto start = std::chrono::steady_clock::now();
-    run();
-    const auto stop = std::chrono::steady_clock::now();
-    times.push_back(std::chrono::duration<double, std::milli>(stop - start).count());
-    total += times.back();
-  }
-  std::nth_element(times.begin(), times.begin() + times.size() / 2, times.end());
-  return times[times.size() / 2];
-}
 
 /// `count` matches drawn without replacement (fixed seed), keeping F and image sizes.
 LabelledMatches subset(const LabelledMatches& all, size_t count, unsigned seed) {

@@ -26,6 +26,8 @@ int runScene(const std::vector<std::string>& args);
 int runMatch(const std::vector<std::string>& args);
 int runBenchFilters(const std::vector<std::string>& args);
 int runEvaluateFilters(const std::vector<std::string>& args);
+int runHull(const std::vector<std::string>& args);
+int runBenchHull(const std::vector<std::string>& args);
 
 /// Parses the command line and runs the chosen command.
 int runMain(int argc, char** argv);

@@ -1,0 +1,195 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "sift_hull/bounding_box.h"
+#include "sift_hull/camera.h"
+#include "sift_hull/mesh.h"
+
+namespace sift_hull {
+
+namespace detail {
+struct HullNode;
+}
+
+/// Signed distance transform of a silhouette in pixels: negative inside, positive outside, zero
+/// on the boundary between inside and outside pixel squares (OpenCV's exact Euclidean
+/// distanceTransform of the mask and of its complement). The map is padded around the image with
+/// `padding_px` pixels; a padding pixel counts as inside when it lies within the silhouette's
+/// bounds, whose sides are open where the image border cuts the silhouette. So a view does not
+/// carve beyond a side of its image where the object may go on, exactly as the bounding-box LP
+/// assumes. Look-ups beyond the padding are clamped to it.
+class SignedDistanceMap {
+ public:
+  SignedDistanceMap() = default;
+  /// `mask`: CV_8UC1, non-zero inside; `bounds`: silhouetteBounds() of the mask. Throws
+  /// std::invalid_argument for another type or an empty mask.
+  SignedDistanceMap(const cv::Mat& mask, const SilhouetteBounds& bounds, int padding_px);
+
+  /// Bilinear look-up at pixel coordinates (pixel centres at integers), clamped to the map.
+  float at(double u_px, double v_px) const;
+  cv::Size imageSize() const { return image_size_; }
+
+ private:
+  cv::Mat distance_px_;  ///< CV_32FC1, padded
+  cv::Size image_size_;
+  int padding_px_ = 0;
+};
+
+/// Octree carving settings.
+struct HullConfig {
+  /// Octree levels below the root cube; resolution = cube edge / 2^max_depth.
+  int max_depth = 8;
+  /// Whether a view carves what it sees outside its image. When false, a view keeps the points
+  /// seen beyond a side of its image where the border cuts its silhouette (the object may go on
+  /// there), and carves the rest; see SignedDistanceMap.
+  bool carve_outside_image = false;
+  /// Added to a cell's projected radius before comparing with the signed distance: covers the error
+  /// of the pixel-sampled, interpolated transform.
+  double distance_slack_px = 1.0;
+  int padding_px = 16;  ///< around each distance map (see SignedDistanceMap)
+  int threads = 2;      ///< for carving and for the mesh's field samples
+};
+
+/// Throws std::invalid_argument naming the first bad field.
+void validate(const HullConfig& config);
+
+/// Where a view puts a cell or point.
+enum class Verdict : uint8_t { kOut, kIn, kUndecided };
+
+/// One calibrated silhouette, ready for carving.
+class HullView {
+ public:
+  /// Throws std::invalid_argument for a mask that is not a non-empty CV_8UC1.
+  HullView(std::string name, const PinholeCamera& camera, const cv::Mat& mask,
+           const HullConfig& config);
+
+  const std::string& name() const { return name_; }
+  const PinholeCamera& camera() const { return camera_; }
+  const cv::Mat& mask() const { return mask_; }
+  /// The silhouette's 2-D bounds; open sides where the border cuts it, unless carving outside.
+  const SilhouetteBounds& bounds() const { return bounds_; }
+  cv::Size imageSize() const { return mask_.size(); }
+
+  /// D_i(P_i X) of the paper's eq. 9 in pixels. A point not in front of the camera gets
+  /// kFarOutside_px when the view has a bounded side (the LP's depth row), else -kFarOutside_px.
+  float valueAt(const Eigen::Vector3d& X_W) const;
+  /// The brute-force test of dense carving: whether the view keeps a point, by the mask pixel
+  /// nearest to its projection, or by the bounds outside the image.
+  bool keeps(const Eigen::Vector3d& X_W) const;
+  /// Whether every point of the ball (centre_W, radius_m) is out of or in the silhouette, from the
+  /// distance at the centre and the ball's projected radius. `centre_value` gets valueAt(centre_W).
+  Verdict classifyBall(const Eigen::Vector3d& centre_W, double radius_m, float* centre_value) const;
+
+  static constexpr float kFarOutside_px = 1e6f;
+
+ private:
+  float valueInCamera(const Eigen::Vector3d& X_C) const;
+
+  std::string name_;
+  PinholeCamera camera_;
+  cv::Mat mask_;
+  SilhouetteBounds bounds_;
+  SignedDistanceMap distance_;
+  double k_norm_ = 1.0;  ///< spectral norm of K's upper-left 2x2: pixels per unit of x/z, y/z
+  bool carves_behind_ = true;
+  double slack_px_ = 1.0;
+};
+
+/// Prepares views (their distance transforms) on `config.threads` threads. Names, cameras and
+/// masks have one entry per view.
+std::vector<HullView> makeHullViews(const std::vector<std::string>& names,
+                                    const std::vector<PinholeCamera>& cameras,
+                                    const std::vector<cv::Mat>& masks, const HullConfig& config);
+
+/// The octree's root cube: the box's longest edge plus at least one voxel on every side, its
+/// corner on the voxel grid (integer multiples of the resolution), so that cells line up with an
+/// OctoMap of the same resolution.
+struct HullCube {
+  Eigen::Vector3i origin_voxels = Eigen::Vector3i::Zero();  ///< corner / resolution
+  double resolution_m = 1.0;                                ///< finest cell edge
+  int depth = 1;
+
+  static HullCube around(const Box3d& box, int depth);
+  Eigen::Vector3d origin_W() const { return origin_voxels.cast<double>() * resolution_m; }
+  double edge_m() const { return resolution_m * (1 << depth); }
+  Box3d box() const;
+};
+
+enum class CellState : uint8_t { kOut, kIn, kSurface };
+
+/// A leaf of the octree: the cell at `depth` with integer index `index` (in cells of that depth)
+/// spans cube.origin_W() + cell_edge * [index, index + 1].
+struct HullCell {
+  Eigen::Vector3i index = Eigen::Vector3i::Zero();
+  int depth = 0;
+  CellState state = CellState::kIn;
+  /// f_iso (eq. 9) at the centre over the views carved so far; meaningful for in and surface cells.
+  float centre_value = 0.0f;
+};
+
+/// Leaf counts and memory of the octree.
+struct HullStats {
+  size_t in_leaves = 0, out_leaves = 0, surface_leaves = 0, nodes = 0;
+  size_t bytes = 0;                 ///< octree nodes only
+  double occupied_volume_m3 = 0.0;  ///< in cells plus finest surface cells with centre inside
+};
+
+/// The visual hull as an octree over a cube, classified with f_iso(v) = max_i D_i(P_i v) (eq. 9):
+/// a cell is out when one view sees all of it outside its silhouette, in when every view sees all
+/// of it inside, otherwise on the surface and split down to config.max_depth. Adding views refines
+/// the existing tree and gives exactly the tree that adding them all at once gives.
+class VisualHull {
+ public:
+  /// Throws std::invalid_argument for a bad config or an empty box.
+  VisualHull(const Box3d& box, const HullConfig& config);
+  ~VisualHull();
+  VisualHull(VisualHull&&) noexcept;
+  VisualHull& operator=(VisualHull&&) noexcept;
+
+  /// Carves with more views. Before any view the whole cube is one in cell.
+  void addViews(std::vector<HullView> views);
+  void addView(HullView view);
+  /// Back to one in cell and no views.
+  void reset();
+
+  const HullCube& cube() const { return cube_; }
+  const HullConfig& config() const { return config_; }
+  const std::vector<HullView>& views() const { return views_; }
+
+  void forEachLeaf(const std::function<void(const HullCell&)>& visit) const;
+  HullStats stats() const;
+  /// The leaf holding a world point (a point outside the cube is out).
+  HullCell leafAt(const Eigen::Vector3d& X_W) const;
+  /// f_iso at a world point over all views (-kFarOutside_px without views).
+  float valueAt(const Eigen::Vector3d& X_W) const;
+  /// f_iso at many points, on config.threads threads.
+  void sampleField(const std::vector<Eigen::Vector3d>& points_W, std::vector<float>* values) const;
+
+  /// The finest surface cells, for marching cubes.
+  SurfaceCells surfaceCells() const;
+  /// Marching cubes on f_iso over the surface cells.
+  TriangleMesh mesh() const;
+
+ private:
+  HullCube cube_;
+  HullConfig config_;
+  std::vector<HullView> views_;
+  std::unique_ptr<detail::HullNode> root_;
+};
+
+/// Occupied cells for maps: in cells of any size and surface cells at the finest level, each as
+/// (min corner in voxels relative to the world origin, edge in voxels).
+struct VoxelBlock {
+  Eigen::Vector3i min_voxels;
+  int edge_voxels;
+};
+std::vector<VoxelBlock> occupiedBlocks(const VisualHull& hull);
+
+}  // namespace sift_hull

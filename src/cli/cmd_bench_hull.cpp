@@ -1,0 +1,254 @@
+// bench-hull: the visual hull on dino and temple at depths 7, 8 and 9 against dense voxel carving
+// at the same resolution, in one run; medians of repeated runs.
+
+#include <algorithm>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+#include <thread>
+
+#include "args.h"
+#include "bench_timing.h"
+#include "commands.h"
+#include "pair_data.h"
+#include "sift_hull/hull_evaluation.h"
+#include "sift_hull/hull_pipeline.h"
+
+namespace sift_hull {
+namespace cli {
+namespace {
+
+const std::vector<int> kDepths = {7, 8, 9};
+
+struct HullDataset {
+  std::string name, directory, calibration, view_list;  ///< view_list empty: all views
+};
+
+const std::vector<HullDataset> kDatasets = {
+    {"dino", "middlebury_mvs_dinoSparseRing", "dinoSR_par.txt",
+     "dinoSR_good_silhouette_images.txt"},
+    {"temple", "middlebury_mvs_templeSparseRing", "templeSR_par.txt", ""},
+};
+
+/// One data set at one depth: the hull's stage times (medians), its quality, and dense carving.
+struct DepthRun {
+  int depth = 0;
+  HullTimings time;
+  size_t surface_leaves = 0, mesh_faces = 0;
+  bool watertight = false;
+  ReprojectionIoU iou;
+  double dense_ms = 0.0, volume_iou = 0.0;
+};
+
+double median(std::vector<double> values) {
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  return values[values.size() / 2];
+}
+
+HullTimings medianTimings(const std::vector<HullTimings>& runs) {
+  const auto field = [&](double HullTimings::*member) {
+    std::vector<double> values;
+    for (const HullTimings& run : runs) values.push_back(run.*member);
+    return median(values);
+  };
+  return {field(&HullTimings::distance_ms), field(&HullTimings::bbox_ms),
+          field(&HullTimings::octree_ms), field(&HullTimings::mesh_ms),
+          field(&HullTimings::total_ms)};
+}
+
+/// Runs the hull at least 3 times (more while under ~2 s) and keeps the last result.
+DepthRun timeHull(const HullInput& input, int depth, std::optional<HullResult>* last) {
+  HullConfig config;
+  config.max_depth = depth;
+  std::vector<HullTimings> runs;
+  double total_ms = 0.0;
+  while (runs.size() < 3 || (total_ms < 2000.0 && runs.size() < 21)) {
+    last->reset();
+    last->emplace(buildHull(input, config));
+    runs.push_back((*last)->time);
+    total_ms += runs.back().total_ms;
+  }
+  DepthRun run;
+  run.depth = depth;
+  run.time = medianTimings(runs);
+  run.surface_leaves = (*last)->hull.stats().surface_leaves;
+  run.mesh_faces = (*last)->mesh.faces.size();
+  run.watertight = (*last)->mesh_check.watertight;
+  run.iou = reprojectionIoU((*last)->mesh, (*last)->hull.views());
+  return run;
+}
+
+void compareWithDense(const HullResult& result, DepthRun* run) {
+  const VisualHull& hull = result.hull;
+  const int cells = 1 << hull.cube().depth;
+  DenseGrid dense;
+  run->dense_ms = medianMs(
+      [&] { dense = denseCarving(hull.views(), hull.cube().box(), cells, hull.config().threads); },
+      3000.0, 1);
+  run->volume_iou = volumeIoU(hull, dense);
+}
+
+struct DatasetRuns {
+  std::string name;
+  size_t views = 0;
+  std::vector<DepthRun> depths;
+  double peak_mib_depth9 = 0.0;  ///< of a separate `sift_hull hull --depth 9` process
+};
+
+DatasetRuns benchDataset(const HullInput& input, const std::string& name) {
+  DatasetRuns runs{name, input.names.size(), {}, 0.0};
+  for (int depth : kDepths) {
+    std::optional<HullResult> last;
+    runs.depths.push_back(timeHull(input, depth, &last));
+    compareWithDense(*last, &runs.depths.back());
+  }
+  return runs;
+}
+
+/// Peak memory of the whole `hull` command at depth 9 (loading, silhouettes, hull, OctoMap, IoU),
+/// run as a child process so that nothing else of this benchmark counts.
+double hullCommandPeakMiB(const std::string& directory, const HullDataset& dataset) {
+  std::string command = "/proc/self/exe hull --depth 9 --json --calib '" + directory + "/" +
+                        dataset.calibration + "' --images '" + directory + "'";
+  if (!dataset.view_list.empty())
+    command += " --views-file '" + directory + "/" + dataset.view_list + "'";
+  FILE* pipe = popen(command.c_str(), "r");
+  if (pipe == nullptr) throw std::runtime_error("cannot run: " + command);
+  std::string output;
+  char buffer[4096];
+  while (size_t read = fread(buffer, 1, sizeof buffer, pipe)) output.append(buffer, read);
+  if (pclose(pipe) != 0) throw std::runtime_error("failed: " + command);
+  return nlohmann::json::parse(output).at("peak_memory_mib").get<double>();
+}
+
+HullInput loadDataset(const std::string& root, const HullDataset& dataset) {
+  const std::string directory = root + "/" + dataset.directory;
+  const std::vector<std::string> names = dataset.view_list.empty()
+                                             ? std::vector<std::string>{}
+                                             : readViewList(directory + "/" + dataset.view_list);
+  return loadHullInput(directory + "/" + dataset.calibration, directory, "", SilhouetteConfig{},
+                       names);
+}
+
+nlohmann::json depthJson(const DepthRun& run) {
+  return {{"depth", run.depth},
+          {"time_ms",
+           {{"distance", run.time.distance_ms},
+            {"bbox", run.time.bbox_ms},
+            {"octree", run.time.octree_ms},
+            {"mesh", run.time.mesh_ms},
+            {"total", run.time.total_ms}}},
+          {"surface_leaves", run.surface_leaves},
+          {"mesh_faces", run.mesh_faces},
+          {"watertight", run.watertight},
+          {"reprojection_iou", {{"min", run.iou.min}, {"mean", run.iou.mean}}},
+          {"dense_ms", run.dense_ms},
+          {"volume_iou_vs_dense", run.volume_iou}};
+}
+
+std::string fixed(double value, int digits) {
+  std::ostringstream out;
+  out << std::fixed << std::setprecision(digits) << value;
+  return out.str();
+}
+
+std::string markdownTable(const std::vector<DatasetRuns>& all) {
+  std::ostringstream out;
+  out << "| data (views) | depth | distance | bbox | octree | mesh | total | dense carving | "
+         "dense / octree | dense / total | surface leaves | faces | watertight | reproj. IoU "
+         "min / mean | volume IoU vs dense |\n"
+      << "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | "
+         "--- |\n";
+  for (const DatasetRuns& runs : all) {
+    for (const DepthRun& r : runs.depths) {
+      out << "| " << runs.name << " (" << runs.views << ") | " << r.depth << " | "
+          << fixed(r.time.distance_ms, 1) << " ms | " << fixed(r.time.bbox_ms, 1) << " ms | "
+          << fixed(r.time.octree_ms, 1) << " ms | " << fixed(r.time.mesh_ms, 1) << " ms | **"
+          << fixed(r.time.total_ms, 1) << " ms** | " << fixed(r.dense_ms, 0) << " ms | "
+          << fixed(r.dense_ms / r.time.octree_ms, 1) << "x | "
+          << fixed(r.dense_ms / r.time.total_ms, 1) << "x | " << r.surface_leaves << " | "
+          << r.mesh_faces << " | " << (r.watertight ? "yes" : "no") << " | " << fixed(r.iou.min, 4)
+          << " / " << fixed(r.iou.mean, 4) << " | " << fixed(r.volume_iou, 4) << " |\n";
+    }
+  }
+  return out.str();
+}
+
+nlohmann::json targetsJson(const std::vector<DatasetRuns>& all) {
+  double worst_8 = 0.0, worst_9 = 0.0, least_speedup = 1e300, least_iou = 1.0, peak_mib = 0.0;
+  for (const DatasetRuns& runs : all) {
+    peak_mib = std::max(peak_mib, runs.peak_mib_depth9);
+    for (const DepthRun& r : runs.depths) {
+      if (r.depth == 8) worst_8 = std::max(worst_8, r.time.total_ms);
+      if (r.depth == 8) least_speedup = std::min(least_speedup, r.dense_ms / r.time.octree_ms);
+      if (r.depth == 9) worst_9 = std::max(worst_9, r.time.total_ms);
+      least_iou = std::min(least_iou, r.iou.mean);
+    }
+  }
+  return {{"depth8_total_ms<=300", {{"measured_ms", worst_8}, {"met", worst_8 <= 300.0}}},
+          {"dense/octree_depth8>=10", {{"measured", least_speedup}, {"met", least_speedup >= 10}}},
+          {"depth9_total_ms<=2000", {{"measured_ms", worst_9}, {"met", worst_9 <= 2000.0}}},
+          {"depth9_peak_MiB<=300", {{"measured", peak_mib}, {"met", peak_mib <= 300.0}}},
+          {"mean_reprojection_iou>=0.98", {{"measured", least_iou}, {"met", least_iou >= 0.98}}}};
+}
+
+std::string markdownReport(const std::vector<DatasetRuns>& all, const nlohmann::json& targets) {
+  std::ostringstream out;
+  out << "Written by `sift_hull bench-hull --write docs/BENCHMARKS.md` on " << todayUtc() << ", "
+      << std::thread::hardware_concurrency() << " hardware threads, 2 carving threads. Times are "
+      << "medians of at least 3 runs (dense carving: at least 1, more within 3 s).\n\n"
+      << markdownTable(all) << "\nPeak resident memory of `sift_hull hull --depth 9` (the whole "
+      << "command: images, silhouettes, hull, mesh, OctoMap, IoU):";
+  for (const DatasetRuns& runs : all)
+    out << ' ' << runs.name << ' ' << fixed(runs.peak_mib_depth9, 0) << " MiB;";
+  out << "\n\n### Targets\n\n";
+  for (const auto& [name, value] : targets.items()) {
+    out << "- `" << name << "`: " << value.dump() << '\n';
+  }
+  return out.str();
+}
+
+int reportBench(const ArgParser& parser, const std::vector<DatasetRuns>& all) {
+  nlohmann::json json = {{"datasets", nlohmann::json::array()}, {"targets", targetsJson(all)}};
+  for (const DatasetRuns& runs : all) {
+    nlohmann::json depths = nlohmann::json::array();
+    for (const DepthRun& run : runs.depths) depths.push_back(depthJson(run));
+    json["datasets"].push_back({{"name", runs.name},
+                                {"views", runs.views},
+                                {"depths", depths},
+                                {"depth9_peak_mib", runs.peak_mib_depth9}});
+  }
+  const std::string report = markdownReport(all, json["targets"]);
+  if (parser.has("write")) replaceMarkedSection(parser.get("write"), "bench-hull", report);
+  printResult(parser.flag("json"), json, report);
+  return 0;
+}
+
+}  // namespace
+
+int runBenchHull(const std::vector<std::string>& args) {
+  ArgParser parser("bench-hull",
+                   "Times the visual hull (distance transforms, LP box, octree, mesh) on dino and\n"
+                   "temple at depths 7, 8, 9 against dense voxel carving at the same resolution.");
+  parser.addOption("data", "DIR", "data root (default: $SIFT_HULL_DATA or ../shared/data)");
+  parser.addOption("write", "MD", "replace the bench-hull section of this Markdown file");
+  parser.addFlag("json", "print the result as one JSON object");
+  if (!parser.parse(args)) return 0;
+  const std::string root = parser.has("data") ? parser.get("data") : defaultDataRoot();
+
+  std::vector<DatasetRuns> all;
+  for (const HullDataset& dataset : kDatasets) {
+    const std::string directory = root + "/" + dataset.directory;
+    if (root.empty() || !std::filesystem::exists(directory)) {
+      std::cerr << "bench-hull: skipping " << dataset.name << ": no " << directory << '\n';
+      continue;
+    }
+    all.push_back(benchDataset(loadDataset(root, dataset), dataset.name));
+    all.back().peak_mib_depth9 = hullCommandPeakMiB(directory, dataset);
+  }
+  return reportBench(parser, all);
+}
+
+}  // namespace cli
+}  // namespace sift_hull

@@ -1,0 +1,96 @@
+#include <octomap/OcTree.h>
+
+#include <opencv2/imgcodecs.hpp>
+#include <sstream>
+
+#include "args.h"
+#include "bench_timing.h"
+#include "commands.h"
+#include "hull_options.h"
+#include "sift_hull/hull_octomap.h"
+#include "silhouette_options.h"
+
+namespace sift_hull {
+namespace cli {
+namespace {
+
+std::vector<std::string> splitList(const std::string& text) {
+  std::vector<std::string> items;
+  std::istringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    if (!item.empty()) items.push_back(item);
+  }
+  return items;
+}
+
+std::vector<std::string> viewNamesFromArgs(const ArgParser& parser) {
+  if (parser.has("views") && parser.has("views-file")) {
+    throw UsageError("give --views or --views-file, not both");
+  }
+  if (parser.has("views")) return splitList(parser.get("views"));
+  if (parser.has("views-file")) return readViewList(parser.get("views-file"));
+  return {};
+}
+
+HullInput inputFromArgs(const ArgParser& parser) {
+  const std::string masks = parser.has("silhouettes") ? parser.get("silhouettes") : "";
+  return loadHullInput(parser.get("calib"), parser.get("images"), masks,
+                       silhouetteConfigFromArgs(parser), viewNamesFromArgs(parser));
+}
+
+void writeOutputs(const ArgParser& parser, const HullResult& result,
+                  const octomap::OcTree& octree) {
+  if (parser.has("out-mesh")) writePly(parser.get("out-mesh"), result.mesh);
+  if (parser.has("out-octree")) writeOctomap(octree, parser.get("out-octree"));
+  if (parser.has("out-render")) {
+    const std::string path = parser.get("out-render");
+    if (!cv::imwrite(path, renderTurntable(result.mesh, 4, cv::Size(480, 480)))) {
+      throw std::runtime_error(path + ": cannot write the image");
+    }
+  }
+}
+
+std::string hullText(const nlohmann::json& result) {
+  std::ostringstream text;
+  text << result["views"] << " views, depth " << result["depth"] << " (voxel "
+       << result["resolution"] << "), box " << result["bbox"]["min"] << " .. "
+       << result["bbox"]["max"] << "\noccupied leaves " << result["occupied_leaves"] << ", mesh "
+       << result["mesh"]["vertices"] << " vertices, " << result["mesh"]["faces"]
+       << " faces, watertight " << result["mesh"]["watertight"] << "\ntime (ms) "
+       << result["time_ms"].dump() << "\nreprojection IoU min " << result["reprojection_iou"]["min"]
+       << ", mean " << result["reprojection_iou"]["mean"] << '\n';
+  return text.str();
+}
+
+}  // namespace
+
+int runHull(const std::vector<std::string>& args) {
+  ArgParser parser("hull",
+                   "Visual hull of calibrated silhouettes: bounding box by linear programming,\n"
+                   "octree carving with signed distances, marching cubes.");
+  parser.addOption("calib", "FILE", "Middlebury par file or projection list");
+  parser.addOption("images", "DIR", "directory of the images the calibration names");
+  addSilhouetteOptions(&parser);
+  parser.addOption("views", "LIST", "comma-separated image names to use (default: all)");
+  parser.addOption("views-file", "FILE", "file of image names to use, one per line");
+  addHullOptions(&parser);
+  parser.addOption("out-mesh", "PLY", "write the mesh (binary PLY, world coordinates)");
+  parser.addOption("out-octree", "BT", "write the OctoMap (.bt)");
+  parser.addOption("out-render", "PNG", "write shaded renderings of the mesh");
+  parser.addFlag("json", "print the result as one JSON object");
+  if (!parser.parse(args)) return 0;
+
+  const HullConfig config = hullConfigFromArgs(parser);
+  const HullResult result = buildHull(inputFromArgs(parser), config, boxFromArgs(parser));
+  const std::unique_ptr<octomap::OcTree> octree = toOctomap(result.hull);
+  const ReprojectionIoU iou = reprojectionIoU(result.mesh, result.hull.views());
+  writeOutputs(parser, result, *octree);
+  nlohmann::json json = hullJson(result, octree->getNumLeafNodes(), iou);
+  json["peak_memory_mib"] = peakMemoryMiB();
+  printResult(parser.flag("json"), json, hullText(json));
+  return 0;
+}
+
+}  // namespace cli
+}  // namespace sift_hull

@@ -1,0 +1,25 @@
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <optional>
+
+#include "args.h"
+#include "sift_hull/hull_evaluation.h"
+#include "sift_hull/hull_pipeline.h"
+
+namespace sift_hull {
+namespace cli {
+
+/// --depth, --carve-outside-image, --slack, --threads, with HullConfig's defaults.
+void addHullOptions(ArgParser* parser);
+HullConfig hullConfigFromArgs(const ArgParser& parser);
+
+/// --box "XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX" when given.
+std::optional<Box3d> boxFromArgs(const ArgParser& parser);
+
+/// The object `sift_hull hull --json` prints.
+nlohmann::json hullJson(const HullResult& result, size_t occupied_leaves,
+                        const ReprojectionIoU& iou);
+
+}  // namespace cli
+}  // namespace sift_hull

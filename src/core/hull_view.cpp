@@ -1,0 +1,181 @@
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+#include <stdexcept>
+#include <thread>
+
+#include "sift_hull/visual_hull.h"
+
+namespace sift_hull {
+namespace {
+
+void checkMask(const cv::Mat& mask) {
+  if (mask.empty() || mask.type() != CV_8UC1) {
+    throw std::invalid_argument("silhouette must be a non-empty CV_8UC1 mask");
+  }
+}
+
+/// Distance of each pixel of `region` (non-zero) to the nearest pixel outside it; 0 outside.
+cv::Mat distanceWithin(const cv::Mat& region) {
+  cv::Mat distance;
+  cv::distanceTransform(region, distance, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
+  return distance;
+}
+
+double spectralNorm2x2(const Eigen::Matrix3d& K) {
+  return Eigen::JacobiSVD<Eigen::Matrix2d>(K.topLeftCorner<2, 2>()).singularValues()(0);
+}
+
+/// Whether a pixel (u, v) satisfies the bounds, open sides unbounded.
+bool withinBounds(const SilhouetteBounds& bounds, double u, double v) {
+  return !bounds.empty && (!bounds.has_u_min || u >= bounds.u_min_px) &&
+         (!bounds.has_u_max || u <= bounds.u_max_px) &&
+         (!bounds.has_v_min || v >= bounds.v_min_px) && (!bounds.has_v_max || v <= bounds.v_max_px);
+}
+
+/// The mask with a border of `padding` pixels, inside where withinBounds.
+cv::Mat paddedMask(const cv::Mat& mask, const SilhouetteBounds& bounds, int padding) {
+  cv::Mat padded(mask.rows + 2 * padding, mask.cols + 2 * padding, CV_8UC1);
+  for (int row = 0; row < padded.rows; ++row) {
+    for (int col = 0; col < padded.cols; ++col) {
+      const int u = col - padding, v = row - padding;
+      padded.at<uint8_t>(row, col) = (u >= 0 && v >= 0 && u < mask.cols && v < mask.rows)
+                                         ? (mask.at<uint8_t>(v, u) ? 255 : 0)
+                                     : withinBounds(bounds, u, v) ? 255
+                                                                  : 0;
+    }
+  }
+  return padded;
+}
+
+}  // namespace
+
+SignedDistanceMap::SignedDistanceMap(const cv::Mat& mask, const SilhouetteBounds& bounds,
+                                     int padding_px)
+    : image_size_(mask.size()), padding_px_(padding_px) {
+  checkMask(mask);
+  const cv::Mat inside = paddedMask(mask, bounds, padding_px);
+  const cv::Mat outside = inside == 0;
+  // Pixel distances are between centres; the boundary lies half a pixel from the last centre.
+  distance_px_ = distanceWithin(outside) - distanceWithin(inside);
+  cv::add(distance_px_, 0.5, distance_px_, inside);
+  cv::subtract(distance_px_, 0.5, distance_px_, outside);
+}
+
+float SignedDistanceMap::at(double u_px, double v_px) const {
+  const double u = std::clamp(u_px + padding_px_, 0.0, distance_px_.cols - 1.0);
+  const double v = std::clamp(v_px + padding_px_, 0.0, distance_px_.rows - 1.0);
+  const int u0 = std::min(static_cast<int>(u), distance_px_.cols - 2);
+  const int v0 = std::min(static_cast<int>(v), distance_px_.rows - 2);
+  const float fu = static_cast<float>(u - u0), fv = static_cast<float>(v - v0);
+  const float* top = distance_px_.ptr<float>(v0) + u0;
+  const float* bottom = distance_px_.ptr<float>(v0 + 1) + u0;
+  const float upper = top[0] + fu * (top[1] - top[0]);
+  const float lower = bottom[0] + fu * (bottom[1] - bottom[0]);
+  return upper + fv * (lower - upper);
+}
+
+void validate(const HullConfig& config) {
+  if (config.max_depth < 2 || config.max_depth > 12) {
+    throw std::invalid_argument("HullConfig::max_depth must be in 2..12");
+  }
+  if (!(config.distance_slack_px >= 0.0)) {
+    throw std::invalid_argument("HullConfig::distance_slack_px must be >= 0");
+  }
+  if (config.padding_px < 1) throw std::invalid_argument("HullConfig::padding_px must be >= 1");
+  if (config.threads < 1) throw std::invalid_argument("HullConfig::threads must be >= 1");
+}
+
+HullView::HullView(std::string name, const PinholeCamera& camera, const cv::Mat& mask,
+                   const HullConfig& config)
+    : name_(std::move(name)),
+      camera_(camera),
+      mask_((checkMask(mask), mask.clone())),
+      bounds_(silhouetteBounds(mask, config.carve_outside_image)),
+      distance_(mask, bounds_, config.padding_px),
+      k_norm_(spectralNorm2x2(camera.K())),
+      carves_behind_(bounds_.empty || bounds_.boundedSides() > 0),
+      slack_px_(config.distance_slack_px) {}
+
+float HullView::valueInCamera(const Eigen::Vector3d& X_C) const {
+  if (!(X_C.z() > 0.0)) return carves_behind_ ? kFarOutside_px : -kFarOutside_px;
+  const Eigen::Vector3d pixel = camera_.K() * (X_C / X_C.z());
+  return distance_.at(pixel.x(), pixel.y());
+}
+
+float HullView::valueAt(const Eigen::Vector3d& X_W) const {
+  return valueInCamera(camera_.toCamera(X_W));
+}
+
+bool HullView::keeps(const Eigen::Vector3d& X_W) const {
+  const Eigen::Vector3d X_C = camera_.toCamera(X_W);
+  if (!(X_C.z() > 0.0)) return !carves_behind_;
+  const Eigen::Vector3d pixel = camera_.K() * (X_C / X_C.z());
+  const long u = std::lround(pixel.x()), v = std::lround(pixel.y());
+  if (u < 0 || v < 0 || u >= mask_.cols || v >= mask_.rows) {
+    return withinBounds(bounds_, pixel.x(), pixel.y());
+  }
+  return mask_.at<uint8_t>(static_cast<int>(v), static_cast<int>(u)) != 0;
+}
+
+Verdict HullView::classifyBall(const Eigen::Vector3d& centre_W, double radius_m,
+                               float* centre_value) const {
+  const Eigen::Vector3d X_C = camera_.toCamera(centre_W);
+  const double depth = X_C.z();
+  *centre_value = valueInCamera(X_C);
+  if (!(depth - radius_m > 0.0)) return Verdict::kUndecided;
+  // |d(K x/z)| <= ||K_2x2|| |X_C| r / (z (z - r)) for any offset of length <= r: the ball's image
+  // lies in this disc around the projected centre, and the distance is 1-Lipschitz in pixels.
+  const double projected_radius_px =
+      k_norm_ * X_C.norm() * radius_m / (depth * (depth - radius_m)) + slack_px_;
+  if (*centre_value - projected_radius_px > 0.0) return Verdict::kOut;
+  if (*centre_value + projected_radius_px < 0.0) return Verdict::kIn;
+  return Verdict::kUndecided;
+}
+
+std::vector<HullView> makeHullViews(const std::vector<std::string>& names,
+                                    const std::vector<PinholeCamera>& cameras,
+                                    const std::vector<cv::Mat>& masks, const HullConfig& config) {
+  if (names.size() != cameras.size() || masks.size() != cameras.size()) {
+    throw std::invalid_argument("makeHullViews: names, cameras and masks differ in count");
+  }
+  std::vector<std::unique_ptr<HullView>> made(cameras.size());
+  std::atomic<size_t> next{0};
+  const auto work = [&] {
+    for (size_t i = next++; i < made.size(); i = next++) {
+      made[i] = std::make_unique<HullView>(names[i], cameras[i], masks[i], config);
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < config.threads; ++t) pool.emplace_back(work);
+  work();
+  for (std::thread& thread : pool) thread.join();
+  std::vector<HullView> views;
+  for (auto& view : made) views.push_back(std::move(*view));
+  return views;
+}
+
+HullCube HullCube::around(const Box3d& box, int depth) {
+  const double longest_m = box.size().maxCoeff();
+  if (!(longest_m > 0.0) || !std::isfinite(longest_m)) {
+    throw std::invalid_argument("hull box must have a positive, finite size");
+  }
+  HullCube cube;
+  cube.depth = depth;
+  // 2^depth voxels = longest edge + 3: snapping the corner down costs up to one voxel, and at
+  // least one voxel of margin remains on every side.
+  cube.resolution_m = longest_m / ((1 << depth) - 3);
+  const Eigen::Vector3d corner = box.min_W / cube.resolution_m - Eigen::Vector3d::Ones();
+  cube.origin_voxels = corner.array().floor().cast<int>();
+  return cube;
+}
+
+Box3d HullCube::box() const {
+  Box3d result;
+  result.min_W = origin_W();
+  result.max_W = result.min_W + Eigen::Vector3d::Constant(edge_m());
+  return result;
+}
+
+}  // namespace sift_hull

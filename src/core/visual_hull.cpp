@@ -1,0 +1,251 @@
+#include "sift_hull/visual_hull.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <stdexcept>
+#include <thread>
+
+namespace sift_hull {
+namespace detail {
+
+struct HullNode {
+  CellState state = CellState::kIn;
+  float centre_value = -HullView::kFarOutside_px;
+  std::unique_ptr<HullNode[]> children;  ///< eight, or none for a leaf
+};
+
+}  // namespace detail
+
+namespace {
+
+using detail::HullNode;
+
+struct CellIndex {
+  Eigen::Vector3i index = Eigen::Vector3i::Zero();
+  int depth = 0;
+};
+
+CellIndex childOf(const CellIndex& cell, int child) {
+  const Eigen::Vector3i offset((child >> 0) & 1, (child >> 1) & 1, (child >> 2) & 1);
+  return {2 * cell.index + offset, cell.depth + 1};
+}
+
+double cellEdge(const HullCube& cube, int depth) { return cube.edge_m() / (1 << depth); }
+
+Eigen::Vector3d cellCentre(const HullCube& cube, const CellIndex& cell) {
+  const double edge = cellEdge(cube, cell.depth);
+  return cube.origin_W() + (cell.index.cast<double>() + Eigen::Vector3d::Constant(0.5)) * edge;
+}
+
+/// Runs fn(i) for i in [0, count) on `threads` threads, handing out indices one at a time.
+template <typename Fn>
+void parallelFor(size_t count, int threads, const Fn& fn) {
+  std::atomic<size_t> next{0};
+  const auto work = [&] {
+    for (size_t i = next++; i < count; i = next++) fn(i);
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads && static_cast<size_t>(t) < count; ++t) pool.emplace_back(work);
+  work();
+  for (std::thread& thread : pool) thread.join();
+}
+
+/// A node whose update waits for the parallel pass.
+struct DeferredUpdate {
+  HullNode* node;
+  CellIndex cell;
+  size_t first_view;
+};
+
+/// Updates nodes with the views from `first_view` on: an out verdict prunes, an undecided verdict
+/// turns an in cell into a surface cell split into children classified by all views.
+class Refiner {
+ public:
+  Refiner(const HullCube& cube, const std::vector<HullView>& views,
+          std::vector<DeferredUpdate>* deferred, int defer_depth)
+      : cube_(cube), views_(views), deferred_(deferred), defer_depth_(defer_depth) {}
+
+  void update(HullNode& node, const CellIndex& cell, size_t first_view) const {
+    if (node.state == CellState::kOut || first_view == views_.size()) return;
+    if (deferred_ != nullptr && cell.depth == defer_depth_) {
+      deferred_->push_back({&node, cell, first_view});
+      return;
+    }
+    float value = 0.0f;
+    const Verdict verdict = classify(cell, first_view, &value);
+    if (verdict == Verdict::kOut) {
+      node.state = CellState::kOut;
+      node.children.reset();
+      return;
+    }
+    node.centre_value = std::max(node.centre_value, value);
+    if (verdict == Verdict::kUndecided && node.state == CellState::kIn) {
+      node.state = CellState::kSurface;
+      split(node, cell);
+    } else if (node.children) {
+      for (int c = 0; c < 8; ++c) update(node.children[c], childOf(cell, c), first_view);
+    }
+  }
+
+ private:
+  void split(HullNode& node, const CellIndex& cell) const {
+    if (cell.depth == cube_.depth) return;
+    node.children = std::make_unique<HullNode[]>(8);
+    for (int c = 0; c < 8; ++c) update(node.children[c], childOf(cell, c), 0);
+  }
+
+  Verdict classify(const CellIndex& cell, size_t first_view, float* value) const {
+    const Eigen::Vector3d centre = cellCentre(cube_, cell);
+    const double radius = 0.5 * std::sqrt(3.0) * cellEdge(cube_, cell.depth);
+    bool all_in = true;
+    *value = -HullView::kFarOutside_px;
+    for (size_t v = first_view; v < views_.size(); ++v) {
+      float view_value = 0.0f;
+      const Verdict verdict = views_[v].classifyBall(centre, radius, &view_value);
+      if (verdict == Verdict::kOut) return Verdict::kOut;
+      all_in = all_in && verdict == Verdict::kIn;
+      *value = std::max(*value, view_value);
+    }
+    return all_in ? Verdict::kIn : Verdict::kUndecided;
+  }
+
+  const HullCube& cube_;
+  const std::vector<HullView>& views_;
+  std::vector<DeferredUpdate>* deferred_;
+  int defer_depth_;
+};
+
+/// Depth at which the tree is split among threads: 64 subtrees balance two threads well.
+constexpr int kParallelDepth = 2;
+
+void visitLeaves(const HullNode& node, const CellIndex& cell,
+                 const std::function<void(const HullCell&)>& visit) {
+  if (!node.children) {
+    visit({cell.index, cell.depth, node.state, node.centre_value});
+    return;
+  }
+  for (int c = 0; c < 8; ++c) visitLeaves(node.children[c], childOf(cell, c), visit);
+}
+
+}  // namespace
+
+VisualHull::VisualHull(const Box3d& box, const HullConfig& config)
+    : cube_(HullCube::around(box, config.max_depth)),
+      config_(config),
+      root_(std::make_unique<HullNode>()) {
+  validate(config);
+}
+
+VisualHull::~VisualHull() = default;
+VisualHull::VisualHull(VisualHull&&) noexcept = default;
+VisualHull& VisualHull::operator=(VisualHull&&) noexcept = default;
+
+void VisualHull::addViews(std::vector<HullView> views) {
+  const size_t first_new = views_.size();
+  for (HullView& view : views) views_.push_back(std::move(view));
+  std::vector<DeferredUpdate> deferred;
+  Refiner(cube_, views_, &deferred, kParallelDepth).update(*root_, CellIndex{}, first_new);
+  const Refiner refiner(cube_, views_, nullptr, 0);
+  parallelFor(deferred.size(), config_.threads, [&](size_t i) {
+    refiner.update(*deferred[i].node, deferred[i].cell, deferred[i].first_view);
+  });
+}
+
+void VisualHull::addView(HullView view) {
+  std::vector<HullView> one;
+  one.push_back(std::move(view));
+  addViews(std::move(one));
+}
+
+void VisualHull::reset() {
+  views_.clear();
+  root_ = std::make_unique<HullNode>();
+}
+
+void VisualHull::forEachLeaf(const std::function<void(const HullCell&)>& visit) const {
+  visitLeaves(*root_, CellIndex{}, visit);
+}
+
+HullStats VisualHull::stats() const {
+  HullStats stats;
+  const double voxel_m3 = std::pow(cube_.resolution_m, 3);
+  forEachLeaf([&](const HullCell& cell) {
+    const double cell_m3 = voxel_m3 * std::pow(8.0, cube_.depth - cell.depth);
+    if (cell.state == CellState::kOut) ++stats.out_leaves;
+    if (cell.state == CellState::kIn) ++stats.in_leaves, stats.occupied_volume_m3 += cell_m3;
+    if (cell.state == CellState::kSurface) {
+      ++stats.surface_leaves;
+      if (cell.centre_value <= 0.0f) stats.occupied_volume_m3 += cell_m3;
+    }
+  });
+  const size_t leaves = stats.in_leaves + stats.out_leaves + stats.surface_leaves;
+  stats.nodes = leaves + (leaves - 1) / 7;
+  stats.bytes = stats.nodes * sizeof(HullNode);
+  return stats;
+}
+
+HullCell VisualHull::leafAt(const Eigen::Vector3d& X_W) const {
+  const Eigen::Vector3d voxel = (X_W - cube_.origin_W()) / cube_.resolution_m;
+  const int cells = 1 << cube_.depth;
+  if (!((voxel.array() >= 0.0).all() && (voxel.array() < cells).all())) {
+    return {Eigen::Vector3i::Zero(), 0, CellState::kOut, HullView::kFarOutside_px};
+  }
+  const Eigen::Vector3i finest = voxel.array().floor().cast<int>();
+  const HullNode* node = root_.get();
+  CellIndex cell;
+  while (node->children) {
+    const int shift = cube_.depth - cell.depth - 1;
+    const int child = ((finest.x() >> shift) & 1) | (((finest.y() >> shift) & 1) << 1) |
+                      (((finest.z() >> shift) & 1) << 2);
+    node = &node->children[child];
+    cell = childOf(cell, child);
+  }
+  return {cell.index, cell.depth, node->state, node->centre_value};
+}
+
+float VisualHull::valueAt(const Eigen::Vector3d& X_W) const {
+  float value = -HullView::kFarOutside_px;
+  for (const HullView& view : views_) value = std::max(value, view.valueAt(X_W));
+  return value;
+}
+
+void VisualHull::sampleField(const std::vector<Eigen::Vector3d>& points_W,
+                             std::vector<float>* values) const {
+  values->resize(points_W.size());
+  constexpr size_t kChunk = 4096;
+  const size_t chunks = (points_W.size() + kChunk - 1) / kChunk;
+  parallelFor(chunks, config_.threads, [&](size_t chunk) {
+    const size_t end = std::min(points_W.size(), (chunk + 1) * kChunk);
+    for (size_t i = chunk * kChunk; i < end; ++i) (*values)[i] = valueAt(points_W[i]);
+  });
+}
+
+SurfaceCells VisualHull::surfaceCells() const {
+  SurfaceCells cells;
+  cells.origin_W = cube_.origin_W();
+  cells.cell_edge_m = cube_.resolution_m;
+  forEachLeaf([&](const HullCell& cell) {
+    if (cell.state == CellState::kSurface) cells.cells.push_back(cell.index);
+  });
+  return cells;
+}
+
+TriangleMesh VisualHull::mesh() const {
+  return marchingCubes(surfaceCells(),
+                       [this](const std::vector<Eigen::Vector3d>& points,
+                              std::vector<float>* values) { sampleField(points, values); });
+}
+
+std::vector<VoxelBlock> occupiedBlocks(const VisualHull& hull) {
+  std::vector<VoxelBlock> blocks;
+  const HullCube& cube = hull.cube();
+  hull.forEachLeaf([&](const HullCell& cell) {
+    if (cell.state == CellState::kOut) return;
+    const int edge = 1 << (cube.depth - cell.depth);
+    blocks.push_back({cube.origin_voxels + cell.index * edge, edge});
+  });
+  return blocks;
+}
+
+}  // namespace sift_hull
