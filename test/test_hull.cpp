@@ -194,6 +194,41 @@ TEST(VisualHull, BoxShapeMatchesDenseCarving) {
   EXPECT_GE(reprojectionIoU(result.mesh, result.hull.views()).min, 0.99);
 }
 
+/// The input with view 0's image shifted right by half its width: the object leaves the image.
+HullInput withFirstViewCutByTheBorder(HullInput input) {
+  const PinholeCamera& camera = input.cameras[0];
+  Eigen::Matrix3d K = camera.K();
+  const int shift = input.masks[0].cols / 2;
+  K(0, 2) += shift;
+  input.cameras[0] = PinholeCamera(K, camera.R(), camera.t());
+  cv::Mat shifted = cv::Mat::zeros(input.masks[0].size(), CV_8UC1);
+  input.masks[0](cv::Rect(0, 0, shift, shifted.rows))
+      .copyTo(shifted(cv::Rect(shift, 0, shift, shifted.rows)));
+  input.masks[0] = shifted;
+  return input;
+}
+
+TEST(VisualHull, ViewsCarveOutsideTheirImageOnlyWhenAsked) {
+  const HullInput full = sceneInput("sphere", 8);
+  const HullInput cut = withFirstViewCutByTheBorder(full);
+  HullInput without_first = full;
+  without_first.names.erase(without_first.names.begin());
+  without_first.cameras.erase(without_first.cameras.begin());
+  without_first.masks.erase(without_first.masks.begin());
+  const Box3d box = buildHull(full, depth(6)).box;  // one box for all three
+  const double all_m3 = buildHull(full, depth(6), box).hull.stats().occupied_volume_m3;
+  const double rest_m3 = buildHull(without_first, depth(6), box).hull.stats().occupied_volume_m3;
+  HullConfig carving = depth(6);
+  carving.carve_outside_image = true;
+  const double kept_m3 = buildHull(cut, depth(6), box).hull.stats().occupied_volume_m3;
+  const double carved_m3 = buildHull(cut, carving, box).hull.stats().occupied_volume_m3;
+  // Kept: the half the cut view still sees carves as the whole view did; the other half is left
+  // to the other views.
+  EXPECT_GE(kept_m3, all_m3 * 0.999);
+  EXPECT_LE(kept_m3, rest_m3 * 1.001);
+  EXPECT_LT(carved_m3, 0.7 * all_m3);
+}
+
 TEST(VisualHull, ResetLeavesOneInCellAndNoViews) {
   HullResult result = buildHull(sceneInput("sphere", 6), depth(5));
   result.hull.reset();

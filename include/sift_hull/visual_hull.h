@@ -91,6 +91,8 @@ class HullView {
 
  private:
   float valueInCamera(const Eigen::Vector3d& X_C) const;
+  /// Pixel of a point in the camera frame (K's last row is 0 0 1).
+  Eigen::Vector2d pixelOf(const Eigen::Vector3d& X_C) const;
 
   std::string name_;
   PinholeCamera camera_;

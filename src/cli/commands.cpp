@@ -39,8 +39,7 @@ const std::vector<Command>& commands() {
       {"evaluate-filters", "precision and recall of every filter on Teddy and graf",
        runEvaluateFilters},
       {"hull", "visual hull of calibrated silhouettes: octree, OctoMap and mesh", runHull},
-      {"bench-hull", "time the visual hull against dense carving on dino and temple",
-       runBenchHull},
+      {"bench-hull", "time the visual hull against dense carving on dino and temple", runBenchHull},
   };
   return all;
 }

@@ -38,14 +38,13 @@ bool withinBounds(const SilhouetteBounds& bounds, double u, double v) {
 cv::Mat paddedMask(const cv::Mat& mask, const SilhouetteBounds& bounds, int padding) {
   cv::Mat padded(mask.rows + 2 * padding, mask.cols + 2 * padding, CV_8UC1);
   for (int row = 0; row < padded.rows; ++row) {
+    uint8_t* out = padded.ptr<uint8_t>(row);
     for (int col = 0; col < padded.cols; ++col) {
-      const int u = col - padding, v = row - padding;
-      padded.at<uint8_t>(row, col) = (u >= 0 && v >= 0 && u < mask.cols && v < mask.rows)
-                                         ? (mask.at<uint8_t>(v, u) ? 255 : 0)
-                                     : withinBounds(bounds, u, v) ? 255
-                                                                  : 0;
+      out[col] = withinBounds(bounds, col - padding, row - padding) ? 255 : 0;
     }
   }
+  const cv::Mat inside = mask != 0;
+  inside.copyTo(padded(cv::Rect(padding, padding, mask.cols, mask.rows)));
   return padded;
 }
 
@@ -100,8 +99,15 @@ HullView::HullView(std::string name, const PinholeCamera& camera, const cv::Mat&
 
 float HullView::valueInCamera(const Eigen::Vector3d& X_C) const {
   if (!(X_C.z() > 0.0)) return carves_behind_ ? kFarOutside_px : -kFarOutside_px;
-  const Eigen::Vector3d pixel = camera_.K() * (X_C / X_C.z());
+  const Eigen::Vector2d pixel = pixelOf(X_C);
   return distance_.at(pixel.x(), pixel.y());
+}
+
+Eigen::Vector2d HullView::pixelOf(const Eigen::Vector3d& X_C) const {
+  const Eigen::Matrix3d& K = camera_.K();
+  const double inverse_depth = 1.0 / X_C.z();
+  const double x = X_C.x() * inverse_depth, y = X_C.y() * inverse_depth;
+  return {K(0, 0) * x + K(0, 1) * y + K(0, 2), K(1, 1) * y + K(1, 2)};
 }
 
 float HullView::valueAt(const Eigen::Vector3d& X_W) const {
@@ -111,7 +117,7 @@ float HullView::valueAt(const Eigen::Vector3d& X_W) const {
 bool HullView::keeps(const Eigen::Vector3d& X_W) const {
   const Eigen::Vector3d X_C = camera_.toCamera(X_W);
   if (!(X_C.z() > 0.0)) return !carves_behind_;
-  const Eigen::Vector3d pixel = camera_.K() * (X_C / X_C.z());
+  const Eigen::Vector2d pixel = pixelOf(X_C);
   const long u = std::lround(pixel.x()), v = std::lround(pixel.y());
   if (u < 0 || v < 0 || u >= mask_.cols || v >= mask_.rows) {
     return withinBounds(bounds_, pixel.x(), pixel.y());

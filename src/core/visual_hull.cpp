@@ -98,12 +98,21 @@ class Refiner {
   Verdict classify(const CellIndex& cell, size_t first_view, float* value) const {
     const Eigen::Vector3d centre = cellCentre(cube_, cell);
     const double radius = 0.5 * std::sqrt(3.0) * cellEdge(cube_, cell.depth);
+    // Neighbouring cells tend to be carved by the same view: start with the last one that carved.
+    static thread_local size_t last_carving = 0;
+    const size_t count = views_.size() - first_view;
+    const size_t start =
+        last_carving >= first_view && last_carving < views_.size() ? last_carving - first_view : 0;
     bool all_in = true;
     *value = -HullView::kFarOutside_px;
-    for (size_t v = first_view; v < views_.size(); ++v) {
+    for (size_t k = 0; k < count; ++k) {
+      const size_t v = first_view + (start + k) % count;
       float view_value = 0.0f;
       const Verdict verdict = views_[v].classifyBall(centre, radius, &view_value);
-      if (verdict == Verdict::kOut) return Verdict::kOut;
+      if (verdict == Verdict::kOut) {
+        last_carving = v;
+        return Verdict::kOut;
+      }
       all_in = all_in && verdict == Verdict::kIn;
       *value = std::max(*value, view_value);
     }
@@ -215,9 +224,15 @@ void VisualHull::sampleField(const std::vector<Eigen::Vector3d>& points_W,
   values->resize(points_W.size());
   constexpr size_t kChunk = 4096;
   const size_t chunks = (points_W.size() + kChunk - 1) / kChunk;
+  // View by view within a chunk, so that one distance map at a time is in the cache.
   parallelFor(chunks, config_.threads, [&](size_t chunk) {
-    const size_t end = std::min(points_W.size(), (chunk + 1) * kChunk);
-    for (size_t i = chunk * kChunk; i < end; ++i) (*values)[i] = valueAt(points_W[i]);
+    const size_t begin = chunk * kChunk, end = std::min(points_W.size(), begin + kChunk);
+    std::fill(values->begin() + begin, values->begin() + end, -HullView::kFarOutside_px);
+    for (const HullView& view : views_) {
+      for (size_t i = begin; i < end; ++i) {
+        (*values)[i] = std::max((*values)[i], view.valueAt(points_W[i]));
+      }
+    }
   });
 }
 
