@@ -24,6 +24,13 @@ match=(match "$out/scene/view_0000.png" "$out/scene/view_0001.png" --gt-scene "$
   --out-image "$out/matches.png" --out-histograms "$out/gsc_histograms.png"
 "$sift_hull" "${match[@]}" --json >"$out/matches.json"
 
+echo "carving the visual hull of the 16 views (depth 7) ..."
+"$sift_hull" hull --calib "$out/scene/scene_par.txt" --images "$out/scene" \
+  --silhouettes "$out/scene/masks" --depth 7 --out-mesh "$out/hull.ply" \
+  --out-octree "$out/hull.bt" --out-render "$out/hull.png" --json >"$out/hull.json"
+"$sift_hull" hull --calib "$out/scene/scene_par.txt" --images "$out/scene" \
+  --silhouettes "$out/scene/masks" --depth 7 | tail -n 1
+
 cat <<SUMMARY
 
 sift_hull demo done.
@@ -34,4 +41,6 @@ sift_hull demo done.
   matches        $out/matches.json (every filter, precision / recall against the scene),
                  $out/matches.png (gsc: kept green, removed red),
                  $out/gsc_histograms.png (GSC histograms of a kept and a removed match)
+  visual hull    $out/hull.json (box, leaves, mesh, times, reprojection IoU),
+                 $out/hull.ply (mesh), $out/hull.bt (OctoMap), $out/hull.png (renderings)
 SUMMARY

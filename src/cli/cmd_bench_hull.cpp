@@ -112,7 +112,8 @@ DatasetRuns benchDataset(const HullInput& input, const std::string& name) {
 /// Peak memory of the whole `hull` command at depth 9 (loading, silhouettes, hull, OctoMap, IoU),
 /// run as a child process so that nothing else of this benchmark counts.
 double hullCommandPeakMiB(const std::string& directory, const HullDataset& dataset) {
-  std::string command = "/proc/self/exe hull --depth 9 --json --threshold " +
+  const std::string self = std::filesystem::read_symlink("/proc/self/exe").string();
+  std::string command = "'" + self + "' hull --depth 9 --json --threshold " +
                         std::to_string(dataset.threshold) + " --calib '" + directory + "/" +
                         dataset.calibration + "' --images '" + directory + "'";
   if (!dataset.view_list.empty())
