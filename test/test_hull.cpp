@@ -103,16 +103,20 @@ class SphereHull : public ::testing::Test {
 HullResult* SphereHull::result_ = nullptr;
 DenseGrid* SphereHull::dense_ = nullptr;
 
-TEST_F(SphereHull, LpBoxHoldsTheDenseHullAndExceedsItByAtMostFivePercent) {
-  const Box3d dense = dense_->occupiedBounds();
-  const Box3d& box = result_->box;
+/// The LP box holds the dense hull (to a dense voxel) and exceeds it by at most 5 % of its edge.
+void expectTightBox(const Box3d& box, const DenseGrid& dense_grid) {
+  const Box3d dense = dense_grid.occupiedBounds();
   const double edge = box.size().maxCoeff();
   for (int axis = 0; axis < 3; ++axis) {
-    EXPECT_LE(box.min_W[axis], dense.min_W[axis] + dense_->voxel_m) << "axis " << axis;
-    EXPECT_GE(box.max_W[axis], dense.max_W[axis] - dense_->voxel_m) << "axis " << axis;
+    EXPECT_LE(box.min_W[axis], dense.min_W[axis] + dense_grid.voxel_m) << "axis " << axis;
+    EXPECT_GE(box.max_W[axis], dense.max_W[axis] - dense_grid.voxel_m) << "axis " << axis;
     EXPECT_LE(dense.min_W[axis] - box.min_W[axis], 0.05 * edge) << "axis " << axis;
     EXPECT_LE(box.max_W[axis] - dense.max_W[axis], 0.05 * edge) << "axis " << axis;
   }
+}
+
+TEST_F(SphereHull, LpBoxHoldsTheDenseHullAndExceedsItByAtMostFivePercent) {
+  expectTightBox(result_->box, *dense_);
 }
 
 TEST_F(SphereHull, VolumeMatchesDenseCarvingAtTwiceTheResolution) {
