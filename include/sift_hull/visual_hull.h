@@ -16,7 +16,18 @@ namespace sift_hull {
 
 namespace detail {
 struct HullNode;
-}
+/// Everything a view's batched look-ups read, as floats.
+struct DistanceKernel {
+  float R[9], t[3];
+  float fx, skew, cx, fy, cy;  ///< K
+  float k_norm;                ///< spectral norm of K's upper-left 2x2
+  float slack_px;
+  float behind_value;  ///< valueAt of a point not in front of the camera
+  const float* map;    ///< padded distance map, row-major
+  int stride;
+  float padding, u_high, v_high;  ///< look-ups clamp to [0, u_high] x [0, v_high]
+};
+}  // namespace detail
 
 /// Signed distance transform of a silhouette in pixels: negative inside, positive outside, zero
 /// on the boundary between inside and outside pixel squares (OpenCV's exact Euclidean
@@ -35,6 +46,9 @@ class SignedDistanceMap {
   /// Bilinear look-up at pixel coordinates (pixel centres at integers), clamped to the map.
   float at(double u_px, double v_px) const;
   cv::Size imageSize() const { return image_size_; }
+  /// The padded map (CV_32FC1, continuous) and its padding, for batched look-ups.
+  const cv::Mat& padded() const { return distance_px_; }
+  int padding() const { return padding_px_; }
 
  private:
   cv::Mat distance_px_;  ///< CV_32FC1, padded
@@ -63,6 +77,14 @@ void validate(const HullConfig& config);
 /// Where a view puts a cell or point.
 enum class Verdict : uint8_t { kOut, kIn, kUndecided };
 
+/// Points in structure-of-arrays form (world coordinates as floats), for batched look-ups.
+struct PointBatch {
+  const float* x;
+  const float* y;
+  const float* z;
+  size_t count;
+};
+
 /// One calibrated silhouette, ready for carving.
 class HullView {
  public:
@@ -83,25 +105,29 @@ class HullView {
   /// The brute-force test of dense carving: whether the view keeps a point, by the mask pixel
   /// nearest to its projection, or by the bounds outside the image.
   bool keeps(const Eigen::Vector3d& X_W) const;
-  /// Whether every point of the ball (centre_W, radius_m) is out of or in the silhouette, from the
-  /// distance at the centre and the ball's projected radius. `centre_value` gets valueAt(centre_W).
-  Verdict classifyBall(const Eigen::Vector3d& centre_W, double radius_m, float* centre_value) const;
+  /// values[i] = max(values[i], D_i(P_i X_i)) for a batch of points: f_iso built view by view.
+  void maxInto(const PointBatch& points, float* values) const;
+  /// For balls of one radius around a batch of centres, from the distance at each centre and the
+  /// ball's projected radius (plus the slack): maxInto for the centres; out[i] set when the view
+  /// sees all of ball i outside the silhouette; in[i] cleared unless it sees all of it inside.
+  void classifyBalls(const PointBatch& centres, float radius_m, float* values, uint8_t* out,
+                     uint8_t* in) const;
 
   static constexpr float kFarOutside_px = 1e6f;
 
  private:
-  float valueInCamera(const Eigen::Vector3d& X_C) const;
   /// Pixel of a point in the camera frame (K's last row is 0 0 1).
   Eigen::Vector2d pixelOf(const Eigen::Vector3d& X_C) const;
+
+  detail::DistanceKernel makeKernel(const HullConfig& config) const;
 
   std::string name_;
   PinholeCamera camera_;
   cv::Mat mask_;
   SilhouetteBounds bounds_;
   SignedDistanceMap distance_;
-  double k_norm_ = 1.0;  ///< spectral norm of K's upper-left 2x2: pixels per unit of x/z, y/z
   bool carves_behind_ = true;
-  double slack_px_ = 1.0;
+  detail::DistanceKernel kernel_;
 };
 
 /// Prepares views (their distance transforms) on `config.threads` threads. Names, cameras and

@@ -83,11 +83,12 @@ int runHull(const std::vector<std::string>& args) {
 
   const HullConfig config = hullConfigFromArgs(parser);
   const HullResult result = buildHull(inputFromArgs(parser), config, boxFromArgs(parser));
+  const double hull_peak_mib = peakMemoryMiB();
   const std::unique_ptr<octomap::OcTree> octree = toOctomap(result.hull);
   const ReprojectionIoU iou = reprojectionIoU(result.mesh, result.hull.views());
   writeOutputs(parser, result, *octree);
   nlohmann::json json = hullJson(result, octree->getNumLeafNodes(), iou);
-  json["peak_memory_mib"] = peakMemoryMiB();
+  json["peak_memory_mib"] = {{"through_hull", hull_peak_mib}, {"total", peakMemoryMiB()}};
   printResult(parser.flag("json"), json, hullText(json));
   return 0;
 }

@@ -1,10 +1,12 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <limits>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 #include <thread>
 
+#include "distance_kernel.h"
 #include "sift_hull/visual_hull.h"
 
 namespace sift_hull {
@@ -34,14 +36,24 @@ bool withinBounds(const SilhouetteBounds& bounds, double u, double v) {
          (!bounds.has_v_min || v >= bounds.v_min_px) && (!bounds.has_v_max || v <= bounds.v_max_px);
 }
 
-/// The mask with a border of `padding` pixels, inside where withinBounds.
+/// The mask with a border of `padding` pixels, inside where withinBounds: the bounds' rectangle
+/// (open sides reaching the map's edge) clipped to the map, then the mask over it.
 cv::Mat paddedMask(const cv::Mat& mask, const SilhouetteBounds& bounds, int padding) {
-  cv::Mat padded(mask.rows + 2 * padding, mask.cols + 2 * padding, CV_8UC1);
-  for (int row = 0; row < padded.rows; ++row) {
-    uint8_t* out = padded.ptr<uint8_t>(row);
-    for (int col = 0; col < padded.cols; ++col) {
-      out[col] = withinBounds(bounds, col - padding, row - padding) ? 255 : 0;
-    }
+  cv::Mat padded = cv::Mat::zeros(mask.rows + 2 * padding, mask.cols + 2 * padding, CV_8UC1);
+  if (!bounds.empty) {
+    // Pixel u lies within [u_min, u_max] exactly when ceil(u_min) <= u <= floor(u_max).
+    const int first_col =
+        bounds.has_u_min ? static_cast<int>(std::ceil(bounds.u_min_px)) + padding : 0;
+    const int last_col = bounds.has_u_max ? static_cast<int>(std::floor(bounds.u_max_px)) + padding
+                                          : padded.cols - 1;
+    const int first_row =
+        bounds.has_v_min ? static_cast<int>(std::ceil(bounds.v_min_px)) + padding : 0;
+    const int last_row = bounds.has_v_max ? static_cast<int>(std::floor(bounds.v_max_px)) + padding
+                                          : padded.rows - 1;
+    const cv::Rect kept =
+        cv::Rect(first_col, first_row, last_col - first_col + 1, last_row - first_row + 1) &
+        cv::Rect(0, 0, padded.cols, padded.rows);
+    padded(kept).setTo(255);
   }
   const cv::Mat inside = mask != 0;
   inside.copyTo(padded(cv::Rect(padding, padding, mask.cols, mask.rows)));
@@ -93,14 +105,35 @@ HullView::HullView(std::string name, const PinholeCamera& camera, const cv::Mat&
       mask_((checkMask(mask), mask.clone())),
       bounds_(silhouetteBounds(mask, config.carve_outside_image)),
       distance_(mask, bounds_, config.padding_px),
-      k_norm_(spectralNorm2x2(camera.K())),
       carves_behind_(bounds_.empty || bounds_.boundedSides() > 0),
-      slack_px_(config.distance_slack_px) {}
+      kernel_(makeKernel(config)) {}
 
-float HullView::valueInCamera(const Eigen::Vector3d& X_C) const {
-  if (!(X_C.z() > 0.0)) return carves_behind_ ? kFarOutside_px : -kFarOutside_px;
-  const Eigen::Vector2d pixel = pixelOf(X_C);
-  return distance_.at(pixel.x(), pixel.y());
+detail::DistanceKernel HullView::makeKernel(const HullConfig& config) const {
+  detail::DistanceKernel kernel{};
+  const Eigen::Matrix3d& R = camera_.R();
+  for (int i = 0; i < 9; ++i) kernel.R[i] = static_cast<float>(R(i / 3, i % 3));
+  for (int i = 0; i < 3; ++i) kernel.t[i] = static_cast<float>(camera_.t()(i));
+  const Eigen::Matrix3d& K = camera_.K();
+  kernel.fx = K(0, 0), kernel.skew = K(0, 1), kernel.cx = K(0, 2);
+  kernel.fy = K(1, 1), kernel.cy = K(1, 2);
+  kernel.k_norm = static_cast<float>(spectralNorm2x2(K));
+  kernel.slack_px = static_cast<float>(config.distance_slack_px);
+  kernel.behind_value = carves_behind_ ? kFarOutside_px : -kFarOutside_px;
+  const cv::Mat& map = distance_.padded();
+  kernel.map = map.ptr<float>();
+  kernel.stride = map.cols;
+  kernel.padding = static_cast<float>(distance_.padding());
+  // Short of the last column / row, so that the right / lower neighbour of a look-up exists.
+  kernel.u_high = map.cols - 1 - 1.0f / 512, kernel.v_high = map.rows - 1 - 1.0f / 512;
+  return kernel;
+}
+
+float HullView::valueAt(const Eigen::Vector3d& X_W) const {
+  const float x = static_cast<float>(X_W.x()), y = static_cast<float>(X_W.y()),
+              z = static_cast<float>(X_W.z());
+  float value = -std::numeric_limits<float>::infinity();
+  maxInto({&x, &y, &z, 1}, &value);
+  return value;
 }
 
 Eigen::Vector2d HullView::pixelOf(const Eigen::Vector3d& X_C) const {
@@ -108,10 +141,6 @@ Eigen::Vector2d HullView::pixelOf(const Eigen::Vector3d& X_C) const {
   const double inverse_depth = 1.0 / X_C.z();
   const double x = X_C.x() * inverse_depth, y = X_C.y() * inverse_depth;
   return {K(0, 0) * x + K(0, 1) * y + K(0, 2), K(1, 1) * y + K(1, 2)};
-}
-
-float HullView::valueAt(const Eigen::Vector3d& X_W) const {
-  return valueInCamera(camera_.toCamera(X_W));
 }
 
 bool HullView::keeps(const Eigen::Vector3d& X_W) const {
@@ -125,19 +154,13 @@ bool HullView::keeps(const Eigen::Vector3d& X_W) const {
   return mask_.at<uint8_t>(static_cast<int>(v), static_cast<int>(u)) != 0;
 }
 
-Verdict HullView::classifyBall(const Eigen::Vector3d& centre_W, double radius_m,
-                               float* centre_value) const {
-  const Eigen::Vector3d X_C = camera_.toCamera(centre_W);
-  const double depth = X_C.z();
-  *centre_value = valueInCamera(X_C);
-  if (!(depth - radius_m > 0.0)) return Verdict::kUndecided;
-  // |d(K x/z)| <= ||K_2x2|| |X_C| r / (z (z - r)) for any offset of length <= r: the ball's image
-  // lies in this disc around the projected centre, and the distance is 1-Lipschitz in pixels.
-  const double projected_radius_px =
-      k_norm_ * X_C.norm() * radius_m / (depth * (depth - radius_m)) + slack_px_;
-  if (*centre_value - projected_radius_px > 0.0) return Verdict::kOut;
-  if (*centre_value + projected_radius_px < 0.0) return Verdict::kIn;
-  return Verdict::kUndecided;
+void HullView::maxInto(const PointBatch& points, float* values) const {
+  detail::maxDistances(kernel_, points, values);
+}
+
+void HullView::classifyBalls(const PointBatch& centres, float radius_m, float* values, uint8_t* out,
+                             uint8_t* in) const {
+  detail::classifyBalls(kernel_, centres, radius_m, values, out, in);
 }
 
 std::vector<HullView> makeHullViews(const std::vector<std::string>& names,

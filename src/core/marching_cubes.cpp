@@ -89,40 +89,53 @@ std::vector<uint64_t> sortedCellKeys(const std::vector<Eigen::Vector3i>& cells,
   return cell_keys;
 }
 
-// Each corner's shifted copy of the sorted cell keys is sorted, so merging the eight copies
-// replaces sorting eight times as many keys.
-std::vector<uint64_t> distinctCornerKeys(const std::vector<uint64_t>& cell_keys) {
-  const size_t count = cell_keys.size();
-  std::vector<uint64_t> corner_keys(8 * count);
-  for (int corner = 0; corner < 8; ++corner) {
-    const uint64_t offset = cornerKeyOffset(corner);
-    std::transform(cell_keys.begin(), cell_keys.end(), corner_keys.begin() + corner * count,
-                   [offset](uint64_t key) { return key + offset; });
+// The sorted union of sorted keys and the same keys shifted by `offset`.
+std::vector<uint64_t> unionWithShifted(const std::vector<uint64_t>& keys, uint64_t offset) {
+  std::vector<uint64_t> merged;
+  merged.reserve(2 * keys.size());
+  size_t plain = 0, shifted = 0;
+  while (plain < keys.size() || shifted < keys.size()) {
+    const bool take_plain =
+        shifted == keys.size() || (plain < keys.size() && keys[plain] <= keys[shifted] + offset);
+    const uint64_t key = take_plain ? keys[plain++] : keys[shifted++] + offset;
+    if (merged.empty() || merged.back() != key) merged.push_back(key);
   }
-  for (size_t width = count; width < corner_keys.size(); width *= 2) {
-    for (size_t first = 0; first + width < corner_keys.size(); first += 2 * width) {
-      const size_t last = std::min(first + 2 * width, corner_keys.size());
-      std::inplace_merge(corner_keys.begin() + first, corner_keys.begin() + first + width,
-                         corner_keys.begin() + last);
-    }
-  }
-  corner_keys.erase(std::unique(corner_keys.begin(), corner_keys.end()), corner_keys.end());
-  return corner_keys;
+  return merged;
 }
 
+// The corners of the cells are the cells shifted by {0, 1} along each axis in turn; three merges
+// of sorted lists keep the keys sorted and need far less memory than sorting eight copies.
+std::vector<uint64_t> distinctCornerKeys(const std::vector<uint64_t>& cell_keys) {
+  std::vector<uint64_t> keys = cell_keys;
+  for (int axis = 0; axis < 3; ++axis) {
+    keys = unionWithShifted(keys, uint64_t{1} << (axis * kKeyBits));
+  }
+  return keys;
+}
+
+// Samples in chunks, so that the points never all exist at once.
 std::vector<float> sampleCorners(const SurfaceCells& cells, const CornerKeys& keys,
                                  const std::vector<uint64_t>& corner_keys,
                                  const FieldSampler& field) {
-  std::vector<Eigen::Vector3d> points_W;
-  points_W.reserve(corner_keys.size());
-  for (uint64_t key : corner_keys) {
-    points_W.push_back(cells.origin_W + cells.cell_edge_m * keys.index(key).cast<double>());
-  }
+  constexpr size_t kChunk = size_t{1} << 16;
   std::vector<float> values;
-  field(points_W, &values);
-  if (values.size() != points_W.size()) {
-    throw std::runtime_error("marchingCubes: the field returned " + std::to_string(values.size()) +
-                             " values for " + std::to_string(points_W.size()) + " points");
+  values.reserve(corner_keys.size());
+  std::vector<Eigen::Vector3d> points_W;
+  std::vector<float> chunk_values;
+  for (size_t begin = 0; begin < corner_keys.size(); begin += kChunk) {
+    const size_t end = std::min(corner_keys.size(), begin + kChunk);
+    points_W.clear();
+    for (size_t i = begin; i < end; ++i) {
+      points_W.push_back(cells.origin_W +
+                         cells.cell_edge_m * keys.index(corner_keys[i]).cast<double>());
+    }
+    field(points_W, &chunk_values);
+    if (chunk_values.size() != points_W.size()) {
+      throw std::runtime_error("marchingCubes: the field returned " +
+                               std::to_string(chunk_values.size()) + " values for " +
+                               std::to_string(points_W.size()) + " points");
+    }
+    values.insert(values.end(), chunk_values.begin(), chunk_values.end());
   }
   return values;
 }

@@ -51,7 +51,7 @@ void parallelFor(size_t count, int threads, const Fn& fn) {
   for (std::thread& thread : pool) thread.join();
 }
 
-/// A node whose update waits for the parallel pass.
+/// The children of a node whose update waits for the parallel pass.
 struct DeferredUpdate {
   HullNode* node;
   CellIndex cell;
@@ -59,21 +59,51 @@ struct DeferredUpdate {
 };
 
 /// Updates nodes with the views from `first_view` on: an out verdict prunes, an undecided verdict
-/// turns an in cell into a surface cell split into children classified by all views.
+/// turns an in cell into a surface cell split into children classified by all views. The eight
+/// children of a node are classified together, view by view.
 class Refiner {
  public:
   Refiner(const HullCube& cube, const std::vector<HullView>& views,
           std::vector<DeferredUpdate>* deferred, int defer_depth)
       : cube_(cube), views_(views), deferred_(deferred), defer_depth_(defer_depth) {}
 
-  void update(HullNode& node, const CellIndex& cell, size_t first_view) const {
-    if (node.state == CellState::kOut || first_view == views_.size()) return;
-    if (deferred_ != nullptr && cell.depth == defer_depth_) {
+  void updateRoot(HullNode& root, size_t first_view) const {
+    if (root.state == CellState::kOut || first_view == views_.size()) return;
+    const Eigen::Vector3f centre = cellCentre(cube_, CellIndex{}).cast<float>();
+    float value;
+    uint8_t out, in;
+    classify({&centre.x(), &centre.y(), &centre.z(), 1}, 0, first_view, &value, &out, &in);
+    apply(root, CellIndex{}, first_view, verdictOf(out, in), value);
+  }
+
+  void updateChildren(HullNode& node, const CellIndex& cell, size_t first_view) const {
+    if (deferred_ != nullptr && cell.depth + 1 == defer_depth_) {
       deferred_->push_back({&node, cell, first_view});
       return;
     }
-    float value = 0.0f;
-    const Verdict verdict = classify(cell, first_view, &value);
+    float x[8], y[8], z[8], values[8];
+    uint8_t out[8], in[8];
+    for (int c = 0; c < 8; ++c) {
+      const Eigen::Vector3d centre = cellCentre(cube_, childOf(cell, c));
+      x[c] = static_cast<float>(centre.x());
+      y[c] = static_cast<float>(centre.y());
+      z[c] = static_cast<float>(centre.z());
+    }
+    classify({x, y, z, 8}, cell.depth + 1, first_view, values, out, in);
+    for (int c = 0; c < 8; ++c) {
+      HullNode& child = node.children[c];
+      if (child.state == CellState::kOut) continue;
+      apply(child, childOf(cell, c), first_view, verdictOf(out[c], in[c]), values[c]);
+    }
+  }
+
+ private:
+  static Verdict verdictOf(uint8_t out, uint8_t in) {
+    return out ? Verdict::kOut : in ? Verdict::kIn : Verdict::kUndecided;
+  }
+
+  void apply(HullNode& node, const CellIndex& cell, size_t first_view, Verdict verdict,
+             float value) const {
     if (verdict == Verdict::kOut) {
       node.state = CellState::kOut;
       node.children.reset();
@@ -82,41 +112,34 @@ class Refiner {
     node.centre_value = std::max(node.centre_value, value);
     if (verdict == Verdict::kUndecided && node.state == CellState::kIn) {
       node.state = CellState::kSurface;
-      split(node, cell);
+      if (cell.depth == cube_.depth) return;
+      node.children = std::make_unique<HullNode[]>(8);
+      updateChildren(node, cell, 0);
     } else if (node.children) {
-      for (int c = 0; c < 8; ++c) update(node.children[c], childOf(cell, c), first_view);
+      updateChildren(node, cell, first_view);
     }
   }
 
- private:
-  void split(HullNode& node, const CellIndex& cell) const {
-    if (cell.depth == cube_.depth) return;
-    node.children = std::make_unique<HullNode[]>(8);
-    for (int c = 0; c < 8; ++c) update(node.children[c], childOf(cell, c), 0);
-  }
-
-  Verdict classify(const CellIndex& cell, size_t first_view, float* value) const {
-    const Eigen::Vector3d centre = cellCentre(cube_, cell);
-    const double radius = 0.5 * std::sqrt(3.0) * cellEdge(cube_, cell.depth);
-    // Neighbouring cells tend to be carved by the same view: start with the last one that carved.
+  /// Verdicts of the views from `first_view` on for cells of one depth, stopping once every cell
+  /// is out. Neighbouring cells tend to be carved by the same view: start with the last that did.
+  void classify(const PointBatch& centres, int depth, size_t first_view, float* values,
+                uint8_t* out, uint8_t* in) const {
     static thread_local size_t last_carving = 0;
+    const float radius = static_cast<float>(0.5 * std::sqrt(3.0) * cellEdge(cube_, depth));
+    std::fill(values, values + centres.count, -HullView::kFarOutside_px);
+    std::fill(out, out + centres.count, 0);
+    std::fill(in, in + centres.count, 1);
     const size_t count = views_.size() - first_view;
     const size_t start =
         last_carving >= first_view && last_carving < views_.size() ? last_carving - first_view : 0;
-    bool all_in = true;
-    *value = -HullView::kFarOutside_px;
-    for (size_t k = 0; k < count; ++k) {
+    size_t carved = 0;
+    for (size_t k = 0; k < count && carved < centres.count; ++k) {
       const size_t v = first_view + (start + k) % count;
-      float view_value = 0.0f;
-      const Verdict verdict = views_[v].classifyBall(centre, radius, &view_value);
-      if (verdict == Verdict::kOut) {
-        last_carving = v;
-        return Verdict::kOut;
-      }
-      all_in = all_in && verdict == Verdict::kIn;
-      *value = std::max(*value, view_value);
+      views_[v].classifyBalls(centres, radius, values, out, in);
+      const size_t now_carved = std::count(out, out + centres.count, 1);
+      if (now_carved > carved) last_carving = v;
+      carved = now_carved;
     }
-    return all_in ? Verdict::kIn : Verdict::kUndecided;
   }
 
   const HullCube& cube_;
@@ -125,8 +148,8 @@ class Refiner {
   int defer_depth_;
 };
 
-/// Depth at which the tree is split among threads: 64 subtrees balance two threads well.
-constexpr int kParallelDepth = 2;
+/// Depth of the cells the threads share out: 64 groups of eight balance two threads well.
+constexpr int kParallelDepth = 3;
 
 void visitLeaves(const HullNode& node, const CellIndex& cell,
                  const std::function<void(const HullCell&)>& visit) {
@@ -154,10 +177,10 @@ void VisualHull::addViews(std::vector<HullView> views) {
   const size_t first_new = views_.size();
   for (HullView& view : views) views_.push_back(std::move(view));
   std::vector<DeferredUpdate> deferred;
-  Refiner(cube_, views_, &deferred, kParallelDepth).update(*root_, CellIndex{}, first_new);
+  Refiner(cube_, views_, &deferred, kParallelDepth).updateRoot(*root_, first_new);
   const Refiner refiner(cube_, views_, nullptr, 0);
   parallelFor(deferred.size(), config_.threads, [&](size_t i) {
-    refiner.update(*deferred[i].node, deferred[i].cell, deferred[i].first_view);
+    refiner.updateChildren(*deferred[i].node, deferred[i].cell, deferred[i].first_view);
   });
 }
 
@@ -224,15 +247,19 @@ void VisualHull::sampleField(const std::vector<Eigen::Vector3d>& points_W,
   values->resize(points_W.size());
   constexpr size_t kChunk = 4096;
   const size_t chunks = (points_W.size() + kChunk - 1) / kChunk;
-  // View by view within a chunk, so that one distance map at a time is in the cache.
+  // View by view within a chunk, as single-precision coordinates for the batched look-ups.
   parallelFor(chunks, config_.threads, [&](size_t chunk) {
     const size_t begin = chunk * kChunk, end = std::min(points_W.size(), begin + kChunk);
-    std::fill(values->begin() + begin, values->begin() + end, -HullView::kFarOutside_px);
-    for (const HullView& view : views_) {
-      for (size_t i = begin; i < end; ++i) {
-        (*values)[i] = std::max((*values)[i], view.valueAt(points_W[i]));
-      }
+    std::vector<float> x, y, z;
+    for (size_t i = begin; i < end; ++i) {
+      x.push_back(static_cast<float>(points_W[i].x()));
+      y.push_back(static_cast<float>(points_W[i].y()));
+      z.push_back(static_cast<float>(points_W[i].z()));
     }
+    float* values_out = values->data() + begin;
+    std::fill(values_out, values_out + (end - begin), -HullView::kFarOutside_px);
+    for (const HullView& view : views_)
+      view.maxInto({x.data(), y.data(), z.data(), end - begin}, values_out);
   });
 }
 

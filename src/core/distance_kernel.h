@@ -1,0 +1,18 @@
+#pragma once
+
+#include <cstdint>
+
+#include "sift_hull/visual_hull.h"
+
+namespace sift_hull {
+namespace detail {
+
+/// values[i] = max(values[i], distance look-up of point i) for one view (HullView::maxInto).
+void maxDistances(const DistanceKernel& kernel, const PointBatch& points, float* values);
+
+/// The ball verdicts of one view (HullView::classifyBalls).
+void classifyBalls(const DistanceKernel& kernel, const PointBatch& centres, float radius,
+                   float* values, uint8_t* out, uint8_t* in);
+
+}  // namespace detail
+}  // namespace sift_hull
