@@ -48,15 +48,23 @@ cv::Mat discMask(cv::Size size, cv::Point2d centre, double radius) {
   return mask;
 }
 
-TEST(SignedDistanceMap, FollowsTheDiscsDistanceWithinAPixel) {
-  const cv::Point2d centre(40.3, 30.6);
+TEST(SignedDistanceMap, FollowsTheDiscsDistanceNearItAndBoundsItFarAway) {
+  const cv::Point2d centre(60.3, 50.6);
   const double radius = 15.0;
-  const cv::Mat disc = discMask({80, 60}, centre, radius);
-  const SignedDistanceMap map(disc, silhouetteBounds(disc, false), 8);
-  for (double u = 0; u < 80; u += 3.7) {
-    for (double v = 0; v < 60; v += 2.9) {
+  const int padding = 8;
+  const cv::Mat disc = discMask({120, 100}, centre, radius);
+  const SignedDistanceMap map(disc, silhouetteBounds(disc, false), padding);
+  for (double u = -20; u < 140; u += 3.7) {
+    for (double v = -20; v < 120; v += 2.9) {
       const double expected = std::hypot(u - centre.x, v - centre.y) - radius;
-      EXPECT_NEAR(map.at(u, v), expected, 1.0) << "at " << u << ", " << v;
+      const bool near = std::abs(u - centre.x) < radius + padding &&
+                        std::abs(v - centre.y) < radius + padding;
+      if (near) {
+        EXPECT_NEAR(map.at(u, v), expected, 1.0) << "at " << u << ", " << v;
+      } else {  // a lower bound, and outside
+        EXPECT_LT(map.at(u, v), expected + 1.0) << "at " << u << ", " << v;
+        EXPECT_GT(map.at(u, v), padding - 1.0) << "at " << u << ", " << v;
+      }
     }
   }
 }

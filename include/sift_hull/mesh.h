@@ -31,10 +31,12 @@ using FieldSampler =
     std::function<void(const std::vector<Eigen::Vector3d>& points_W, std::vector<float>* values)>;
 
 /// Marching cubes over the given cells only (VTK's case table): evaluates the field once per
-/// distinct corner, through calls of `field` on chunks of up to 65,536 points, puts a vertex where the field crosses zero along a
-/// cell edge (linear interpolation), shares vertices between cells. A closed surface results when
-/// every cell in which the field changes sign is listed.
-TriangleMesh marchingCubes(const SurfaceCells& cells, const FieldSampler& field);
+/// distinct corner, through calls of `field` on chunks of up to 65,536 points, puts a vertex where
+/// the field crosses zero along a cell edge (linear interpolation), shares vertices between cells.
+/// A closed surface results when every cell in which the field changes sign is listed. Works
+/// through the cells in slabs of whole z layers, so that its working arrays stay small; takes the
+/// cells by value to free them early.
+TriangleMesh marchingCubes(SurfaceCells cells, const FieldSampler& field);
 
 /// Topology of a mesh. Watertight: every edge has exactly two faces, which traverse it in opposite
 /// directions, and no face is degenerate (repeated vertex index).

@@ -25,17 +25,22 @@ struct DistanceKernel {
   float behind_value;  ///< valueAt of a point not in front of the camera
   const float* map;    ///< padded distance map, row-major
   int stride;
-  float padding, u_high, v_high;  ///< look-ups clamp to [0, u_high] x [0, v_high]
+  float offset_u, offset_v;  ///< map column / row = pixel u / v + offset
+  float u_high, v_high;      ///< look-ups clamp to [0, u_high] x [0, v_high]
 };
 }  // namespace detail
 
 /// Signed distance transform of a silhouette in pixels: negative inside, positive outside, zero
 /// on the boundary between inside and outside pixel squares (OpenCV's exact Euclidean
-/// distanceTransform of the mask and of its complement). The map is padded around the image with
-/// `padding_px` pixels; a padding pixel counts as inside when it lies within the silhouette's
-/// bounds, whose sides are open where the image border cuts the silhouette. So a view does not
-/// carve beyond a side of its image where the object may go on, exactly as the bounding-box LP
-/// assumes. Look-ups beyond the padding are clamped to it.
+/// distanceTransform of the mask and of its complement). The image is padded with `padding_px`
+/// pixels; a padding pixel counts as inside when it lies within the silhouette's bounds, whose
+/// sides are open where the image border cuts the silhouette. So a view does not carve beyond a
+/// side of its image where the object may go on, exactly as the bounding-box LP assumes.
+///
+/// The map covers only the inside pixels' bounding box plus `padding_px` on every side (within
+/// the padded image): exact there. Look-ups elsewhere are clamped to the map, which gives a
+/// lower bound of the distance (the map is convex and holds every inside pixel): safe for
+/// carving, and positive, as those points are outside.
 class SignedDistanceMap {
  public:
   SignedDistanceMap() = default;
@@ -46,14 +51,14 @@ class SignedDistanceMap {
   /// Bilinear look-up at pixel coordinates (pixel centres at integers), clamped to the map.
   float at(double u_px, double v_px) const;
   cv::Size imageSize() const { return image_size_; }
-  /// The padded map (CV_32FC1, continuous) and its padding, for batched look-ups.
-  const cv::Mat& padded() const { return distance_px_; }
-  int padding() const { return padding_px_; }
+  /// The map (CV_32FC1, continuous, at least 2x2) and the image pixel of its first element.
+  const cv::Mat& map() const { return distance_px_; }
+  cv::Point origin() const { return origin_; }
 
  private:
-  cv::Mat distance_px_;  ///< CV_32FC1, padded
+  cv::Mat distance_px_;  ///< CV_32FC1
   cv::Size image_size_;
-  int padding_px_ = 0;
+  cv::Point origin_;  ///< image pixel of map element (0, 0)
 };
 
 /// Octree carving settings.

@@ -27,8 +27,8 @@ Projected project(const DistanceKernel& k, float X, float Y, float Z) {
   const bool in_front = p.z > 0.0f;
   const float inverse_depth = 1.0f / (in_front ? p.z : 1.0f);
   const float x = p.x * inverse_depth, y = p.y * inverse_depth;
-  const float u = std::min(std::max(k.fx * x + k.skew * y + k.cx + k.padding, 0.0f), k.u_high);
-  const float v = std::min(std::max(k.fy * y + k.cy + k.padding, 0.0f), k.v_high);
+  const float u = std::min(std::max(k.fx * x + k.skew * y + k.cx + k.offset_u, 0.0f), k.u_high);
+  const float v = std::min(std::max(k.fy * y + k.cy + k.offset_v, 0.0f), k.v_high);
   const int u0 = static_cast<int>(u), v0 = static_cast<int>(v);
   const float fu = u - u0, fv = v - v0;
   const float* top = k.map + v0 * k.stride + u0;
@@ -86,10 +86,10 @@ __attribute__((target("avx2"))) Projected8 project8(const DistanceKernel& k, __m
       _mm256_add_ps(_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(_mm256_set1_ps(k.fx), x),
                                                 _mm256_mul_ps(_mm256_set1_ps(k.skew), y)),
                                   _mm256_set1_ps(k.cx)),
-                    _mm256_set1_ps(k.padding));
+                    _mm256_set1_ps(k.offset_u));
   const __m256 v_raw =
       _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(_mm256_set1_ps(k.fy), y), _mm256_set1_ps(k.cy)),
-                    _mm256_set1_ps(k.padding));
+                    _mm256_set1_ps(k.offset_v));
   const __m256 u = clampTo(u_raw, k.u_high), v = clampTo(v_raw, k.v_high);
   const __m256i u0 = _mm256_cvttps_epi32(u), v0 = _mm256_cvttps_epi32(v);
   const __m256 fu = _mm256_sub_ps(u, _mm256_cvtepi32_ps(u0));

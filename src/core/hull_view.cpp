@@ -60,23 +60,46 @@ cv::Mat paddedMask(const cv::Mat& mask, const SilhouetteBounds& bounds, int padd
   return padded;
 }
 
+/// The inside pixels' bounding box grown by `margin` on every side, within the image; the whole
+/// image when nothing is inside; at least 2x2 (for bilinear look-ups).
+cv::Rect mapWindow(const cv::Mat& inside, int margin) {
+  const cv::Rect image(0, 0, inside.cols, inside.rows);
+  cv::Rect window = cv::boundingRect(inside);
+  if (window.empty()) return image;
+  window = cv::Rect(window.x - margin, window.y - margin, window.width + 2 * margin,
+                    window.height + 2 * margin) &
+           image;
+  window.width = std::max(window.width, 2);
+  window.height = std::max(window.height, 2);
+  return window & image;
+}
+
 }  // namespace
 
 SignedDistanceMap::SignedDistanceMap(const cv::Mat& mask, const SilhouetteBounds& bounds,
                                      int padding_px)
-    : image_size_(mask.size()), padding_px_(padding_px) {
+    : image_size_(mask.size()) {
   checkMask(mask);
-  const cv::Mat inside = paddedMask(mask, bounds, padding_px);
-  const cv::Mat outside = inside == 0;
+  const cv::Mat padded = paddedMask(mask, bounds, padding_px);
+  const cv::Rect window = mapWindow(padded, padding_px);
+  origin_ = window.tl() - cv::Point(padding_px, padding_px);
+  const cv::Mat inside = padded(window).clone();
+  const cv::Mat to_inside = distanceWithin(inside == 0);
+  distance_px_ = distanceWithin(inside);
   // Pixel distances are between centres; the boundary lies half a pixel from the last centre.
-  distance_px_ = distanceWithin(outside) - distanceWithin(inside);
-  cv::add(distance_px_, 0.5, distance_px_, inside);
-  cv::subtract(distance_px_, 0.5, distance_px_, outside);
+  for (int row = 0; row < inside.rows; ++row) {
+    const uint8_t* is_inside = inside.ptr<uint8_t>(row);
+    const float* outside_distance = to_inside.ptr<float>(row);
+    float* distance = distance_px_.ptr<float>(row);
+    for (int col = 0; col < inside.cols; ++col) {
+      distance[col] = is_inside[col] ? 0.5f - distance[col] : outside_distance[col] - 0.5f;
+    }
+  }
 }
 
 float SignedDistanceMap::at(double u_px, double v_px) const {
-  const double u = std::clamp(u_px + padding_px_, 0.0, distance_px_.cols - 1.0);
-  const double v = std::clamp(v_px + padding_px_, 0.0, distance_px_.rows - 1.0);
+  const double u = std::clamp(u_px - origin_.x, 0.0, distance_px_.cols - 1.0);
+  const double v = std::clamp(v_px - origin_.y, 0.0, distance_px_.rows - 1.0);
   const int u0 = std::min(static_cast<int>(u), distance_px_.cols - 2);
   const int v0 = std::min(static_cast<int>(v), distance_px_.rows - 2);
   const float fu = static_cast<float>(u - u0), fv = static_cast<float>(v - v0);
@@ -119,10 +142,11 @@ detail::DistanceKernel HullView::makeKernel(const HullConfig& config) const {
   kernel.k_norm = static_cast<float>(spectralNorm2x2(K));
   kernel.slack_px = static_cast<float>(config.distance_slack_px);
   kernel.behind_value = carves_behind_ ? kFarOutside_px : -kFarOutside_px;
-  const cv::Mat& map = distance_.padded();
+  const cv::Mat& map = distance_.map();
   kernel.map = map.ptr<float>();
   kernel.stride = map.cols;
-  kernel.padding = static_cast<float>(distance_.padding());
+  kernel.offset_u = static_cast<float>(-distance_.origin().x);
+  kernel.offset_v = static_cast<float>(-distance_.origin().y);
   // Short of the last column / row, so that the right / lower neighbour of a look-up exists.
   kernel.u_high = map.cols - 1 - 1.0f / 512, kernel.v_high = map.rows - 1 - 1.0f / 512;
   return kernel;

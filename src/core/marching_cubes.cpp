@@ -7,6 +7,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <unordered_map>
 
 #include "sift_hull/mesh.h"
 
@@ -79,12 +80,25 @@ uint64_t cornerKeyOffset(int corner) {
          (static_cast<uint64_t>(kCornerOffsets[corner][2]) << (2 * kKeyBits));
 }
 
+// Least-significant-digit radix sort, 16 bits a pass, skipping digits all keys share.
+void radixSort(std::vector<uint64_t>* keys) {
+  std::vector<uint64_t> buffer(keys->size());
+  for (int shift = 0; shift < 64; shift += 16) {
+    std::array<size_t, (1 << 16) + 1> starts{};
+    for (uint64_t key : *keys) ++starts[((key >> shift) & 0xffff) + 1];
+    if (std::count(starts.begin(), starts.end(), keys->size()) == 1) continue;
+    for (size_t digit = 1; digit < starts.size(); ++digit) starts[digit] += starts[digit - 1];
+    for (uint64_t key : *keys) buffer[starts[(key >> shift) & 0xffff]++] = key;
+    keys->swap(buffer);
+  }
+}
+
 std::vector<uint64_t> sortedCellKeys(const std::vector<Eigen::Vector3i>& cells,
                                      const CornerKeys& keys) {
   std::vector<uint64_t> cell_keys;
   cell_keys.reserve(cells.size());
   for (const Eigen::Vector3i& cell : cells) cell_keys.push_back(keys.key(cell));
-  std::sort(cell_keys.begin(), cell_keys.end());
+  radixSort(&cell_keys);
   cell_keys.erase(std::unique(cell_keys.begin(), cell_keys.end()), cell_keys.end());
   return cell_keys;
 }
@@ -105,8 +119,8 @@ std::vector<uint64_t> unionWithShifted(const std::vector<uint64_t>& keys, uint64
 
 // The corners of the cells are the cells shifted by {0, 1} along each axis in turn; three merges
 // of sorted lists keep the keys sorted and need far less memory than sorting eight copies.
-std::vector<uint64_t> distinctCornerKeys(const std::vector<uint64_t>& cell_keys) {
-  std::vector<uint64_t> keys = cell_keys;
+std::vector<uint64_t> distinctCornerKeys(const uint64_t* first_cell, const uint64_t* last_cell) {
+  std::vector<uint64_t> keys(first_cell, last_cell);
   for (int axis = 0; axis < 3; ++axis) {
     keys = unionWithShifted(keys, uint64_t{1} << (axis * kKeyBits));
   }
@@ -148,37 +162,70 @@ double zeroCrossing(float lower_value, float upper_value) {
   return std::clamp(fraction, kMinEdgeFraction, 1.0 - kMinEdgeFraction);
 }
 
-class Polygoniser {
+int zOfKey(uint64_t key) { return static_cast<int>(key >> (2 * kKeyBits)); }
+
+/// Vertices on the x and y edges of one z plane, by 2 * corner key + axis: what one slab of cells
+/// hands on to the next, which shares that plane.
+using PlaneVertices = std::unordered_map<uint64_t, int>;
+
+/// Marching cubes over one slab of cells (whole z layers), appending to a mesh. Working in slabs
+/// keeps the corner arrays small.
+class SlabPolygoniser {
  public:
-  Polygoniser(const SurfaceCells& cells, const FieldSampler& field)
+  SlabPolygoniser(const SurfaceCells& cells, const CornerKeys& keys, const uint64_t* first_cell,
+                  const uint64_t* last_cell, const FieldSampler& field, TriangleMesh* mesh)
       : cells_(cells),
-        keys_(cells.cells),
-        cell_keys_(sortedCellKeys(cells.cells, keys_)),
-        corner_keys_(distinctCornerKeys(cell_keys_)),
-        values_(sampleCorners(cells, keys_, corner_keys_, field)),
-        edge_vertices_(3 * corner_keys_.size(), -1) {
-    mesh_.vertices_W.reserve(cell_keys_.size());
-    mesh_.faces.reserve(2 * cell_keys_.size());
-  }
+        keys_(keys),
+        first_cell_(first_cell),
+        last_cell_(last_cell),
+        corner_keys_(distinctCornerKeys(first_cell, last_cell)),
+        values_(sampleCorners(cells, keys, corner_keys_, field)),
+        edge_vertices_(3 * corner_keys_.size(), -1),
+        mesh_(mesh) {}
 
   // Visits the cells in key order, so each corner's key only grows from one cell to the next and
-  // its id is found by advancing a cursor through the sorted corner keys.
-  TriangleMesh run() {
+  // its id is found by advancing a cursor through the sorted corner keys. Returns the vertices on
+  // the slab's top plane.
+  PlaneVertices run(const PlaneVertices& bottom_plane) {
+    reuse(bottom_plane);
     // Corners 0, 3, 4, 7 start the runs along +i; the other corners are the next keys.
     constexpr std::array<int, 4> kRunStarts = {0, 3, 4, 7};
     std::array<size_t, 4> cursors = {0, 0, 0, 0};
-    for (uint64_t cell_key : cell_keys_) {
+    for (const uint64_t* cell_key = first_cell_; cell_key != last_cell_; ++cell_key) {
       for (int run = 0; run < 4; ++run) {
-        const uint64_t target = cell_key + cornerKeyOffset(kRunStarts[run]);
+        const uint64_t target = *cell_key + cornerKeyOffset(kRunStarts[run]);
         while (corner_keys_[cursors[run]] < target) ++cursors[run];
       }
-      const std::array<int, 8> ids = cornerIds(cursors);
-      polygoniseCell(keys_.index(cell_key), ids);
+      polygoniseCell(keys_.index(*cell_key), cornerIds(cursors));
     }
-    return std::move(mesh_);
+    return topPlane();
   }
 
  private:
+  /// Vertex slots of the bottom plane's edges that the slab below already filled.
+  void reuse(const PlaneVertices& bottom_plane) {
+    if (bottom_plane.empty()) return;
+    const int bottom = zOfKey(corner_keys_.front());
+    for (size_t id = 0; id < corner_keys_.size() && zOfKey(corner_keys_[id]) == bottom; ++id) {
+      for (int axis = 0; axis < 2; ++axis) {
+        const auto found = bottom_plane.find(2 * corner_keys_[id] + axis);
+        if (found != bottom_plane.end()) edge_vertices_[3 * id + axis] = found->second;
+      }
+    }
+  }
+
+  PlaneVertices topPlane() const {
+    PlaneVertices plane;
+    const int top = zOfKey(corner_keys_.back());
+    for (size_t id = corner_keys_.size(); id-- > 0 && zOfKey(corner_keys_[id]) == top;) {
+      for (int axis = 0; axis < 2; ++axis) {
+        const int vertex = edge_vertices_[3 * id + axis];
+        if (vertex >= 0) plane.emplace(2 * corner_keys_[id] + axis, vertex);
+      }
+    }
+    return plane;
+  }
+
   // Corner ids in VTK order from the ids of corners 0, 3, 4 and 7.
   static std::array<int, 8> cornerIds(const std::array<size_t, 4>& run_starts) {
     const int base = static_cast<int>(run_starts[0]);
@@ -195,8 +242,8 @@ class Polygoniser {
     if (vertex >= 0) return vertex;
     Eigen::Vector3d grid_point = cornerOf(cell, lower).cast<double>();
     grid_point[axis] += zeroCrossing(values_[ids[lower]], values_[ids[kEdgeCorners[edge][1]]]);
-    vertex = static_cast<int>(mesh_.vertices_W.size());
-    mesh_.vertices_W.push_back((cells_.origin_W + cells_.cell_edge_m * grid_point).cast<float>());
+    vertex = static_cast<int>(mesh_->vertices_W.size());
+    mesh_->vertices_W.push_back((cells_.origin_W + cells_.cell_edge_m * grid_point).cast<float>());
     return vertex;
   }
 
@@ -212,22 +259,34 @@ class Polygoniser {
       const int first = vertexOnEdge(cell, ids, edges[0]);
       const int second = vertexOnEdge(cell, ids, edges[1]);
       const int third = vertexOnEdge(cell, ids, edges[2]);
-      mesh_.faces.emplace_back(first, third, second);
+      mesh_->faces.emplace_back(first, third, second);
     }
   }
 
   const SurfaceCells& cells_;
-  CornerKeys keys_;
-  std::vector<uint64_t> cell_keys_;  ///< sorted, each cell once
+  const CornerKeys& keys_;
+  const uint64_t* first_cell_;
+  const uint64_t* last_cell_;
   std::vector<uint64_t> corner_keys_;
   std::vector<float> values_;
   std::vector<int> edge_vertices_;  ///< vertex per (lower corner id, axis), -1 if none yet
-  TriangleMesh mesh_;
+  TriangleMesh* mesh_;
 };
+
+/// About this many cells to a slab, rounded up to whole z layers.
+constexpr size_t kSlabCells = size_t{1} << 16;
+
+/// End of the slab that starts at `first`: whole z layers holding about kSlabCells cells.
+const uint64_t* slabEnd(const uint64_t* first, const uint64_t* last) {
+  if (static_cast<size_t>(last - first) <= kSlabCells) return last;
+  const int layer = zOfKey(first[kSlabCells - 1]);
+  return std::find_if(first + kSlabCells, last,
+                      [layer](uint64_t key) { return zOfKey(key) != layer; });
+}
 
 }  // namespace
 
-TriangleMesh marchingCubes(const SurfaceCells& cells, const FieldSampler& field) {
+TriangleMesh marchingCubes(SurfaceCells cells, const FieldSampler& field) {
   if (!(cells.cell_edge_m > 0.0 && std::isfinite(cells.cell_edge_m))) {
     throw std::invalid_argument("marchingCubes: cell_edge_m must be positive and finite");
   }
@@ -235,7 +294,21 @@ TriangleMesh marchingCubes(const SurfaceCells& cells, const FieldSampler& field)
     throw std::invalid_argument("marchingCubes: origin_W must be finite");
   }
   if (cells.cells.empty()) return {};
-  return Polygoniser(cells, field).run();
+  const CornerKeys keys(cells.cells);
+  const std::vector<uint64_t> cell_keys = sortedCellKeys(cells.cells, keys);
+  cells.cells = {};  // only the keys are needed from here on
+  TriangleMesh mesh;
+  // Typical surfaces give about one vertex per two cells and one face per cell.
+  mesh.vertices_W.reserve(cell_keys.size() / 2);
+  mesh.faces.reserve(cell_keys.size());
+  PlaneVertices plane;
+  const uint64_t* last = cell_keys.data() + cell_keys.size();
+  for (const uint64_t* first = cell_keys.data(); first != last;) {
+    const uint64_t* end = slabEnd(first, last);
+    plane = SlabPolygoniser(cells, keys, first, end, field, &mesh).run(plane);
+    first = end;
+  }
+  return mesh;
 }
 
 }  // namespace sift_hull

@@ -160,6 +160,22 @@ void visitLeaves(const HullNode& node, const CellIndex& cell,
   for (int c = 0; c < 8; ++c) visitLeaves(node.children[c], childOf(cell, c), visit);
 }
 
+size_t countSurfaceLeaves(const HullNode& node) {
+  if (!node.children) return node.state == CellState::kSurface ? 1 : 0;
+  size_t count = 0;
+  for (int c = 0; c < 8; ++c) count += countSurfaceLeaves(node.children[c]);
+  return count;
+}
+
+void collectSurfaceLeaves(const HullNode& node, const CellIndex& cell,
+                          std::vector<Eigen::Vector3i>* cells) {
+  if (!node.children) {
+    if (node.state == CellState::kSurface) cells->push_back(cell.index);
+    return;
+  }
+  for (int c = 0; c < 8; ++c) collectSurfaceLeaves(node.children[c], childOf(cell, c), cells);
+}
+
 }  // namespace
 
 VisualHull::VisualHull(const Box3d& box, const HullConfig& config)
@@ -267,9 +283,8 @@ SurfaceCells VisualHull::surfaceCells() const {
   SurfaceCells cells;
   cells.origin_W = cube_.origin_W();
   cells.cell_edge_m = cube_.resolution_m;
-  forEachLeaf([&](const HullCell& cell) {
-    if (cell.state == CellState::kSurface) cells.cells.push_back(cell.index);
-  });
+  cells.cells.reserve(countSurfaceLeaves(*root_));
+  collectSurfaceLeaves(*root_, CellIndex{}, &cells.cells);
   return cells;
 }
 
