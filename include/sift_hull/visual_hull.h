@@ -112,11 +112,11 @@ class HullView {
   bool keeps(const Eigen::Vector3d& X_W) const;
   /// values[i] = max(values[i], D_i(P_i X_i)) for a batch of points: f_iso built view by view.
   void maxInto(const PointBatch& points, float* values) const;
-  /// For balls of one radius around a batch of centres, from the distance at each centre and the
-  /// ball's projected radius (plus the slack): maxInto for the centres; out[i] set when the view
-  /// sees all of ball i outside the silhouette; in[i] cleared unless it sees all of it inside.
-  void classifyBalls(const PointBatch& centres, float radius_m, float* values, uint8_t* out,
-                     uint8_t* in) const;
+  /// For balls of one radius around up to 32 centres, from the distance at each centre and the
+  /// ball's projected radius (plus the slack): maxInto for the centres; bit i of `out_bits` set
+  /// when the view sees all of ball i outside the silhouette, of `in_bits` when all inside.
+  void classifyBalls(const PointBatch& centres, float radius_m, float* values, uint32_t* out_bits,
+                     uint32_t* in_bits) const;
 
   static constexpr float kFarOutside_px = 1e6f;
 

@@ -41,15 +41,25 @@ Projected project(const DistanceKernel& k, float X, float Y, float Z) {
 
 /// |d(K x/z)| <= ||K_2x2|| |X_C| r / (z (z - r)) for any offset of length <= r: the ball's image
 /// lies in this disc around the projected centre, and the distance is 1-Lipschitz in pixels.
-void judgeBall(const DistanceKernel& k, const Projected& p, float radius, uint8_t* out,
-               uint8_t* in) {
+uint32_t judgeBall(const DistanceKernel& k, const Projected& p, float radius, bool want_out) {
   const float clearance = p.z - radius;
   const bool ahead = clearance > 0.0f;
   const float norm = std::sqrt(p.x * p.x + p.y * p.y + p.z * p.z);
   const float projected_radius =
       k.k_norm * norm * radius / (ahead ? p.z * clearance : 1.0f) + k.slack_px;
-  *out |= ahead && p.value - projected_radius > 0.0f;
-  *in &= ahead && p.value + projected_radius < 0.0f;
+  return want_out ? ahead && p.value - projected_radius > 0.0f
+                  : ahead && p.value + projected_radius < 0.0f;
+}
+
+/// Scalar verdicts of centres [first, count), as bits from `first` on.
+void classifyBallsScalar(const DistanceKernel& k, const PointBatch& centres, size_t first,
+                         float radius, float* values, uint32_t* out_bits, uint32_t* in_bits) {
+  for (size_t i = first; i < centres.count; ++i) {
+    const Projected p = project(k, centres.x[i], centres.y[i], centres.z[i]);
+    values[i] = std::max(values[i], p.value);
+    *out_bits |= judgeBall(k, p, radius, true) << i;
+    *in_bits |= judgeBall(k, p, radius, false) << i;
+  }
 }
 
 struct Projected8 {
@@ -120,7 +130,8 @@ __attribute__((target("avx2"))) void maxDistancesAvx2(const DistanceKernel& k,
 
 __attribute__((target("avx2"))) void classifyBallsAvx2(const DistanceKernel& k,
                                                        const PointBatch& centres, float radius,
-                                                       float* values, uint8_t* out, uint8_t* in) {
+                                                       float* values, uint32_t* out_bits,
+                                                       uint32_t* in_bits) {
   size_t i = 0;
   const __m256 r = _mm256_set1_ps(radius), zero = _mm256_setzero_ps();
   for (; i + 8 <= centres.count; i += 8) {
@@ -136,20 +147,16 @@ __attribute__((target("avx2"))) void classifyBallsAvx2(const DistanceKernel& k,
     const __m256 projected_radius = _mm256_add_ps(
         _mm256_div_ps(_mm256_mul_ps(_mm256_mul_ps(_mm256_set1_ps(k.k_norm), norm), r), denominator),
         _mm256_set1_ps(k.slack_px));
-    const int out_bits = _mm256_movemask_ps(_mm256_and_ps(
-        ahead, _mm256_cmp_ps(_mm256_sub_ps(p.value, projected_radius), zero, _CMP_GT_OQ)));
-    const int in_bits = _mm256_movemask_ps(_mm256_and_ps(
-        ahead, _mm256_cmp_ps(_mm256_add_ps(p.value, projected_radius), zero, _CMP_LT_OQ)));
-    for (int c = 0; c < 8; ++c) {
-      out[i + c] |= (out_bits >> c) & 1;
-      in[i + c] &= (in_bits >> c) & 1;
-    }
+    *out_bits |=
+        static_cast<uint32_t>(_mm256_movemask_ps(_mm256_and_ps(
+            ahead, _mm256_cmp_ps(_mm256_sub_ps(p.value, projected_radius), zero, _CMP_GT_OQ))))
+        << i;
+    *in_bits |=
+        static_cast<uint32_t>(_mm256_movemask_ps(_mm256_and_ps(
+            ahead, _mm256_cmp_ps(_mm256_add_ps(p.value, projected_radius), zero, _CMP_LT_OQ))))
+        << i;
   }
-  for (; i < centres.count; ++i) {
-    const Projected p = project(k, centres.x[i], centres.y[i], centres.z[i]);
-    values[i] = std::max(values[i], p.value);
-    judgeBall(k, p, radius, out + i, in + i);
-  }
+  classifyBallsScalar(k, centres, i, radius, values, out_bits, in_bits);
 }
 
 bool hasAvx2() {
@@ -167,13 +174,11 @@ void maxDistances(const DistanceKernel& kernel, const PointBatch& points, float*
 }
 
 void classifyBalls(const DistanceKernel& kernel, const PointBatch& centres, float radius,
-                   float* values, uint8_t* out, uint8_t* in) {
-  if (hasAvx2()) return classifyBallsAvx2(kernel, centres, radius, values, out, in);
-  for (size_t i = 0; i < centres.count; ++i) {
-    const Projected p = project(kernel, centres.x[i], centres.y[i], centres.z[i]);
-    values[i] = std::max(values[i], p.value);
-    judgeBall(kernel, p, radius, out + i, in + i);
-  }
+                   float* values, uint32_t* out_bits, uint32_t* in_bits) {
+  *out_bits = 0;
+  *in_bits = 0;
+  if (hasAvx2()) return classifyBallsAvx2(kernel, centres, radius, values, out_bits, in_bits);
+  classifyBallsScalar(kernel, centres, 0, radius, values, out_bits, in_bits);
 }
 
 }  // namespace detail

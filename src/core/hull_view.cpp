@@ -182,9 +182,10 @@ void HullView::maxInto(const PointBatch& points, float* values) const {
   detail::maxDistances(kernel_, points, values);
 }
 
-void HullView::classifyBalls(const PointBatch& centres, float radius_m, float* values, uint8_t* out,
-                             uint8_t* in) const {
-  detail::classifyBalls(kernel_, centres, radius_m, values, out, in);
+void HullView::classifyBalls(const PointBatch& centres, float radius_m, float* values,
+                             uint32_t* out_bits, uint32_t* in_bits) const {
+  if (centres.count > 32) throw std::invalid_argument("classifyBalls: more than 32 centres");
+  detail::classifyBalls(kernel_, centres, radius_m, values, out_bits, in_bits);
 }
 
 std::vector<HullView> makeHullViews(const std::vector<std::string>& names,

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <numeric>
 #include <stdexcept>
 #include <thread>
 
@@ -51,15 +52,44 @@ void parallelFor(size_t count, int threads, const Fn& fn) {
   for (std::thread& thread : pool) thread.join();
 }
 
-/// The children of a node whose update waits for the parallel pass.
+using ViewList = std::vector<uint32_t>;
+
+/// The children of a node whose update waits for the parallel pass, with the views to apply.
 struct DeferredUpdate {
   HullNode* node;
   CellIndex cell;
-  size_t first_view;
+  ViewList views;
 };
 
-/// Updates nodes with the views from `first_view` on: an out verdict prunes, an undecided verdict
-/// turns an in cell into a surface cell split into children classified by all views. The eight
+/// Verdicts of a list of views on up to eight cells.
+struct Verdicts {
+  float values[8];
+  uint32_t out_bits = 0;
+  std::vector<uint8_t> in_bits;  ///< per view applied, bit c: cell c is all inside
+  size_t applied = 0;            ///< views applied before every cell was out
+};
+
+/// Per-thread buffers by depth, reused from node to node: the walk is depth first, so a level's
+/// buffers are free again once its node is done.
+struct Scratch {
+  std::vector<ViewList> views;     ///< [d]: the views applied to the node at depth d
+  std::vector<Verdicts> verdicts;  ///< [d]: the verdicts on the children of the node at depth d
+
+  static Scratch& forThread(int depths) {
+    static thread_local Scratch scratch;
+    if (scratch.views.size() < static_cast<size_t>(depths)) {
+      scratch.views.resize(depths);
+      scratch.verdicts.resize(depths);
+    }
+    return scratch;
+  }
+};
+
+/// Updates nodes with a list of views: an out verdict prunes, an undecided verdict turns an in
+/// cell into a surface cell split into children. A view that sees all of a cell inside its
+/// silhouette sees its children inside too, so a node passes on to its children only the views
+/// that did not: near the surface, a few of them. The centre value then is the maximum over the
+/// views applied, which has the sign of f_iso (the views left out are negative there). The eight
 /// children of a node are classified together, view by view.
 class Refiner {
  public:
@@ -69,41 +99,60 @@ class Refiner {
 
   void updateRoot(HullNode& root, size_t first_view) const {
     if (root.state == CellState::kOut || first_view == views_.size()) return;
+    ViewList views(views_.size() - first_view);
+    std::iota(views.begin(), views.end(), static_cast<uint32_t>(first_view));
     const Eigen::Vector3f centre = cellCentre(cube_, CellIndex{}).cast<float>();
-    float value;
-    uint8_t out, in;
-    classify({&centre.x(), &centre.y(), &centre.z(), 1}, 0, first_view, &value, &out, &in);
-    apply(root, CellIndex{}, first_view, verdictOf(out, in), value);
+    Scratch& scratch = Scratch::forThread(cube_.depth + 2);
+    Verdicts& verdicts = scratch.verdicts[0];
+    classify({&centre.x(), &centre.y(), &centre.z(), 1}, 0, views, &verdicts);
+    viewsNotIn(verdicts, views, 0, &scratch.views[0]);
+    apply(root, CellIndex{}, verdictOf(verdicts, 0), verdicts.values[0], scratch.views[0]);
   }
 
-  void updateChildren(HullNode& node, const CellIndex& cell, size_t first_view) const {
+  void updateChildren(HullNode& node, const CellIndex& cell, const ViewList& views) const {
+    if (views.empty()) return;
     if (deferred_ != nullptr && cell.depth + 1 == defer_depth_) {
-      deferred_->push_back({&node, cell, first_view});
+      deferred_->push_back({&node, cell, views});
       return;
     }
-    float x[8], y[8], z[8], values[8];
-    uint8_t out[8], in[8];
+    float x[8], y[8], z[8];
     for (int c = 0; c < 8; ++c) {
       const Eigen::Vector3d centre = cellCentre(cube_, childOf(cell, c));
       x[c] = static_cast<float>(centre.x());
       y[c] = static_cast<float>(centre.y());
       z[c] = static_cast<float>(centre.z());
     }
-    classify({x, y, z, 8}, cell.depth + 1, first_view, values, out, in);
+    Scratch& scratch = Scratch::forThread(cube_.depth + 2);
+    Verdicts& verdicts = scratch.verdicts[cell.depth];
+    classify({x, y, z, 8}, cell.depth + 1, views, &verdicts);
+    ViewList& child_views = scratch.views[cell.depth + 1];
     for (int c = 0; c < 8; ++c) {
       HullNode& child = node.children[c];
       if (child.state == CellState::kOut) continue;
-      apply(child, childOf(cell, c), first_view, verdictOf(out[c], in[c]), values[c]);
+      viewsNotIn(verdicts, views, c, &child_views);
+      apply(child, childOf(cell, c), verdictOf(verdicts, c), verdicts.values[c], child_views);
     }
   }
 
  private:
-  static Verdict verdictOf(uint8_t out, uint8_t in) {
-    return out ? Verdict::kOut : in ? Verdict::kIn : Verdict::kUndecided;
+  static Verdict verdictOf(const Verdicts& verdicts, int cell) {
+    if ((verdicts.out_bits >> cell) & 1) return Verdict::kOut;
+    for (size_t k = 0; k < verdicts.applied; ++k) {
+      if (!((verdicts.in_bits[k] >> cell) & 1)) return Verdict::kUndecided;
+    }
+    return Verdict::kIn;
   }
 
-  void apply(HullNode& node, const CellIndex& cell, size_t first_view, Verdict verdict,
-             float value) const {
+  static void viewsNotIn(const Verdicts& verdicts, const ViewList& views, int cell,
+                         ViewList* not_in) {
+    not_in->clear();
+    for (size_t k = 0; k < verdicts.applied; ++k) {
+      if (!((verdicts.in_bits[k] >> cell) & 1)) not_in->push_back(views[k]);
+    }
+  }
+
+  void apply(HullNode& node, const CellIndex& cell, Verdict verdict, float value,
+             const ViewList& views_not_in) const {
     if (verdict == Verdict::kOut) {
       node.state = CellState::kOut;
       node.children.reset();
@@ -114,31 +163,26 @@ class Refiner {
       node.state = CellState::kSurface;
       if (cell.depth == cube_.depth) return;
       node.children = std::make_unique<HullNode[]>(8);
-      updateChildren(node, cell, 0);
+      updateChildren(node, cell, views_not_in);
     } else if (node.children) {
-      updateChildren(node, cell, first_view);
+      updateChildren(node, cell, views_not_in);
     }
   }
 
-  /// Verdicts of the views from `first_view` on for cells of one depth, stopping once every cell
-  /// is out. Neighbouring cells tend to be carved by the same view: start with the last that did.
-  void classify(const PointBatch& centres, int depth, size_t first_view, float* values,
-                uint8_t* out, uint8_t* in) const {
-    static thread_local size_t last_carving = 0;
+  /// Applies the views in order, stopping once every cell is out.
+  void classify(const PointBatch& centres, int depth, const ViewList& views,
+                Verdicts* verdicts) const {
     const float radius = static_cast<float>(0.5 * std::sqrt(3.0) * cellEdge(cube_, depth));
-    std::fill(values, values + centres.count, -HullView::kFarOutside_px);
-    std::fill(out, out + centres.count, 0);
-    std::fill(in, in + centres.count, 1);
-    const size_t count = views_.size() - first_view;
-    const size_t start =
-        last_carving >= first_view && last_carving < views_.size() ? last_carving - first_view : 0;
-    size_t carved = 0;
-    for (size_t k = 0; k < count && carved < centres.count; ++k) {
-      const size_t v = first_view + (start + k) % count;
-      views_[v].classifyBalls(centres, radius, values, out, in);
-      const size_t now_carved = std::count(out, out + centres.count, 1);
-      if (now_carved > carved) last_carving = v;
-      carved = now_carved;
+    const uint32_t all = (uint32_t{1} << centres.count) - 1;
+    std::fill(verdicts->values, verdicts->values + 8, -HullView::kFarOutside_px);
+    verdicts->out_bits = 0;
+    verdicts->in_bits.resize(views.size());
+    verdicts->applied = 0;
+    for (; verdicts->applied < views.size() && verdicts->out_bits != all; ++verdicts->applied) {
+      uint32_t out = 0, in = 0;
+      views_[views[verdicts->applied]].classifyBalls(centres, radius, verdicts->values, &out, &in);
+      verdicts->out_bits |= out;
+      verdicts->in_bits[verdicts->applied] = static_cast<uint8_t>(in);
     }
   }
 
@@ -196,7 +240,7 @@ void VisualHull::addViews(std::vector<HullView> views) {
   Refiner(cube_, views_, &deferred, kParallelDepth).updateRoot(*root_, first_new);
   const Refiner refiner(cube_, views_, nullptr, 0);
   parallelFor(deferred.size(), config_.threads, [&](size_t i) {
-    refiner.updateChildren(*deferred[i].node, deferred[i].cell, deferred[i].first_view);
+    refiner.updateChildren(*deferred[i].node, deferred[i].cell, deferred[i].views);
   });
 }
 
