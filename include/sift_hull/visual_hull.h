@@ -163,7 +163,9 @@ struct HullCell {
   Eigen::Vector3i index = Eigen::Vector3i::Zero();
   int depth = 0;
   CellState state = CellState::kIn;
-  /// f_iso (eq. 9) at the centre over the views carved so far; meaningful for in and surface cells.
+  /// For in and surface cells: the maximum of D_i at the centre over the views the cell applied
+  /// (those its parent did not see all inside). It has the sign of f_iso (eq. 9) there, and its
+  /// value where that is >= 0.
   float centre_value = 0.0f;
 };
 
