@@ -1,0 +1,174 @@
+#include "conversions.h"
+
+#include <octomap/OcTree.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+#include <pcl_conversions/pcl_conversions.h>
+
+#include <cmath>
+#include <map>
+#include <sstream>
+
+namespace sift_hull {
+namespace ros_conversions {
+
+cv::Mat maskFromImage(const sensor_msgs::Image& image, std::string* why_not) {
+  if (image.encoding != "mono8") {
+    *why_not = "silhouette encoding is '" + image.encoding + "', expected mono8";
+    return {};
+  }
+  if (image.width == 0 || image.height == 0) {
+    *why_not = "silhouette is empty (" + std::to_string(image.width) + "x" +
+               std::to_string(image.height) + ")";
+    return {};
+  }
+  if (image.step < image.width ||
+      image.data.size() < static_cast<size_t>(image.step) * image.height) {
+    *why_not = "silhouette data (" + std::to_string(image.data.size()) + " bytes, step " +
+               std::to_string(image.step) + ") does not hold " + std::to_string(image.width) + "x" +
+               std::to_string(image.height) + " pixels";
+    return {};
+  }
+  const cv::Mat view(image.height, image.width, CV_8UC1, const_cast<uint8_t*>(image.data.data()),
+                     image.step);
+  return view.clone();
+}
+
+namespace {
+
+bool intrinsicsFromInfo(const sensor_msgs::CameraInfo& info, Eigen::Matrix3d* K,
+                        std::string* why_not) {
+  for (int i = 0; i < 9; ++i) (*K)(i / 3, i % 3) = info.K[i];
+  if (!K->allFinite() || (*K)(2, 2) == 0.0) {
+    *why_not = "camera_info K is not finite or has K[8] = 0";
+    return false;
+  }
+  *K /= (*K)(2, 2);
+  if ((*K)(1, 0) != 0.0 || (*K)(2, 0) != 0.0 || (*K)(2, 1) != 0.0 || !((*K)(0, 0) > 0.0) ||
+      !((*K)(1, 1) > 0.0)) {
+    *why_not = "camera_info K is not upper triangular with positive focal lengths";
+    return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+bool cameraFromInfo(const sensor_msgs::CameraInfo& info, const Eigen::Isometry3d& T_W_C,
+                    cv::Size image_size, PinholeCamera* camera, std::string* why_not) {
+  Eigen::Matrix3d K;
+  if (!intrinsicsFromInfo(info, &K, why_not)) return false;
+  if (image_size.area() > 0 && (static_cast<int>(info.width) != image_size.width ||
+                                static_cast<int>(info.height) != image_size.height)) {
+    std::ostringstream message;
+    message << "camera_info is " << info.width << "x" << info.height << " but the silhouette is "
+            << image_size.width << "x" << image_size.height;
+    *why_not = message.str();
+    return false;
+  }
+  if (!T_W_C.matrix().allFinite()) {
+    *why_not = "camera pose is not finite";
+    return false;
+  }
+  const Eigen::Isometry3d T_C_W = T_W_C.inverse();
+  try {
+    *camera = PinholeCamera(K, T_C_W.linear(), T_C_W.translation());
+  } catch (const std::invalid_argument& e) {
+    *why_not = std::string("camera: ") + e.what();
+    return false;
+  }
+  return true;
+}
+
+sift_hull::Octomap octomapMessage(const octomap::OcTree& tree, const std_msgs::Header& header) {
+  sift_hull::Octomap message;
+  message.header = header;
+  message.binary = true;
+  message.id = tree.getTreeType();
+  message.resolution = tree.getResolution();
+  std::stringstream stream;
+  tree.writeBinaryData(stream);
+  const std::string bytes = stream.str();
+  message.data.assign(bytes.begin(), bytes.end());
+  return message;
+}
+
+sensor_msgs::PointCloud2 occupiedCellsCloud(const octomap::OcTree& tree,
+                                            const std_msgs::Header& header) {
+  pcl::PointCloud<pcl::PointXYZ> cloud;
+  for (auto leaf = tree.begin_leafs(); leaf != tree.end_leafs(); ++leaf) {
+    if (!tree.isNodeOccupied(*leaf)) continue;
+    cloud.push_back(pcl::PointXYZ(leaf.getX(), leaf.getY(), leaf.getZ()));
+  }
+  sensor_msgs::PointCloud2 message;
+  pcl::toROSMsg(cloud, message);
+  message.header = header;
+  return message;
+}
+
+namespace {
+
+std_msgs::ColorRGBA heightColour(double fraction) {
+  std_msgs::ColorRGBA colour;
+  colour.r = static_cast<float>(std::clamp(1.5 - std::abs(4.0 * fraction - 3.0), 0.0, 1.0));
+  colour.g = static_cast<float>(std::clamp(1.5 - std::abs(4.0 * fraction - 2.0), 0.0, 1.0));
+  colour.b = static_cast<float>(std::clamp(1.5 - std::abs(4.0 * fraction - 1.0), 0.0, 1.0));
+  colour.a = 1.0f;
+  return colour;
+}
+
+}  // namespace
+
+visualization_msgs::MarkerArray occupiedCellsMarkers(const octomap::OcTree& tree,
+                                                     const std_msgs::Header& header) {
+  double min_x, min_y, min_z, max_x, max_y, max_z;
+  tree.getMetricMin(min_x, min_y, min_z);
+  tree.getMetricMax(max_x, max_y, max_z);
+  const double height = std::max(max_z - min_z, 1e-9);
+  std::map<unsigned, visualization_msgs::Marker> by_depth;
+  for (auto leaf = tree.begin_leafs(); leaf != tree.end_leafs(); ++leaf) {
+    if (!tree.isNodeOccupied(*leaf)) continue;
+    visualization_msgs::Marker& marker = by_depth[leaf.getDepth()];
+    geometry_msgs::Point centre;
+    centre.x = leaf.getX(), centre.y = leaf.getY(), centre.z = leaf.getZ();
+    marker.points.push_back(centre);
+    marker.colors.push_back(heightColour((centre.z - min_z) / height));
+    marker.scale.x = marker.scale.y = marker.scale.z = leaf.getSize();
+  }
+  visualization_msgs::MarkerArray array;
+  for (auto& [depth, marker] : by_depth) {
+    marker.header = header;
+    marker.ns = "occupied_cells";
+    marker.id = static_cast<int>(depth);
+    marker.type = visualization_msgs::Marker::CUBE_LIST;
+    marker.action = visualization_msgs::Marker::ADD;
+    marker.pose.orientation.w = 1.0;
+    array.markers.push_back(marker);
+  }
+  return array;
+}
+
+visualization_msgs::Marker meshMarker(const TriangleMesh& mesh, const std_msgs::Header& header) {
+  visualization_msgs::Marker marker;
+  marker.header = header;
+  marker.ns = "hull_mesh";
+  marker.type = visualization_msgs::Marker::TRIANGLE_LIST;
+  marker.action = visualization_msgs::Marker::ADD;
+  marker.pose.orientation.w = 1.0;
+  marker.scale.x = marker.scale.y = marker.scale.z = 1.0;
+  marker.color.r = marker.color.g = marker.color.b = 0.8f;
+  marker.color.a = 1.0f;
+  marker.points.reserve(3 * mesh.faces.size());
+  for (const Eigen::Vector3i& face : mesh.faces) {
+    for (int corner = 0; corner < 3; ++corner) {
+      const Eigen::Vector3f& vertex = mesh.vertices_W[face[corner]];
+      geometry_msgs::Point point;
+      point.x = vertex.x(), point.y = vertex.y(), point.z = vertex.z();
+      marker.points.push_back(point);
+    }
+  }
+  return marker;
+}
+
+}  // namespace ros_conversions
+}  // namespace sift_hull

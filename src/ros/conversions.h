@@ -1,0 +1,54 @@
+#pragma once
+
+// Every conversion between sift_hull's core types and ROS messages.
+
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <visualization_msgs/Marker.h>
+#include <visualization_msgs/MarkerArray.h>
+
+#include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+#include <string>
+
+#include "sift_hull/Octomap.h"
+#include "sift_hull/camera.h"
+#include "sift_hull/mesh.h"
+
+namespace octomap {
+class OcTree;
+}
+
+namespace sift_hull {
+namespace ros_conversions {
+
+/// A silhouette message as a CV_8UC1 mask sharing nothing with the message. Accepts mono8 only
+/// (non-zero inside); returns an empty Mat and sets `why_not` for another encoding, an empty image
+/// or a step that does not match the width.
+cv::Mat maskFromImage(const sensor_msgs::Image& image, std::string* why_not);
+
+/// The camera of a view: K from `info` (pixels) and the pose T_W_C (the camera frame in the world
+/// frame, as tf gives it). Returns false and sets `why_not` for a K that is zero, not finite or not
+/// upper triangular with K(2,2) = 1 (after scaling), a pose that is not finite, or an image size
+/// that disagrees with `image_size` (when non-zero).
+bool cameraFromInfo(const sensor_msgs::CameraInfo& info, const Eigen::Isometry3d& T_W_C,
+                    cv::Size image_size, PinholeCamera* camera, std::string* why_not);
+
+/// The tree as an Octomap message (binary stream, as octomap_msgs::binaryMapToMsg writes it).
+sift_hull::Octomap octomapMessage(const octomap::OcTree& tree, const std_msgs::Header& header);
+
+/// Occupied leaf centres of the tree, metres, as an XYZ PointCloud2 (via pcl_conversions).
+sensor_msgs::PointCloud2 occupiedCellsCloud(const octomap::OcTree& tree,
+                                            const std_msgs::Header& header);
+
+/// Occupied leaves as CUBE_LIST markers, one per leaf size (octomap_server's
+/// occupied_cells_vis_array), coloured by height.
+visualization_msgs::MarkerArray occupiedCellsMarkers(const octomap::OcTree& tree,
+                                                     const std_msgs::Header& header);
+
+/// The mesh as a TRIANGLE_LIST marker in the header's frame, metres.
+visualization_msgs::Marker meshMarker(const TriangleMesh& mesh, const std_msgs::Header& header);
+
+}  // namespace ros_conversions
+}  // namespace sift_hull

@@ -1,0 +1,160 @@
+#include "hull_node.h"
+
+#include <tf2_eigen/tf2_eigen.h>
+
+#include "conversions.h"
+#include "ros_params.h"
+#include "sift_hull/hull_octomap.h"
+
+namespace sift_hull {
+namespace {
+
+constexpr double kThrottle_s = 5.0;
+
+HullNodeConfig readNodeConfig(const ros::NodeHandle& private_nh) {
+  HullNodeConfig config;
+  private_nh.param("world_frame", config.world_frame, config.world_frame);
+  private_nh.param("queue_size", config.queue_size, config.queue_size);
+  return config;
+}
+
+}  // namespace
+
+HullNode::HullNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
+    : HullNode(nh, private_nh, readNodeConfig(private_nh),
+               ros_params::readHullStreamConfig(private_nh)) {}
+
+HullNode::HullNode(ros::NodeHandle nh, ros::NodeHandle private_nh, HullNodeConfig node_config,
+                   HullStreamConfig hull_config)
+    : nh_(nh),
+      private_nh_(private_nh),
+      config_(std::move(node_config)),
+      stream_(std::move(hull_config)),
+      tf_listener_(tf_buffer_),
+      silhouette_sub_(nh_, "silhouette", config_.queue_size),
+      info_sub_(nh_, "camera_info", config_.queue_size),
+      pose_filter_(silhouette_sub_, tf_buffer_, config_.world_frame, config_.queue_size, nh_),
+      sync_(pose_filter_, info_sub_, config_.queue_size) {
+  pose_filter_.setTolerance(ros::Duration(0.0));
+  pose_filter_.registerFailureCallback(
+      [this](const sensor_msgs::ImageConstPtr& image,
+             tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
+        onPoseMissing(image, reason);
+      });
+  sync_.registerCallback(&HullNode::onView, this);
+  octomap_pub_ = nh_.advertise<sift_hull::Octomap>("octomap_binary", 1, true);
+  cloud_pub_ = nh_.advertise<sensor_msgs::PointCloud2>("occupied_cells", 1, true);
+  markers_pub_ =
+      nh_.advertise<visualization_msgs::MarkerArray>("occupied_cells_vis_array", 1, true);
+  mesh_pub_ = nh_.advertise<visualization_msgs::Marker>("mesh", 1, true);
+  reset_srv_ = private_nh_.advertiseService("reset", &HullNode::reset, this);
+  save_srv_ = private_nh_.advertiseService("save", &HullNode::save, this);
+}
+
+void HullNode::onPoseMissing(const sensor_msgs::ImageConstPtr& silhouette,
+                             tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
+  ROS_ERROR_THROTTLE(
+      kThrottle_s, "hull: dropped the silhouette of frame '%s' at %.3f: no pose in '%s' (%s)",
+      silhouette->header.frame_id.c_str(), silhouette->header.stamp.toSec(),
+      config_.world_frame.c_str(),
+      reason == tf2_ros::filter_failure_reasons::EmptyFrameID ? "empty frame id"
+      : reason == tf2_ros::filter_failure_reasons::OutTheBack ? "older than the transforms tf keeps"
+                                                              : "the transform never arrived");
+}
+
+bool HullNode::cameraOf(const sensor_msgs::Image& silhouette, const sensor_msgs::CameraInfo& info,
+                        PinholeCamera* camera) {
+  Eigen::Isometry3d T_W_C;
+  try {
+    T_W_C = tf2::transformToEigen(tf_buffer_.lookupTransform(
+        config_.world_frame, silhouette.header.frame_id, silhouette.header.stamp));
+  } catch (const tf2::TransformException& e) {
+    ROS_ERROR_THROTTLE(kThrottle_s, "hull: no pose for '%s': %s",
+                       silhouette.header.frame_id.c_str(), e.what());
+    return false;
+  }
+  std::string why_not;
+  if (!ros_conversions::cameraFromInfo(info, T_W_C, cv::Size(silhouette.width, silhouette.height),
+                                       camera, &why_not)) {
+    ROS_ERROR_THROTTLE(kThrottle_s, "hull: view '%s' ignored: %s",
+                       silhouette.header.frame_id.c_str(), why_not.c_str());
+    return false;
+  }
+  return true;
+}
+
+void HullNode::onView(const sensor_msgs::ImageConstPtr& silhouette,
+                      const sensor_msgs::CameraInfoConstPtr& info) {
+  std::string why_not;
+  const cv::Mat mask = ros_conversions::maskFromImage(*silhouette, &why_not);
+  if (mask.empty()) {
+    ROS_ERROR_THROTTLE(kThrottle_s, "hull: view '%s' ignored: %s",
+                       silhouette->header.frame_id.c_str(), why_not.c_str());
+    return;
+  }
+  PinholeCamera camera;
+  if (!cameraOf(*silhouette, *info, &camera)) return;
+  carve(silhouette->header.frame_id, camera, mask);
+  if (stream_.hasHull()) publish(silhouette->header.stamp);
+}
+
+void HullNode::carve(const std::string& name, const PinholeCamera& camera, const cv::Mat& mask) {
+  try {
+    const HullStream::Outcome outcome = stream_.add(name, camera, mask);
+    if (outcome == HullStream::Outcome::kWaiting) {
+      ROS_INFO_THROTTLE(kThrottle_s, "hull: %zu view(s) waiting for a bounding box: %s",
+                        stream_.waitingViews(), stream_.whyNoBox().c_str());
+    }
+    if (outcome == HullStream::Outcome::kSkipped) ROS_INFO("hull: view '%s' skipped", name.c_str());
+  } catch (const std::exception& e) {
+    ROS_ERROR_THROTTLE(kThrottle_s, "hull: view '%s' ignored: %s", name.c_str(), e.what());
+  }
+}
+
+void HullNode::publish(const ros::Time& stamp) {
+  std_msgs::Header header;
+  header.stamp = stamp;
+  header.frame_id = config_.world_frame;
+  octree_ = toOctomap(stream_.hull());
+  octomap_pub_.publish(ros_conversions::octomapMessage(*octree_, header));
+  cloud_pub_.publish(ros_conversions::occupiedCellsCloud(*octree_, header));
+  if (markers_pub_.getNumSubscribers() > 0) {
+    markers_pub_.publish(ros_conversions::occupiedCellsMarkers(*octree_, header));
+  }
+  if (mesh_pub_.getNumSubscribers() > 0) {
+    mesh_pub_.publish(ros_conversions::meshMarker(stream_.hull().mesh(), header));
+  }
+}
+
+bool HullNode::reset(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
+  stream_.reset();
+  octree_.reset();
+  std_msgs::Header header;
+  header.stamp = ros::Time::now();
+  header.frame_id = config_.world_frame;
+  const octomap::OcTree empty(0.1);
+  octomap_pub_.publish(ros_conversions::octomapMessage(empty, header));
+  cloud_pub_.publish(ros_conversions::occupiedCellsCloud(empty, header));
+  ROS_INFO("hull: reset");
+  return true;
+}
+
+bool HullNode::save(sift_hull::Save::Request& request, sift_hull::Save::Response& response) {
+  if (!stream_.hasHull() || !octree_) {
+    response.success = false;
+    response.message = "no hull yet";
+    return true;
+  }
+  try {
+    writeOctomap(*octree_, request.path + ".bt");
+    writePly(request.path + ".ply", stream_.hull().mesh());
+    response.success = true;
+    response.message = "wrote " + request.path + ".bt and " + request.path + ".ply";
+  } catch (const std::exception& e) {
+    response.success = false;
+    response.message = e.what();
+  }
+  return true;
+}
+
+}  // namespace sift_hull
