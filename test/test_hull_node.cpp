@@ -1,0 +1,207 @@
+// The hull node wired up: synthetic silhouettes, camera_info and tf in; octomap and cloud out;
+// ~reset; bad input answered with an error while later good input still counts. Every wait has a
+// deadline.
+
+#include <geometry_msgs/TransformStamped.h>
+#include <gtest/gtest.h>
+#include <octomap/OcTree.h>
+#include <ros/ros.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <std_srvs/Empty.h>
+#include <tf2_eigen/tf2_eigen.h>
+#include <tf2_ros/static_transform_broadcaster.h>
+
+#include <cmath>
+#include <functional>
+#include <sstream>
+
+#include "sift_hull/Octomap.h"
+#include "sift_hull/hull_pipeline.h"
+#include "sift_hull/hull_octomap.h"
+#include "sift_hull/scene.h"
+
+namespace sift_hull {
+namespace {
+
+constexpr double kDeadline_s = 30.0;
+constexpr int kViews = 8;
+
+bool waitFor(const std::function<bool()>& done, double seconds = kDeadline_s) {
+  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(seconds);
+  while (ros::ok() && ros::WallTime::now() < deadline) {
+    ros::spinOnce();
+    if (done()) return true;
+    ros::WallDuration(0.01).sleep();
+  }
+  return done();
+}
+
+std::vector<RenderedView> sphereViews() {
+  SceneConfig config;
+  config.shape = "sphere";
+  config.views = kViews;
+  config.layout = "sphere";
+  config.width_px = 320;
+  config.height_px = 240;
+  return renderScene(config);
+}
+
+std::string frameOf(int view) { return "camera_" + std::to_string(view); }
+
+geometry_msgs::TransformStamped poseOf(const PinholeCamera& camera, int view) {
+  Eigen::Isometry3d T_W_C = Eigen::Isometry3d::Identity();
+  T_W_C.linear() = camera.R().transpose();
+  T_W_C.translation() = camera.centre();
+  geometry_msgs::TransformStamped pose = tf2::eigenToTransform(T_W_C);
+  pose.header.frame_id = "world";
+  pose.child_frame_id = frameOf(view);
+  return pose;
+}
+
+sensor_msgs::Image imageOf(const cv::Mat& mask, const std_msgs::Header& header) {
+  sensor_msgs::Image image;
+  image.header = header;
+  image.width = mask.cols;
+  image.height = mask.rows;
+  image.encoding = "mono8";
+  image.step = mask.cols;
+  image.data.assign(mask.datastart, mask.dataend);
+  return image;
+}
+
+sensor_msgs::CameraInfo infoOf(const PinholeCamera& camera, cv::Size size,
+                               const std_msgs::Header& header) {
+  sensor_msgs::CameraInfo info;
+  info.header = header;
+  info.width = size.width;
+  info.height = size.height;
+  for (int i = 0; i < 9; ++i) info.K[i] = camera.K()(i / 3, i % 3);
+  return info;
+}
+
+double occupiedVolume(const sift_hull::Octomap& message) {
+  if (message.data.empty()) return 0.0;  // an empty tree
+  octomap::OcTree tree(message.resolution);
+  std::stringstream data(std::string(message.data.begin(), message.data.end()));
+  tree.readBinaryData(data);
+  double volume = 0.0;
+  for (auto leaf = tree.begin_leafs(); leaf != tree.end_leafs(); ++leaf) {
+    if (tree.isNodeOccupied(*leaf)) volume += std::pow(leaf.getSize(), 3);
+  }
+  return volume;
+}
+
+class HullNodeTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    views_ = sphereViews();
+    std::vector<geometry_msgs::TransformStamped> poses;
+    for (int v = 0; v < kViews; ++v) poses.push_back(poseOf(views_[v].view.camera, v));
+    tf_.sendTransform(poses);
+    silhouette_pub_ = nh_.advertise<sensor_msgs::Image>("silhouette", 20);
+    info_pub_ = nh_.advertise<sensor_msgs::CameraInfo>("camera_info", 20);
+    octomap_sub_ = nh_.subscribe("octomap_binary", 20, &HullNodeTest::onOctomap, this);
+    cloud_sub_ = nh_.subscribe("occupied_cells", 20, &HullNodeTest::onCloud, this);
+    ASSERT_TRUE(waitFor([&] {
+      return silhouette_pub_.getNumSubscribers() > 0 && info_pub_.getNumSubscribers() > 0;
+    })) << "the hull node did not subscribe";
+  }
+
+  /// Publishes view `v` with a fresh stamp; `change` may spoil the messages first.
+  ros::Time publishView(int v, const std::function<void(sensor_msgs::Image*,
+                                                        sensor_msgs::CameraInfo*)>& change = {}) {
+    std_msgs::Header header;
+    header.stamp = ros::Time::now();
+    header.frame_id = frameOf(v);
+    sensor_msgs::Image image = imageOf(views_[v].mask, header);
+    sensor_msgs::CameraInfo info = infoOf(views_[v].view.camera, views_[v].mask.size(), header);
+    if (change) change(&image, &info);
+    info_pub_.publish(info);
+    silhouette_pub_.publish(image);
+    ros::WallDuration(0.05).sleep();
+    return header.stamp;
+  }
+
+  bool octomapStampedAtLeast(const ros::Time& stamp) {
+    return waitFor([&] { return last_octomap_ && last_octomap_->header.stamp >= stamp; });
+  }
+
+  void onOctomap(const sift_hull::OctomapConstPtr& message) { last_octomap_ = message; }
+  void onCloud(const sensor_msgs::PointCloud2ConstPtr& message) { last_cloud_ = message; }
+
+  ros::NodeHandle nh_;
+  tf2_ros::StaticTransformBroadcaster tf_;
+  ros::Publisher silhouette_pub_, info_pub_;
+  ros::Subscriber octomap_sub_, cloud_sub_;
+  std::vector<RenderedView> views_;
+  sift_hull::OctomapConstPtr last_octomap_;
+  sensor_msgs::PointCloud2ConstPtr last_cloud_;
+};
+
+TEST_F(HullNodeTest, CarvesTheSphereResetsAndSurvivesBadInput) {
+  ros::Time last;
+  for (int v = 0; v < kViews; ++v) last = publishView(v);
+  ASSERT_TRUE(octomapStampedAtLeast(last)) << "no octomap for the last view";
+
+  // The node's hull equals the offline one of the same views in the box of the first two (the
+  // first views whose LP bounds a box), and is near the sphere.
+  HullInput input;
+  for (const RenderedView& view : views_) {
+    input.names.push_back(view.view.name);
+    input.cameras.push_back(view.view.camera);
+    input.masks.push_back(view.mask);
+  }
+  HullConfig config;
+  config.max_depth = 6;
+  const std::vector<HullView> first_two =
+      makeHullViews({input.names[0], input.names[1]}, {input.cameras[0], input.cameras[1]},
+                    {input.masks[0], input.masks[1]}, config);
+  const HullResult offline = buildHull(input, config, boundingBoxOf(first_two));
+  double offline_m3 = 0.0;
+  const std::unique_ptr<octomap::OcTree> tree = toOctomap(offline.hull);
+  for (auto leaf = tree->begin_leafs(); leaf != tree->end_leafs(); ++leaf) {
+    offline_m3 += std::pow(leaf.getSize(), 3);
+  }
+  EXPECT_EQ(last_octomap_->header.frame_id, "world");
+  EXPECT_NEAR(occupiedVolume(*last_octomap_), offline_m3, 1e-6 * offline_m3);
+  const double sphere_m3 = 4.0 / 3.0 * M_PI * std::pow(0.8, 3);
+  EXPECT_NEAR(occupiedVolume(*last_octomap_), sphere_m3, 0.3 * sphere_m3);
+  ASSERT_TRUE(waitFor([&] { return last_cloud_ && last_cloud_->header.stamp >= last; }));
+  EXPECT_GT(last_cloud_->width * last_cloud_->height, 100u);
+
+  std_srvs::Empty reset;
+  ASSERT_TRUE(ros::service::waitForService("/hull/reset", ros::Duration(kDeadline_s)));
+  ASSERT_TRUE(ros::service::call("/hull/reset", reset));
+  ASSERT_TRUE(waitFor([&] { return occupiedVolume(*last_octomap_) == 0.0; }));
+
+  // Bad input: each is refused with an error, and the node carries on.
+  publishView(0, [](sensor_msgs::Image* image, sensor_msgs::CameraInfo*) {
+    image->encoding = "rgb8";
+  });
+  publishView(1, [](sensor_msgs::Image*, sensor_msgs::CameraInfo* info) { info->width = 640; });
+  publishView(2, [](sensor_msgs::Image*, sensor_msgs::CameraInfo* info) { info->K.fill(0.0); });
+  publishView(3, [](sensor_msgs::Image*, sensor_msgs::CameraInfo* info) {
+    info->K[0] = std::nan("");
+  });
+  publishView(4, [](sensor_msgs::Image* image, sensor_msgs::CameraInfo*) {
+    image->data.clear();
+  });
+  publishView(5, [](sensor_msgs::Image* image, sensor_msgs::CameraInfo* info) {
+    image->header.frame_id = info->header.frame_id = "camera_without_pose";
+  });
+  for (int v = 0; v < kViews; ++v) last = publishView(v);
+  ASSERT_TRUE(octomapStampedAtLeast(last)) << "good views after bad ones were not carved";
+  EXPECT_NEAR(occupiedVolume(*last_octomap_), offline_m3, 1e-6 * offline_m3);
+}
+
+}  // namespace
+}  // namespace sift_hull
+
+int main(int argc, char** argv) {
+  ::testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_hull_node");
+  ros::NodeHandle nh;  // keeps the node alive through the tests
+  return RUN_ALL_TESTS();
+}
