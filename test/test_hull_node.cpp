@@ -18,8 +18,8 @@
 #include <sstream>
 
 #include "sift_hull/Octomap.h"
-#include "sift_hull/hull_pipeline.h"
 #include "sift_hull/hull_octomap.h"
+#include "sift_hull/hull_pipeline.h"
 #include "sift_hull/scene.h"
 
 namespace sift_hull {
@@ -110,8 +110,9 @@ class HullNodeTest : public ::testing::Test {
   }
 
   /// Publishes view `v` with a fresh stamp; `change` may spoil the messages first.
-  ros::Time publishView(int v, const std::function<void(sensor_msgs::Image*,
-                                                        sensor_msgs::CameraInfo*)>& change = {}) {
+  ros::Time publishView(
+      int v,
+      const std::function<void(sensor_msgs::Image*, sensor_msgs::CameraInfo*)>& change = {}) {
     std_msgs::Header header;
     header.stamp = ros::Time::now();
     header.frame_id = frameOf(v);
@@ -177,17 +178,13 @@ TEST_F(HullNodeTest, CarvesTheSphereResetsAndSurvivesBadInput) {
   ASSERT_TRUE(waitFor([&] { return occupiedVolume(*last_octomap_) == 0.0; }));
 
   // Bad input: each is refused with an error, and the node carries on.
-  publishView(0, [](sensor_msgs::Image* image, sensor_msgs::CameraInfo*) {
-    image->encoding = "rgb8";
-  });
+  publishView(
+      0, [](sensor_msgs::Image* image, sensor_msgs::CameraInfo*) { image->encoding = "rgb8"; });
   publishView(1, [](sensor_msgs::Image*, sensor_msgs::CameraInfo* info) { info->width = 640; });
   publishView(2, [](sensor_msgs::Image*, sensor_msgs::CameraInfo* info) { info->K.fill(0.0); });
-  publishView(3, [](sensor_msgs::Image*, sensor_msgs::CameraInfo* info) {
-    info->K[0] = std::nan("");
-  });
-  publishView(4, [](sensor_msgs::Image* image, sensor_msgs::CameraInfo*) {
-    image->data.clear();
-  });
+  publishView(
+      3, [](sensor_msgs::Image*, sensor_msgs::CameraInfo* info) { info->K[0] = std::nan(""); });
+  publishView(4, [](sensor_msgs::Image* image, sensor_msgs::CameraInfo*) { image->data.clear(); });
   publishView(5, [](sensor_msgs::Image* image, sensor_msgs::CameraInfo* info) {
     image->header.frame_id = info->header.frame_id = "camera_without_pose";
   });

@@ -3,7 +3,7 @@
 
 #include "args.h"
 #include "commands.h"
-#include "match_drawing.h"
+#include "sift_hull/match_drawing.h"
 #include "match_eval.h"
 #include "match_options.h"
 #include "sift_hull/camera.h"

@@ -34,5 +34,68 @@ HullStreamConfig readHullStreamConfig(const ros::NodeHandle& private_nh) {
   return config;
 }
 
+SiftConfig readSiftConfig(const ros::NodeHandle& private_nh) {
+  SiftConfig config;
+  private_nh.param("max_features", config.max_features, config.max_features);
+  private_nh.param("octave_layers", config.octave_layers, config.octave_layers);
+  private_nh.param("contrast_threshold", config.contrast_threshold, config.contrast_threshold);
+  private_nh.param("edge_threshold", config.edge_threshold, config.edge_threshold);
+  private_nh.param("sigma_px", config.sigma_px, config.sigma_px);
+  validate(config);
+  return config;
+}
+
+MatchConfig readMatchConfig(const ros::NodeHandle& private_nh) {
+  MatchConfig config;
+  private_nh.param("ratio", config.ratio, config.ratio);
+  double max_distance = 0.0;
+  private_nh.param("max_descriptor_distance", max_distance, max_distance);
+  if (max_distance > 0.0) config.max_descriptor_distance = max_distance;
+  private_nh.param("cross_check", config.cross_check, config.cross_check);
+  private_nh.param("matcher", config.backend, config.backend);
+  validate(config);
+  return config;
+}
+
+namespace {
+
+void readRobustFit(const ros::NodeHandle& private_nh, const std::string& prefix,
+                   RobustFitConfig* config) {
+  private_nh.param(prefix + "_max_epipolar_px", config->max_epipolar_px, config->max_epipolar_px);
+  private_nh.param("robust_confidence", config->confidence, config->confidence);
+  private_nh.param("robust_max_iterations", config->max_iterations, config->max_iterations);
+}
+
+}  // namespace
+
+FilterConfigs readFilterConfigs(const ros::NodeHandle& private_nh) {
+  FilterConfigs configs;
+  GscConfig& gsc = configs.gsc;
+  private_nh.param("gsc_max_histogram_distance", gsc.max_histogram_distance,
+                   gsc.max_histogram_distance);
+  private_nh.param("gsc_threads", gsc.threads, gsc.threads);
+  readRobustFit(private_nh, "ransac", &configs.ransac);
+  readRobustFit(private_nh, "magsac", &configs.magsac);
+  GmsConfig& gms = configs.gms;
+  private_nh.param("gms_grid_cells", gms.grid_cells, gms.grid_cells);
+  private_nh.param("gms_threshold_factor", gms.threshold_factor, gms.threshold_factor);
+  private_nh.param("gms_with_rotation", gms.with_rotation, gms.with_rotation);
+  private_nh.param("gms_with_scale", gms.with_scale, gms.with_scale);
+  validate(configs);
+  return configs;
+}
+
+MatcherSettings readMatcherSettings(const ros::NodeHandle& private_nh) {
+  MatcherSettings settings;
+  MatcherNodeConfig& node = settings.node;
+  private_nh.param("filters", node.filters, node.filters);
+  private_nh.param("queue_size", node.queue_size, node.queue_size);
+  private_nh.param("approximate_sync", node.approximate_sync, node.approximate_sync);
+  settings.sift = readSiftConfig(private_nh);
+  settings.matching = readMatchConfig(private_nh);
+  settings.filters = readFilterConfigs(private_nh);
+  return settings;
+}
+
 }  // namespace ros_params
 }  // namespace sift_hull

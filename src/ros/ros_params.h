@@ -4,6 +4,7 @@
 
 #include <ros/node_handle.h>
 
+#include "matcher_node.h"
 #include "sift_hull/hull_stream.h"
 
 namespace sift_hull {
@@ -16,6 +17,20 @@ HullConfig readHullConfig(const ros::NodeHandle& private_nh);
 /// or absent: automatic) and ~skip_views (frame ids of silhouettes to leave out). Throws
 /// std::invalid_argument for a box that is not six numbers with max > min.
 HullStreamConfig readHullStreamConfig(const ros::NodeHandle& private_nh);
+
+/// ~max_features, ~octave_layers, ~contrast_threshold, ~edge_threshold, ~sigma_px.
+SiftConfig readSiftConfig(const ros::NodeHandle& private_nh);
+
+/// ~ratio, ~max_descriptor_distance (<= 0: none), ~cross_check, ~matcher.
+MatchConfig readMatchConfig(const ros::NodeHandle& private_nh);
+
+/// ~gsc_max_histogram_distance, ~gsc_threads, ~ransac_max_epipolar_px, ~magsac_max_epipolar_px,
+/// ~robust_confidence, ~robust_max_iterations, ~gms_grid_cells, ~gms_threshold_factor,
+/// ~gms_with_rotation, ~gms_with_scale.
+FilterConfigs readFilterConfigs(const ros::NodeHandle& private_nh);
+
+/// The readers above and ~filters, ~queue_size, ~approximate_sync.
+MatcherSettings readMatcherSettings(const ros::NodeHandle& private_nh);
 
 }  // namespace ros_params
 }  // namespace sift_hull

@@ -1,4 +1,4 @@
-#include "match_drawing.h"
+#include "sift_hull/match_drawing.h"
 
 #include <algorithm>
 #include <cstdio>
@@ -6,7 +6,6 @@
 #include <string>
 
 namespace sift_hull {
-namespace cli {
 namespace {
 
 const cv::Scalar kGreen(0, 200, 0), kRed(0, 0, 255), kWhite(255, 255, 255), kGrey(90, 90, 90);
@@ -79,5 +78,4 @@ cv::Mat drawGscHistograms(const GscHistograms& kept, const GscHistograms& remove
   return figure;
 }
 
-}  // namespace cli
 }  // namespace sift_hull

@@ -5,7 +5,6 @@
 #include "sift_hull/filters.h"
 
 namespace sift_hull {
-namespace cli {
 
 /// Both images side by side (BGR), each match a line: kept green, removed red.
 cv::Mat drawMatchDecisions(const cv::Mat& left_image, const cv::Mat& right_image,
@@ -15,5 +14,4 @@ cv::Mat drawMatchDecisions(const cv::Mat& left_image, const cv::Mat& right_image
 /// each, with their distances.
 cv::Mat drawGscHistograms(const GscHistograms& kept, const GscHistograms& removed);
 
-}  // namespace cli
 }  // namespace sift_hull

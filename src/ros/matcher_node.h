@@ -1,0 +1,75 @@
+#pragma once
+
+#include <image_transport/image_transport.h>
+#include <image_transport/subscriber_filter.h>
+#include <message_filters/sync_policies/approximate_time.h>
+#include <message_filters/sync_policies/exact_time.h>
+#include <message_filters/synchronizer.h>
+#include <ros/ros.h>
+#include <sensor_msgs/Image.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "sift_hull/Correspondences.h"
+#include "sift_hull/features.h"
+#include "sift_hull/filters.h"
+#include "sift_hull/matching.h"
+
+namespace sift_hull {
+
+/// Node settings besides the matching's own (SiftConfig, MatchConfig, FilterConfigs).
+struct MatcherNodeConfig {
+  /// Filters to run, by makeFilter name ("gsc", "magsac", "gsc+magsac", ...). The epipolar
+  /// filter needs calibration, which this node does not take yet.
+  std::vector<std::string> filters = {"gsc"};
+  int queue_size = 10;            ///< image pairs waiting for their partner
+  bool approximate_sync = false;  ///< pair images by nearest stamps instead of equal ones
+};
+
+/// Everything the matcher node is configured with.
+struct MatcherSettings {
+  MatcherNodeConfig node;
+  SiftConfig sift;
+  MatchConfig matching;
+  FilterConfigs filters;
+};
+
+/// The matcher node: a left and a right image, paired by stamp, give SIFT matches and the
+/// verdicts of each filter on them (`correspondences`), and, when someone subscribes, a drawing of
+/// the first filter's verdicts (`matches_image`).
+class MatcherNode {
+ public:
+  /// Reads the private parameters (ros_params.h) and subscribes.
+  MatcherNode(ros::NodeHandle nh, ros::NodeHandle private_nh);
+  /// With config structs, no parameter server needed. Throws std::invalid_argument for a filter
+  /// name makeFilter does not know, or one this node cannot run.
+  MatcherNode(ros::NodeHandle nh, ros::NodeHandle private_nh, MatcherSettings settings);
+
+ private:
+  using Image = sensor_msgs::Image;
+  using ExactSync =
+      message_filters::Synchronizer<message_filters::sync_policies::ExactTime<Image, Image>>;
+  using ApproximateSync =
+      message_filters::Synchronizer<message_filters::sync_policies::ApproximateTime<Image, Image>>;
+
+  void onPair(const sensor_msgs::ImageConstPtr& left, const sensor_msgs::ImageConstPtr& right);
+  sift_hull::Correspondences message(const sensor_msgs::Image& left,
+                                     const sensor_msgs::Image& right,
+                                     const PutativeMatches& matches,
+                                     const std::vector<FilterResult>& results) const;
+
+  ros::NodeHandle nh_, private_nh_;
+  MatcherSettings settings_;
+  std::vector<std::unique_ptr<MatchFilter>> filters_;
+  std::string settings_json_;
+  image_transport::ImageTransport transport_;
+  image_transport::SubscriberFilter left_sub_, right_sub_;
+  std::unique_ptr<ExactSync> exact_sync_;
+  std::unique_ptr<ApproximateSync> approximate_sync_;
+  ros::Publisher correspondences_pub_;
+  image_transport::Publisher matches_image_pub_;
+};
+
+}  // namespace sift_hull

@@ -1,0 +1,140 @@
+// The matcher node wired up: a synthetic stereo pair in, correspondences out with the input stamps
+// and a precision against the scene's ground truth; bad pairs answered with an error while later
+// good pairs still count. Every wait has a deadline.
+
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+#include <sensor_msgs/Image.h>
+
+#include <functional>
+
+#include "sift_hull/Correspondences.h"
+#include "sift_hull/evaluation.h"
+#include "sift_hull/scene.h"
+
+namespace sift_hull {
+namespace {
+
+constexpr double kDeadline_s = 30.0;
+
+bool waitFor(const std::function<bool()>& done, double seconds = kDeadline_s) {
+  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(seconds);
+  while (ros::ok() && ros::WallTime::now() < deadline) {
+    ros::spinOnce();
+    if (done()) return true;
+    ros::WallDuration(0.01).sleep();
+  }
+  return done();
+}
+
+sensor_msgs::Image bgrImage(const cv::Mat& image, const ros::Time& stamp,
+                            const std::string& frame) {
+  sensor_msgs::Image message;
+  message.header.stamp = stamp;
+  message.header.frame_id = frame;
+  message.width = image.cols;
+  message.height = image.rows;
+  message.encoding = "bgr8";
+  message.step = image.cols * 3;
+  message.data.assign(image.datastart, image.dataend);
+  return message;
+}
+
+PutativeMatches putativesOf(const sift_hull::Correspondences& message, cv::Size size) {
+  PutativeMatches matches;
+  matches.left_image_size = matches.right_image_size = size;
+  for (const sift_hull::Correspondence& c : message.matches) {
+    const int index = static_cast<int>(matches.matches.size());
+    matches.left_keypoints.emplace_back(c.left.x, c.left.y, c.left.size, c.left.angle);
+    matches.right_keypoints.emplace_back(c.right.x, c.right.y, c.right.size, c.right.angle);
+    matches.matches.emplace_back(index, index, c.descriptor_distance);
+  }
+  return matches;
+}
+
+class MatcherNodeTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    SceneConfig config;
+    config.width_px = 320;
+    config.height_px = 240;
+    left_ = renderSceneView(config, 0);
+    right_ = renderSceneView(config, 1);
+    left_pub_ = nh_.advertise<sensor_msgs::Image>("left/image", 5);
+    right_pub_ = nh_.advertise<sensor_msgs::Image>("right/image", 5);
+    sub_ = nh_.subscribe("correspondences", 5, &MatcherNodeTest::onCorrespondences, this);
+    ASSERT_TRUE(waitFor([&] {
+      return left_pub_.getNumSubscribers() > 0 && right_pub_.getNumSubscribers() > 0 &&
+             sub_.getNumPublishers() > 0;
+    })) << "the matcher node did not connect";
+  }
+
+  ros::Time publishPair(const cv::Mat& left, const cv::Mat& right) {
+    const ros::Time stamp = ros::Time::now();
+    if (!left.empty()) left_pub_.publish(bgrImage(left, stamp, "left"));
+    if (!right.empty()) right_pub_.publish(bgrImage(right, stamp, "right"));
+    return stamp;
+  }
+
+  bool answeredAtLeast(const ros::Time& stamp) {
+    return waitFor([&] { return last_ && last_->header.stamp >= stamp; });
+  }
+
+  void onCorrespondences(const sift_hull::CorrespondencesConstPtr& message) { last_ = message; }
+
+  ros::NodeHandle nh_;
+  ros::Publisher left_pub_, right_pub_;
+  ros::Subscriber sub_;
+  RenderedView left_, right_;
+  sift_hull::CorrespondencesConstPtr last_;
+};
+
+TEST_F(MatcherNodeTest, MatchesAPairWithTheInputStampsAndGoodPrecision) {
+  const ros::Time stamp = publishPair(left_.image, right_.image);
+  ASSERT_TRUE(answeredAtLeast(stamp)) << "no correspondences for the pair";
+  EXPECT_EQ(last_->header.stamp, stamp);
+  EXPECT_EQ(last_->header.frame_id, "left");
+  EXPECT_EQ(last_->right_header.frame_id, "right");
+  ASSERT_EQ(last_->filters, (std::vector<std::string>{"gsc", "magsac"}));
+  ASSERT_GE(last_->matches.size(), 50u);
+
+  const PutativeMatches putatives = putativesOf(*last_, left_.image.size());
+  const std::vector<MatchTruth> truth = judgeBySceneDepth(
+      putatives, {left_.view.camera, left_.depth}, {right_.view.camera, right_.depth});
+  size_t kept = 0, kept_correct = 0;
+  for (size_t m = 0; m < truth.size(); ++m) {
+    if (!(last_->matches[m].kept_by & 1u) || truth[m] == MatchTruth::kUnknown) continue;
+    ++kept;
+    kept_correct += truth[m] == MatchTruth::kCorrect;
+  }
+  ASSERT_GT(kept, 20u);
+  EXPECT_GE(static_cast<double>(kept_correct) / kept, 0.9);  // gsc's precision on this pair
+}
+
+TEST_F(MatcherNodeTest, RefusesBadPairsAndCarriesOn) {
+  const cv::Mat black = cv::Mat::zeros(left_.image.size(), CV_8UC3);
+  publishPair(black, black);            // fewer than two keypoints
+  publishPair(left_.image, cv::Mat());  // a left image without its right partner
+  sensor_msgs::Image depth = bgrImage(right_.image, ros::Time::now(), "right");
+  depth.encoding = "16UC1";  // not an 8-bit image
+  depth.step = right_.image.cols * 2;
+  depth.data.resize(depth.step * depth.height);
+  left_pub_.publish(bgrImage(left_.image, depth.header.stamp, "left"));
+  right_pub_.publish(depth);
+  ros::WallDuration(0.5).sleep();
+  ros::spinOnce();
+  EXPECT_FALSE(last_) << "a bad pair was answered";
+  const ros::Time stamp = publishPair(left_.image, right_.image);
+  ASSERT_TRUE(answeredAtLeast(stamp)) << "a good pair after bad ones was not matched";
+  EXPECT_EQ(last_->header.stamp, stamp);
+}
+
+}  // namespace
+}  // namespace sift_hull
+
+int main(int argc, char** argv) {
+  ::testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_matcher_node");
+  ros::NodeHandle nh;
+  return RUN_ALL_TESTS();
+}
