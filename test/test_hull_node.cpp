@@ -17,6 +17,7 @@
 #include <functional>
 #include <sstream>
 
+#include "../src/ros/conversions.h"
 #include "sift_hull/Octomap.h"
 #include "sift_hull/hull_octomap.h"
 #include "sift_hull/hull_pipeline.h"
@@ -50,37 +51,6 @@ std::vector<RenderedView> sphereViews() {
 
 std::string frameOf(int view) { return "camera_" + std::to_string(view); }
 
-geometry_msgs::TransformStamped poseOf(const PinholeCamera& camera, int view) {
-  Eigen::Isometry3d T_W_C = Eigen::Isometry3d::Identity();
-  T_W_C.linear() = camera.R().transpose();
-  T_W_C.translation() = camera.centre();
-  geometry_msgs::TransformStamped pose = tf2::eigenToTransform(T_W_C);
-  pose.header.frame_id = "world";
-  pose.child_frame_id = frameOf(view);
-  return pose;
-}
-
-sensor_msgs::Image imageOf(const cv::Mat& mask, const std_msgs::Header& header) {
-  sensor_msgs::Image image;
-  image.header = header;
-  image.width = mask.cols;
-  image.height = mask.rows;
-  image.encoding = "mono8";
-  image.step = mask.cols;
-  image.data.assign(mask.datastart, mask.dataend);
-  return image;
-}
-
-sensor_msgs::CameraInfo infoOf(const PinholeCamera& camera, cv::Size size,
-                               const std_msgs::Header& header) {
-  sensor_msgs::CameraInfo info;
-  info.header = header;
-  info.width = size.width;
-  info.height = size.height;
-  for (int i = 0; i < 9; ++i) info.K[i] = camera.K()(i / 3, i % 3);
-  return info;
-}
-
 double occupiedVolume(const sift_hull::Octomap& message) {
   if (message.data.empty()) return 0.0;  // an empty tree
   octomap::OcTree tree(message.resolution);
@@ -98,7 +68,10 @@ class HullNodeTest : public ::testing::Test {
   void SetUp() override {
     views_ = sphereViews();
     std::vector<geometry_msgs::TransformStamped> poses;
-    for (int v = 0; v < kViews; ++v) poses.push_back(poseOf(views_[v].view.camera, v));
+    for (int v = 0; v < kViews; ++v) {
+      poses.push_back(
+          ros_conversions::cameraPoseMessage(views_[v].view.camera, "world", frameOf(v), {}));
+    }
     tf_.sendTransform(poses);
     silhouette_pub_ = nh_.advertise<sensor_msgs::Image>("silhouette", 20);
     info_pub_ = nh_.advertise<sensor_msgs::CameraInfo>("camera_info", 20);
@@ -116,8 +89,9 @@ class HullNodeTest : public ::testing::Test {
     std_msgs::Header header;
     header.stamp = ros::Time::now();
     header.frame_id = frameOf(v);
-    sensor_msgs::Image image = imageOf(views_[v].mask, header);
-    sensor_msgs::CameraInfo info = infoOf(views_[v].view.camera, views_[v].mask.size(), header);
+    sensor_msgs::Image image = ros_conversions::imageMessage(views_[v].mask, header);
+    sensor_msgs::CameraInfo info =
+        ros_conversions::cameraInfoMessage(views_[v].view.camera, views_[v].mask.size(), header);
     if (change) change(&image, &info);
     info_pub_.publish(info);
     silhouette_pub_.publish(image);

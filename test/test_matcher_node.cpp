@@ -8,6 +8,7 @@
 
 #include <functional>
 
+#include "../src/ros/conversions.h"
 #include "sift_hull/Correspondences.h"
 #include "sift_hull/evaluation.h"
 #include "sift_hull/scene.h"
@@ -29,15 +30,10 @@ bool waitFor(const std::function<bool()>& done, double seconds = kDeadline_s) {
 
 sensor_msgs::Image bgrImage(const cv::Mat& image, const ros::Time& stamp,
                             const std::string& frame) {
-  sensor_msgs::Image message;
-  message.header.stamp = stamp;
-  message.header.frame_id = frame;
-  message.width = image.cols;
-  message.height = image.rows;
-  message.encoding = "bgr8";
-  message.step = image.cols * 3;
-  message.data.assign(image.datastart, image.dataend);
-  return message;
+  std_msgs::Header header;
+  header.stamp = stamp;
+  header.frame_id = frame;
+  return ros_conversions::imageMessage(image, header);
 }
 
 PutativeMatches putativesOf(const sift_hull::Correspondences& message, cv::Size size) {

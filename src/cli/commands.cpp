@@ -40,6 +40,7 @@ const std::vector<Command>& commands() {
        runEvaluateFilters},
       {"hull", "visual hull of calibrated silhouettes: octree, OctoMap and mesh", runHull},
       {"bench-hull", "time the visual hull against dense carving on dino and temple", runBenchHull},
+      {"bag", "write calibrated views as a ROS bag that drives both nodes", runBag},
   };
   return all;
 }

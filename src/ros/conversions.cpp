@@ -4,6 +4,7 @@
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 #include <pcl_conversions/pcl_conversions.h>
+#include <tf2_eigen/tf2_eigen.h>
 
 #include <cmath>
 #include <map>
@@ -78,6 +79,54 @@ bool cameraFromInfo(const sensor_msgs::CameraInfo& info, const Eigen::Isometry3d
     return false;
   }
   return true;
+}
+
+sensor_msgs::Image imageMessage(const cv::Mat& image, const std_msgs::Header& header) {
+  if (image.type() != CV_8UC1 && image.type() != CV_8UC3) {
+    throw std::invalid_argument("imageMessage: expected an 8-bit grey or BGR image");
+  }
+  sensor_msgs::Image message;
+  message.header = header;
+  message.width = image.cols;
+  message.height = image.rows;
+  message.encoding = image.channels() == 1 ? "mono8" : "bgr8";
+  message.step = static_cast<uint32_t>(image.cols * image.elemSize());
+  message.data.resize(static_cast<size_t>(message.step) * image.rows);
+  for (int row = 0; row < image.rows; ++row) {
+    std::copy(image.ptr<uint8_t>(row), image.ptr<uint8_t>(row) + message.step,
+              message.data.begin() + static_cast<size_t>(row) * message.step);
+  }
+  return message;
+}
+
+sensor_msgs::CameraInfo cameraInfoMessage(const PinholeCamera& camera, cv::Size size,
+                                          const std_msgs::Header& header) {
+  sensor_msgs::CameraInfo info;
+  info.header = header;
+  info.width = size.width;
+  info.height = size.height;
+  info.distortion_model = "plumb_bob";
+  info.D.assign(5, 0.0);
+  for (int i = 0; i < 9; ++i) {
+    info.K[i] = camera.K()(i / 3, i % 3);
+    info.R[i] = i % 4 == 0 ? 1.0 : 0.0;
+    info.P[i / 3 * 4 + i % 3] = camera.K()(i / 3, i % 3);
+  }
+  return info;
+}
+
+geometry_msgs::TransformStamped cameraPoseMessage(const PinholeCamera& camera,
+                                                  const std::string& world_frame,
+                                                  const std::string& camera_frame,
+                                                  const ros::Time& stamp) {
+  Eigen::Isometry3d T_W_C = Eigen::Isometry3d::Identity();
+  T_W_C.linear() = camera.R().transpose();
+  T_W_C.translation() = camera.centre();
+  geometry_msgs::TransformStamped pose = tf2::eigenToTransform(T_W_C);
+  pose.header.stamp = stamp;
+  pose.header.frame_id = world_frame;
+  pose.child_frame_id = camera_frame;
+  return pose;
 }
 
 sift_hull::Octomap octomapMessage(const octomap::OcTree& tree, const std_msgs::Header& header) {

@@ -2,6 +2,7 @@
 
 // Every conversion between sift_hull's core types and ROS messages.
 
+#include <geometry_msgs/TransformStamped.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/PointCloud2.h>
@@ -34,6 +35,21 @@ cv::Mat maskFromImage(const sensor_msgs::Image& image, std::string* why_not);
 /// that disagrees with `image_size` (when non-zero).
 bool cameraFromInfo(const sensor_msgs::CameraInfo& info, const Eigen::Isometry3d& T_W_C,
                     cv::Size image_size, PinholeCamera* camera, std::string* why_not);
+
+/// An 8-bit image as a message: CV_8UC1 as mono8, CV_8UC3 as bgr8. Throws std::invalid_argument
+/// for another type.
+sensor_msgs::Image imageMessage(const cv::Mat& image, const std_msgs::Header& header);
+
+/// camera_info of a pinhole camera of the given image size: K, P = K [I | 0], R = I, no
+/// distortion (plumb_bob with zero coefficients).
+sensor_msgs::CameraInfo cameraInfoMessage(const PinholeCamera& camera, cv::Size size,
+                                          const std_msgs::Header& header);
+
+/// The camera's pose T_W_C: the transform from `world_frame` to `camera_frame` that tf needs.
+geometry_msgs::TransformStamped cameraPoseMessage(const PinholeCamera& camera,
+                                                  const std::string& world_frame,
+                                                  const std::string& camera_frame,
+                                                  const ros::Time& stamp);
 
 /// The tree as an Octomap message (binary stream, as octomap_msgs::binaryMapToMsg writes it).
 sift_hull::Octomap octomapMessage(const octomap::OcTree& tree, const std_msgs::Header& header);
