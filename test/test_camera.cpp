@@ -47,6 +47,25 @@ Eigen::Vector3d randomPoint(std::mt19937* rng) {
   return {coordinate(*rng), coordinate(*rng), coordinate(*rng)};
 }
 
+TEST(Camera, TriangulationRecoversPointsInFrontOfBothCameras) {
+  std::mt19937 rng(11);
+  for (int trial = 0; trial < 200; ++trial) {
+    const PinholeCamera a = randomCamera(&rng), b = randomCamera(&rng);
+    const Eigen::Vector3d X = randomPoint(&rng);
+    const std::optional<Eigen::Vector3d> found = triangulate(a, b, a.project(X), b.project(X));
+    ASSERT_TRUE(found.has_value());
+    EXPECT_LT((*found - X).norm(), 1e-6);
+  }
+  // A point behind one camera is refused.
+  const PinholeCamera a = randomCamera(&rng);
+  // Turned half round its y axis, ten units ahead of `a`: it looks back, past the point.
+  const Eigen::Matrix3d turned = Eigen::Vector3d(-1.0, 1.0, -1.0).asDiagonal() * a.R();
+  const PinholeCamera behind =
+      PinholeCamera::fromCentre(a.K(), turned, a.centre() + 10.0 * a.opticalAxis());
+  const Eigen::Vector3d X = a.centre() + 12.0 * a.opticalAxis();  // behind `behind`
+  EXPECT_FALSE(triangulate(a, behind, a.project(X), behind.project(X)).has_value());
+}
+
 TEST(Camera, ProjectBackProjectRoundTrip) {
   std::mt19937 rng(7);
   for (int trial = 0; trial < 200; ++trial) {

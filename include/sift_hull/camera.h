@@ -2,6 +2,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <optional>
 
 namespace sift_hull {
 
@@ -58,6 +59,11 @@ Eigen::Matrix3d skew(const Eigen::Vector3d& v);
 /// view b (pixels, homogeneous). The paper's eq. 10, F = A_r^-T [t]x R A_l^-1, with the relative
 /// pose R = R_b R_a^T and t = t_b - R t_a taking camera-a coordinates into camera b.
 Eigen::Matrix3d fundamentalMatrix(const PinholeCamera& a, const PinholeCamera& b);
+
+/// The world point seen at x_a in view a and at x_b in view b, by linear triangulation (DLT, the
+/// smallest singular vector); empty when it is at infinity or not in front of both cameras.
+std::optional<Eigen::Vector3d> triangulate(const PinholeCamera& a, const PinholeCamera& b,
+                                           const Eigen::Vector2d& x_a, const Eigen::Vector2d& x_b);
 
 /// Distances in pixels of each point of a match to the epipolar line of the other.
 struct EpipolarDistances {

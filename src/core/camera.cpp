@@ -2,6 +2,7 @@
 
 #include <Eigen/LU>
 #include <Eigen/QR>
+#include <Eigen/SVD>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -123,6 +124,22 @@ EpipolarDistances epipolarDistances(const Eigen::Matrix3d& F, const Eigen::Vecto
     return norm > 0.0 ? residual / norm : std::numeric_limits<double>::infinity();
   };
   return {distance(line_in_a), distance(line_in_b)};
+}
+
+std::optional<Eigen::Vector3d> triangulate(const PinholeCamera& a, const PinholeCamera& b,
+                                           const Eigen::Vector2d& x_a, const Eigen::Vector2d& x_b) {
+  const Matrix34d P_a = a.projectionMatrix(), P_b = b.projectionMatrix();
+  Eigen::Matrix4d A;
+  A.row(0) = x_a.x() * P_a.row(2) - P_a.row(0);
+  A.row(1) = x_a.y() * P_a.row(2) - P_a.row(1);
+  A.row(2) = x_b.x() * P_b.row(2) - P_b.row(0);
+  A.row(3) = x_b.y() * P_b.row(2) - P_b.row(1);
+  const Eigen::Vector4d X =
+      Eigen::JacobiSVD<Eigen::Matrix4d>(A, Eigen::ComputeFullV).matrixV().col(3);
+  if (std::abs(X.w()) < 1e-12) return std::nullopt;
+  const Eigen::Vector3d X_W = X.head<3>() / X.w();
+  if (!(a.depth(X_W) > 0.0 && b.depth(X_W) > 0.0)) return std::nullopt;
+  return X_W;
 }
 
 }  // namespace sift_hull
