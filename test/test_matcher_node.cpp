@@ -5,6 +5,9 @@
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <sensor_msgs/Image.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <sensor_msgs/point_cloud2_iterator.h>
+#include <tf2_ros/static_transform_broadcaster.h>
 
 #include <functional>
 
@@ -123,6 +126,72 @@ TEST_F(MatcherNodeTest, RefusesBadPairsAndCarriesOn) {
   const ros::Time stamp = publishPair(left_.image, right_.image);
   ASSERT_TRUE(answeredAtLeast(stamp)) << "a good pair after bad ones was not matched";
   EXPECT_EQ(last_->header.stamp, stamp);
+}
+
+/// The same pair with camera_info and the right camera's pose relative to the left in tf.
+class CalibratedMatcherTest : public MatcherNodeTest {
+ protected:
+  void SetUp() override {
+    MatcherNodeTest::SetUp();
+    left_info_pub_ = nh_.advertise<sensor_msgs::CameraInfo>("left/camera_info", 5);
+    right_info_pub_ = nh_.advertise<sensor_msgs::CameraInfo>("right/camera_info", 5);
+    points_sub_ = nh_.subscribe("points", 5, &CalibratedMatcherTest::onPoints, this);
+    // The left camera's frame is the "world" of the right camera's pose.
+    const PinholeCamera& left = left_.view.camera;
+    const PinholeCamera& right = right_.view.camera;
+    const PinholeCamera right_in_left(right.K(), right.R() * left.R().transpose(),
+                                      right.t() - right.R() * left.R().transpose() * left.t());
+    tf_.sendTransform(ros_conversions::cameraPoseMessage(right_in_left, "left", "right", {}));
+    ASSERT_TRUE(waitFor([&] {
+      return left_info_pub_.getNumSubscribers() > 0 && right_info_pub_.getNumSubscribers() > 0 &&
+             points_sub_.getNumPublishers() > 0;
+    }));
+  }
+
+  ros::Time publishCalibratedPair() {
+    const ros::Time stamp = ros::Time::now();
+    std_msgs::Header header;
+    header.stamp = stamp;
+    header.frame_id = "left";
+    left_info_pub_.publish(
+        ros_conversions::cameraInfoMessage(left_.view.camera, left_.image.size(), header));
+    header.frame_id = "right";
+    right_info_pub_.publish(
+        ros_conversions::cameraInfoMessage(right_.view.camera, right_.image.size(), header));
+    left_pub_.publish(bgrImage(left_.image, stamp, "left"));
+    right_pub_.publish(bgrImage(right_.image, stamp, "right"));
+    return stamp;
+  }
+
+  void onPoints(const sensor_msgs::PointCloud2ConstPtr& message) { points_ = message; }
+
+  tf2_ros::StaticTransformBroadcaster tf_;
+  ros::Publisher left_info_pub_, right_info_pub_;
+  ros::Subscriber points_sub_;
+  sensor_msgs::PointCloud2ConstPtr points_;
+};
+
+TEST_F(CalibratedMatcherTest, FiltersByEpipolarLinesAndTriangulatesOntoTheScene) {
+  const ros::Time stamp = publishCalibratedPair();
+  ASSERT_TRUE(answeredAtLeast(stamp)) << "no correspondences for the calibrated pair";
+  ASSERT_EQ(last_->filters, (std::vector<std::string>{"epipolar", "gsc"}));
+  ASSERT_TRUE(waitFor([&] { return points_ && points_->header.stamp == stamp; }));
+  EXPECT_EQ(points_->header.frame_id, "left");
+  // Each point, in the left camera's frame, lies where the left depth map says (within 2 %).
+  const PinholeCamera camera(left_.view.camera.K(), Eigen::Matrix3d::Identity(),
+                             Eigen::Vector3d::Zero());
+  size_t points = 0, on_surface = 0;
+  for (sensor_msgs::PointCloud2ConstIterator<float> p(*points_, "x"); p != p.end(); ++p) {
+    const Eigen::Vector3d X(p[0], p[1], p[2]);
+    const Eigen::Vector2d pixel = camera.project(X);
+    const int u = static_cast<int>(std::lround(pixel.x())),
+              v = static_cast<int>(std::lround(pixel.y()));
+    ++points;
+    if (u < 0 || v < 0 || u >= left_.depth.cols || v >= left_.depth.rows) continue;
+    on_surface += std::abs(left_.depth.at<float>(v, u) - X.z()) < 0.02 * X.z();
+  }
+  ASSERT_GE(points, 20u);
+  EXPECT_GE(static_cast<double>(on_surface) / points, 0.9);
 }
 
 }  // namespace

@@ -142,6 +142,18 @@ sift_hull::Octomap octomapMessage(const octomap::OcTree& tree, const std_msgs::H
   return message;
 }
 
+sensor_msgs::PointCloud2 pointCloudMessage(const std::vector<Eigen::Vector3d>& points,
+                                           const std_msgs::Header& header) {
+  pcl::PointCloud<pcl::PointXYZ> cloud;
+  for (const Eigen::Vector3d& point : points) {
+    cloud.push_back(pcl::PointXYZ(point.x(), point.y(), point.z()));
+  }
+  sensor_msgs::PointCloud2 message;
+  pcl::toROSMsg(cloud, message);
+  message.header = header;
+  return message;
+}
+
 sensor_msgs::PointCloud2 occupiedCellsCloud(const octomap::OcTree& tree,
                                             const std_msgs::Header& header) {
   pcl::PointCloud<pcl::PointXYZ> cloud;

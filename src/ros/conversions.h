@@ -54,6 +54,10 @@ geometry_msgs::TransformStamped cameraPoseMessage(const PinholeCamera& camera,
 /// The tree as an Octomap message (binary stream, as octomap_msgs::binaryMapToMsg writes it).
 sift_hull::Octomap octomapMessage(const octomap::OcTree& tree, const std_msgs::Header& header);
 
+/// Points (metres, in the header's frame) as an XYZ PointCloud2 (via pcl_conversions).
+sensor_msgs::PointCloud2 pointCloudMessage(const std::vector<Eigen::Vector3d>& points,
+                                           const std_msgs::Header& header);
+
 /// Occupied leaf centres of the tree, metres, as an XYZ PointCloud2 (via pcl_conversions).
 sensor_msgs::PointCloud2 occupiedCellsCloud(const octomap::OcTree& tree,
                                             const std_msgs::Header& header);

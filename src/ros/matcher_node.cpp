@@ -2,6 +2,7 @@
 
 #include <cv_bridge/cv_bridge.h>
 #include <sensor_msgs/image_encodings.h>
+#include <tf2_eigen/tf2_eigen.h>
 
 #include <cmath>
 #include <nlohmann/json.hpp>
@@ -18,10 +19,10 @@ constexpr double kThrottle_s = 5.0;
 std::vector<std::unique_ptr<MatchFilter>> makeFilters(const MatcherSettings& settings) {
   std::vector<std::unique_ptr<MatchFilter>> filters;
   for (const std::string& spec : settings.node.filters) {
-    if (spec.find("epipolar") != std::string::npos) {
+    if (spec.find("epipolar") != std::string::npos && !settings.node.calibrated) {
       throw std::invalid_argument("filter '" + spec +
-                                  "': the epipolar filter needs calibration, which matcher_node "
-                                  "does not take yet");
+                                  "': the epipolar filter needs ~calibrated: true (camera_info "
+                                  "of both images and tf between their frames)");
     }
     filters.push_back(makeFilter(spec, settings.filters));
   }
@@ -91,9 +92,25 @@ MatcherNode::MatcherNode(ros::NodeHandle nh, ros::NodeHandle private_nh, Matcher
       settings_json_(settingsJson(settings_)),
       transport_(nh_),
       left_sub_(transport_, "left/image", settings_.node.queue_size),
-      right_sub_(transport_, "right/image", settings_.node.queue_size) {
+      right_sub_(transport_, "right/image", settings_.node.queue_size),
+      tf_listener_(tf_buffer_) {
+  subscribe();
+  correspondences_pub_ =
+      nh_.advertise<sift_hull::Correspondences>("correspondences", settings_.node.queue_size);
+  if (settings_.node.calibrated) points_pub_ = nh_.advertise<sensor_msgs::PointCloud2>("points", 1);
+  matches_image_pub_ = transport_.advertise("matches_image", 1);
+}
+
+void MatcherNode::subscribe() {
   const int queue = settings_.node.queue_size;
-  if (settings_.node.approximate_sync) {
+  if (settings_.node.calibrated) {
+    left_info_sub_.subscribe(nh_, "left/camera_info", queue);
+    right_info_sub_.subscribe(nh_, "right/camera_info", queue);
+    calibrated_sync_ = std::make_unique<CalibratedSync>(
+        message_filters::sync_policies::ExactTime<Image, Image, Info, Info>(queue), left_sub_,
+        right_sub_, left_info_sub_, right_info_sub_);
+    calibrated_sync_->registerCallback(&MatcherNode::onCalibratedPair, this);
+  } else if (settings_.node.approximate_sync) {
     approximate_sync_ = std::make_unique<ApproximateSync>(
         message_filters::sync_policies::ApproximateTime<Image, Image>(queue), left_sub_,
         right_sub_);
@@ -103,12 +120,49 @@ MatcherNode::MatcherNode(ros::NodeHandle nh, ros::NodeHandle private_nh, Matcher
         message_filters::sync_policies::ExactTime<Image, Image>(queue), left_sub_, right_sub_);
     exact_sync_->registerCallback(&MatcherNode::onPair, this);
   }
-  correspondences_pub_ = nh_.advertise<sift_hull::Correspondences>("correspondences", queue);
-  matches_image_pub_ = transport_.advertise("matches_image", 1);
+}
+
+void MatcherNode::onCalibratedPair(const sensor_msgs::ImageConstPtr& left,
+                                   const sensor_msgs::ImageConstPtr& right,
+                                   const sensor_msgs::CameraInfoConstPtr& left_info,
+                                   const sensor_msgs::CameraInfoConstPtr& right_info) {
+  StereoCameras cameras;
+  if (!stereoCameras(*left, *right, *left_info, *right_info, &cameras)) return;
+  process(left, right, &cameras);
+}
+
+bool MatcherNode::stereoCameras(const Image& left, const Image& right, const Info& left_info,
+                                const Info& right_info, StereoCameras* cameras) {
+  Eigen::Isometry3d T_L_R;
+  try {
+    T_L_R = tf2::transformToEigen(tf_buffer_.lookupTransform(
+        left.header.frame_id, right.header.frame_id, left.header.stamp, ros::Duration(0.5)));
+  } catch (const tf2::TransformException& e) {
+    ROS_ERROR_THROTTLE(kThrottle_s, "matcher: no pose of '%s' relative to '%s': %s",
+                       right.header.frame_id.c_str(), left.header.frame_id.c_str(), e.what());
+    return false;
+  }
+  std::string why_not;
+  const bool ok =
+      ros_conversions::cameraFromInfo(left_info, Eigen::Isometry3d::Identity(),
+                                      cv::Size(left.width, left.height), &cameras->left,
+                                      &why_not) &&
+      ros_conversions::cameraFromInfo(right_info, T_L_R, cv::Size(right.width, right.height),
+                                      &cameras->right, &why_not);
+  if (!ok) {
+    ROS_ERROR_THROTTLE(kThrottle_s, "matcher: pair at %.3f ignored: %s", left.header.stamp.toSec(),
+                       why_not.c_str());
+  }
+  return ok;
 }
 
 void MatcherNode::onPair(const sensor_msgs::ImageConstPtr& left,
                          const sensor_msgs::ImageConstPtr& right) {
+  process(left, right, nullptr);
+}
+
+void MatcherNode::process(const sensor_msgs::ImageConstPtr& left,
+                          const sensor_msgs::ImageConstPtr& right, const StereoCameras* cameras) {
   std::string why_not;
   const cv::Mat left_image = imageOf(left, &why_not);
   const cv::Mat right_image = left_image.empty() ? cv::Mat() : imageOf(right, &why_not);
@@ -117,7 +171,7 @@ void MatcherNode::onPair(const sensor_msgs::ImageConstPtr& left,
                        why_not.c_str());
     return;
   }
-  const PutativeMatches matches =
+  PutativeMatches matches =
       matchImages(left_image, right_image, settings_.sift, settings_.matching);
   if (matches.left_keypoints.size() < 2 || matches.right_keypoints.size() < 2) {
     ROS_ERROR_THROTTLE(kThrottle_s, "matcher: pair at %.3f has %zu and %zu keypoints, too few",
@@ -125,13 +179,30 @@ void MatcherNode::onPair(const sensor_msgs::ImageConstPtr& left,
                        matches.right_keypoints.size());
     return;
   }
+  if (cameras != nullptr) matches.F_right_left = fundamentalMatrix(cameras->left, cameras->right);
   std::vector<FilterResult> results;
   for (const auto& filter : filters_) results.push_back(filter->apply(matches));
   correspondences_pub_.publish(message(*left, *right, matches, results));
+  if (cameras != nullptr) publishPoints(left->header, *cameras, matches, results.front());
   if (matches_image_pub_.getNumSubscribers() > 0) {
     const cv::Mat drawing = drawMatchDecisions(left_image, right_image, matches, results.front());
     matches_image_pub_.publish(cv_bridge::CvImage(left->header, "bgr8", drawing).toImageMsg());
   }
+}
+
+void MatcherNode::publishPoints(const std_msgs::Header& header, const StereoCameras& cameras,
+                                const PutativeMatches& matches, const FilterResult& kept) {
+  std::vector<Eigen::Vector3d> points_L;
+  for (size_t m = 0; m < matches.matches.size(); ++m) {
+    if (!kept.keep[m]) continue;
+    const cv::Point2f& left = matches.left(m).pt;
+    const cv::Point2f& right = matches.right(m).pt;
+    const std::optional<Eigen::Vector3d> point =
+        triangulate(cameras.left, cameras.right, Eigen::Vector2d(left.x, left.y),
+                    Eigen::Vector2d(right.x, right.y));
+    if (point) points_L.push_back(*point);
+  }
+  points_pub_.publish(ros_conversions::pointCloudMessage(points_L, header));
 }
 
 sift_hull::Correspondences MatcherNode::message(const sensor_msgs::Image& left,

@@ -2,17 +2,22 @@
 
 #include <image_transport/image_transport.h>
 #include <image_transport/subscriber_filter.h>
+#include <message_filters/subscriber.h>
 #include <message_filters/sync_policies/approximate_time.h>
 #include <message_filters/sync_policies/exact_time.h>
 #include <message_filters/synchronizer.h>
 #include <ros/ros.h>
+#include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_listener.h>
 
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "sift_hull/Correspondences.h"
+#include "sift_hull/camera.h"
 #include "sift_hull/features.h"
 #include "sift_hull/filters.h"
 #include "sift_hull/matching.h"
@@ -21,11 +26,15 @@ namespace sift_hull {
 
 /// Node settings besides the matching's own (SiftConfig, MatchConfig, FilterConfigs).
 struct MatcherNodeConfig {
-  /// Filters to run, by makeFilter name ("gsc", "magsac", "gsc+magsac", ...). The epipolar
-  /// filter needs calibration, which this node does not take yet.
+  /// Filters to run, by makeFilter name ("gsc", "magsac", "epipolar+gsc", ...). The epipolar
+  /// filter needs `calibrated`.
   std::vector<std::string> filters = {"gsc"};
   int queue_size = 10;            ///< image pairs waiting for their partner
   bool approximate_sync = false;  ///< pair images by nearest stamps instead of equal ones
+  /// Also take left/camera_info and right/camera_info (paired by equal stamps with the images)
+  /// and the right camera's pose relative to the left from tf: the epipolar filter's F, and the
+  /// `points` of the matches the first filter keeps.
+  bool calibrated = false;
 };
 
 /// Everything the matcher node is configured with.
@@ -53,8 +62,27 @@ class MatcherNode {
       message_filters::Synchronizer<message_filters::sync_policies::ExactTime<Image, Image>>;
   using ApproximateSync =
       message_filters::Synchronizer<message_filters::sync_policies::ApproximateTime<Image, Image>>;
+  using Info = sensor_msgs::CameraInfo;
+  using CalibratedSync = message_filters::Synchronizer<
+      message_filters::sync_policies::ExactTime<Image, Image, Info, Info>>;
 
+  /// The pair's cameras, the left one at the origin of its own frame.
+  struct StereoCameras {
+    PinholeCamera left, right;
+  };
+
+  void subscribe();
   void onPair(const sensor_msgs::ImageConstPtr& left, const sensor_msgs::ImageConstPtr& right);
+  void onCalibratedPair(const sensor_msgs::ImageConstPtr& left,
+                        const sensor_msgs::ImageConstPtr& right,
+                        const sensor_msgs::CameraInfoConstPtr& left_info,
+                        const sensor_msgs::CameraInfoConstPtr& right_info);
+  void process(const sensor_msgs::ImageConstPtr& left, const sensor_msgs::ImageConstPtr& right,
+               const StereoCameras* cameras);
+  bool stereoCameras(const Image& left, const Image& right, const Info& left_info,
+                     const Info& right_info, StereoCameras* cameras);
+  void publishPoints(const std_msgs::Header& header, const StereoCameras& cameras,
+                     const PutativeMatches& matches, const FilterResult& kept);
   sift_hull::Correspondences message(const sensor_msgs::Image& left,
                                      const sensor_msgs::Image& right,
                                      const PutativeMatches& matches,
@@ -68,7 +96,11 @@ class MatcherNode {
   image_transport::SubscriberFilter left_sub_, right_sub_;
   std::unique_ptr<ExactSync> exact_sync_;
   std::unique_ptr<ApproximateSync> approximate_sync_;
-  ros::Publisher correspondences_pub_;
+  message_filters::Subscriber<Info> left_info_sub_, right_info_sub_;
+  std::unique_ptr<CalibratedSync> calibrated_sync_;
+  tf2_ros::Buffer tf_buffer_;
+  tf2_ros::TransformListener tf_listener_;
+  ros::Publisher correspondences_pub_, points_pub_;
   image_transport::Publisher matches_image_pub_;
 };
 

@@ -29,7 +29,7 @@ MatchConfig readMatchConfig(const ros::NodeHandle& private_nh);
 /// ~gms_with_rotation, ~gms_with_scale.
 FilterConfigs readFilterConfigs(const ros::NodeHandle& private_nh);
 
-/// The readers above and ~filters, ~queue_size, ~approximate_sync.
+/// The readers above and ~filters, ~queue_size, ~approximate_sync, ~calibrated.
 MatcherSettings readMatcherSettings(const ros::NodeHandle& private_nh);
 
 }  // namespace ros_params
