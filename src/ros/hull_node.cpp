@@ -53,13 +53,13 @@ HullNode::HullNode(ros::NodeHandle nh, ros::NodeHandle private_nh, HullNodeConfi
 
 void HullNode::onPoseMissing(const sensor_msgs::ImageConstPtr& silhouette,
                              tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
-  ROS_ERROR_THROTTLE(
-      kThrottle_s, "hull: dropped the silhouette of frame '%s' at %.3f: no pose in '%s' (%s)",
-      silhouette->header.frame_id.c_str(), silhouette->header.stamp.toSec(),
-      config_.world_frame.c_str(),
-      reason == tf2_ros::filter_failure_reasons::EmptyFrameID ? "empty frame id"
-      : reason == tf2_ros::filter_failure_reasons::OutTheBack ? "older than the transforms tf keeps"
-                                                              : "the transform never arrived");
+  const char* why = reason == tf2_ros::filter_failure_reasons::EmptyFrameID ? "empty frame id"
+                    : reason == tf2_ros::filter_failure_reasons::OutTheBack
+                        ? "older than the transforms tf keeps"
+                        : "the transform never arrived";
+  log_.error("hull: dropped a silhouette: ", "no pose of '" + silhouette->header.frame_id +
+                                                 "' in '" + config_.world_frame + "' (" + why +
+                                                 ")");
 }
 
 bool HullNode::cameraOf(const sensor_msgs::Image& silhouette, const sensor_msgs::CameraInfo& info,
@@ -69,15 +69,13 @@ bool HullNode::cameraOf(const sensor_msgs::Image& silhouette, const sensor_msgs:
     T_W_C = tf2::transformToEigen(tf_buffer_.lookupTransform(
         config_.world_frame, silhouette.header.frame_id, silhouette.header.stamp));
   } catch (const tf2::TransformException& e) {
-    ROS_ERROR_THROTTLE(kThrottle_s, "hull: no pose for '%s': %s",
-                       silhouette.header.frame_id.c_str(), e.what());
+    log_.error("hull: view ignored: ", e.what());
     return false;
   }
   std::string why_not;
   if (!ros_conversions::cameraFromInfo(info, T_W_C, cv::Size(silhouette.width, silhouette.height),
                                        camera, &why_not)) {
-    ROS_ERROR_THROTTLE(kThrottle_s, "hull: view '%s' ignored: %s",
-                       silhouette.header.frame_id.c_str(), why_not.c_str());
+    log_.error("hull: view '" + silhouette.header.frame_id + "' ignored: ", why_not);
     return false;
   }
   return true;
@@ -88,8 +86,7 @@ void HullNode::onView(const sensor_msgs::ImageConstPtr& silhouette,
   std::string why_not;
   const cv::Mat mask = ros_conversions::maskFromImage(*silhouette, &why_not);
   if (mask.empty()) {
-    ROS_ERROR_THROTTLE(kThrottle_s, "hull: view '%s' ignored: %s",
-                       silhouette->header.frame_id.c_str(), why_not.c_str());
+    log_.error("hull: view '" + silhouette->header.frame_id + "' ignored: ", why_not);
     return;
   }
   PinholeCamera camera;
@@ -107,7 +104,7 @@ void HullNode::carve(const std::string& name, const PinholeCamera& camera, const
     }
     if (outcome == HullStream::Outcome::kSkipped) ROS_INFO("hull: view '%s' skipped", name.c_str());
   } catch (const std::exception& e) {
-    ROS_ERROR_THROTTLE(kThrottle_s, "hull: view '%s' ignored: %s", name.c_str(), e.what());
+    log_.error("hull: view '" + name + "' ignored: ", e.what());
   }
 }
 

@@ -16,6 +16,7 @@
 
 #include "sift_hull/Save.h"
 #include "sift_hull/hull_stream.h"
+#include "throttled_log.h"
 
 namespace sift_hull {
 
@@ -54,6 +55,7 @@ class HullNode {
   ros::NodeHandle nh_, private_nh_;
   HullNodeConfig config_;
   HullStream stream_;
+  ThrottledLog log_;
   std::unique_ptr<octomap::OcTree> octree_;
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;

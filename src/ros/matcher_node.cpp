@@ -14,8 +14,6 @@
 namespace sift_hull {
 namespace {
 
-constexpr double kThrottle_s = 5.0;
-
 std::vector<std::unique_ptr<MatchFilter>> makeFilters(const MatcherSettings& settings) {
   std::vector<std::unique_ptr<MatchFilter>> filters;
   for (const std::string& spec : settings.node.filters) {
@@ -138,8 +136,7 @@ bool MatcherNode::stereoCameras(const Image& left, const Image& right, const Inf
     T_L_R = tf2::transformToEigen(tf_buffer_.lookupTransform(
         left.header.frame_id, right.header.frame_id, left.header.stamp, ros::Duration(0.5)));
   } catch (const tf2::TransformException& e) {
-    ROS_ERROR_THROTTLE(kThrottle_s, "matcher: no pose of '%s' relative to '%s': %s",
-                       right.header.frame_id.c_str(), left.header.frame_id.c_str(), e.what());
+    log_.error("matcher: pair ignored: ", e.what());
     return false;
   }
   std::string why_not;
@@ -150,8 +147,7 @@ bool MatcherNode::stereoCameras(const Image& left, const Image& right, const Inf
       ros_conversions::cameraFromInfo(right_info, T_L_R, cv::Size(right.width, right.height),
                                       &cameras->right, &why_not);
   if (!ok) {
-    ROS_ERROR_THROTTLE(kThrottle_s, "matcher: pair at %.3f ignored: %s", left.header.stamp.toSec(),
-                       why_not.c_str());
+    log_.error("matcher: pair ignored: ", why_not);
   }
   return ok;
 }
@@ -167,16 +163,16 @@ void MatcherNode::process(const sensor_msgs::ImageConstPtr& left,
   const cv::Mat left_image = imageOf(left, &why_not);
   const cv::Mat right_image = left_image.empty() ? cv::Mat() : imageOf(right, &why_not);
   if (left_image.empty() || right_image.empty()) {
-    ROS_ERROR_THROTTLE(kThrottle_s, "matcher: pair at %.3f ignored: %s", left->header.stamp.toSec(),
-                       why_not.c_str());
+    log_.error("matcher: pair ignored: ", why_not);
     return;
   }
   PutativeMatches matches =
       matchImages(left_image, right_image, settings_.sift, settings_.matching);
   if (matches.left_keypoints.size() < 2 || matches.right_keypoints.size() < 2) {
-    ROS_ERROR_THROTTLE(kThrottle_s, "matcher: pair at %.3f has %zu and %zu keypoints, too few",
-                       left->header.stamp.toSec(), matches.left_keypoints.size(),
-                       matches.right_keypoints.size());
+    log_.error("matcher: pair ignored: ", "fewer than two keypoints in an image (" +
+                                              std::to_string(matches.left_keypoints.size()) +
+                                              " and " +
+                                              std::to_string(matches.right_keypoints.size()) + ")");
     return;
   }
   if (cameras != nullptr) matches.F_right_left = fundamentalMatrix(cameras->left, cameras->right);

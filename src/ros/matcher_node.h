@@ -21,6 +21,7 @@
 #include "sift_hull/features.h"
 #include "sift_hull/filters.h"
 #include "sift_hull/matching.h"
+#include "throttled_log.h"
 
 namespace sift_hull {
 
@@ -92,6 +93,7 @@ class MatcherNode {
   MatcherSettings settings_;
   std::vector<std::unique_ptr<MatchFilter>> filters_;
   std::string settings_json_;
+  ThrottledLog log_;
   image_transport::ImageTransport transport_;
   image_transport::SubscriberFilter left_sub_, right_sub_;
   std::unique_ptr<ExactSync> exact_sync_;
