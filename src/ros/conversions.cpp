@@ -1,9 +1,11 @@
 #include "conversions.h"
 
+#include <cv_bridge/cv_bridge.h>
 #include <octomap/OcTree.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
 #include <pcl_conversions/pcl_conversions.h>
+#include <sensor_msgs/image_encodings.h>
 #include <tf2_eigen/tf2_eigen.h>
 
 #include <cmath>
@@ -33,6 +35,28 @@ cv::Mat maskFromImage(const sensor_msgs::Image& image, std::string* why_not) {
   const cv::Mat view(image.height, image.width, CV_8UC1, const_cast<uint8_t*>(image.data.data()),
                      image.step);
   return view.clone();
+}
+
+cv::Mat eightBitImage(const sensor_msgs::ImageConstPtr& image, std::string* why_not) {
+  namespace enc = sensor_msgs::image_encodings;
+  if (image->width == 0 || image->height == 0) {
+    *why_not = "the image is empty";
+    return {};
+  }
+  if (!enc::isColor(image->encoding) && !enc::isMono(image->encoding)) {
+    *why_not = "encoding '" + image->encoding + "' is neither colour nor mono";
+    return {};
+  }
+  if (enc::bitDepth(image->encoding) != 8) {
+    *why_not = "encoding '" + image->encoding + "' is not 8 bits per channel";
+    return {};
+  }
+  try {
+    return cv_bridge::toCvShare(image, enc::isMono(image->encoding) ? "mono8" : "bgr8")->image;
+  } catch (const cv_bridge::Exception& e) {
+    *why_not = e.what();
+    return {};
+  }
 }
 
 namespace {

@@ -29,6 +29,11 @@ namespace ros_conversions {
 /// or a step that does not match the width.
 cv::Mat maskFromImage(const sensor_msgs::Image& image, std::string* why_not);
 
+/// An 8-bit colour or mono image as BGR or grey, sharing the message's pixels (keep the message
+/// while the Mat is in use). Returns an empty Mat and sets `why_not` for an empty image or
+/// another encoding.
+cv::Mat eightBitImage(const sensor_msgs::ImageConstPtr& image, std::string* why_not);
+
 /// The camera of a view: K from `info` (pixels) and the pose T_W_C (the camera frame in the world
 /// frame, as tf gives it). Returns false and sets `why_not` for a K that is zero, not finite or not
 /// upper triangular with K(2,2) = 1 (after scaling), a pose that is not finite, or an image size

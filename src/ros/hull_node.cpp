@@ -15,6 +15,8 @@ HullNodeConfig readNodeConfig(const ros::NodeHandle& private_nh) {
   HullNodeConfig config;
   private_nh.param("world_frame", config.world_frame, config.world_frame);
   private_nh.param("queue_size", config.queue_size, config.queue_size);
+  private_nh.param("from_image", config.from_image, config.from_image);
+  config.recipe = ros_params::readSilhouetteConfig(private_nh);
   return config;
 }
 
@@ -31,7 +33,7 @@ HullNode::HullNode(ros::NodeHandle nh, ros::NodeHandle private_nh, HullNodeConfi
       config_(std::move(node_config)),
       stream_(std::move(hull_config)),
       tf_listener_(tf_buffer_),
-      silhouette_sub_(nh_, "silhouette", config_.queue_size),
+      silhouette_sub_(nh_, config_.from_image ? "image" : "silhouette", config_.queue_size),
       info_sub_(nh_, "camera_info", config_.queue_size),
       pose_filter_(silhouette_sub_, tf_buffer_, config_.world_frame, config_.queue_size, nh_),
       sync_(pose_filter_, info_sub_, config_.queue_size) {
@@ -84,7 +86,7 @@ bool HullNode::cameraOf(const sensor_msgs::Image& silhouette, const sensor_msgs:
 void HullNode::onView(const sensor_msgs::ImageConstPtr& silhouette,
                       const sensor_msgs::CameraInfoConstPtr& info) {
   std::string why_not;
-  const cv::Mat mask = ros_conversions::maskFromImage(*silhouette, &why_not);
+  const cv::Mat mask = maskOf(silhouette, &why_not);
   if (mask.empty()) {
     log_.error("hull: view '" + silhouette->header.frame_id + "' ignored: ", why_not);
     return;
@@ -93,6 +95,12 @@ void HullNode::onView(const sensor_msgs::ImageConstPtr& silhouette,
   if (!cameraOf(*silhouette, *info, &camera)) return;
   carve(silhouette->header.frame_id, camera, mask);
   if (stream_.hasHull()) publish(silhouette->header.stamp);
+}
+
+cv::Mat HullNode::maskOf(const sensor_msgs::ImageConstPtr& message, std::string* why_not) const {
+  if (!config_.from_image) return ros_conversions::maskFromImage(*message, why_not);
+  const cv::Mat image = ros_conversions::eightBitImage(message, why_not);
+  return image.empty() ? image : silhouetteFromImage(image, config_.recipe);
 }
 
 void HullNode::carve(const std::string& name, const PinholeCamera& camera, const cv::Mat& mask) {

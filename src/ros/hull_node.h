@@ -15,6 +15,7 @@
 #include <string>
 
 #include "sift_hull/Save.h"
+#include "sift_hull/dataset.h"
 #include "sift_hull/hull_stream.h"
 #include "throttled_log.h"
 
@@ -26,6 +27,10 @@ struct HullNodeConfig {
   /// Silhouettes waiting for their camera_info or their pose; when more wait, the oldest is
   /// dropped with an error (a pose that never arrives).
   int queue_size = 10;
+  /// Subscribe `image` (8-bit colour or mono) instead of `silhouette`, and extract each
+  /// silhouette by `recipe` (the Middlebury threshold, dilation and erosion).
+  bool from_image = false;
+  SilhouetteConfig recipe;
 };
 
 /// The hull node: silhouettes (mono8) with their camera_info, once tf knows the camera's pose in
@@ -43,6 +48,8 @@ class HullNode {
 
   void onView(const sensor_msgs::ImageConstPtr& silhouette,
               const sensor_msgs::CameraInfoConstPtr& info);
+  /// The view's mask: the silhouette message, or the one extracted from the image.
+  cv::Mat maskOf(const sensor_msgs::ImageConstPtr& message, std::string* why_not) const;
   bool cameraOf(const sensor_msgs::Image& silhouette, const sensor_msgs::CameraInfo& info,
                 PinholeCamera* camera);
   void carve(const std::string& name, const PinholeCamera& camera, const cv::Mat& mask);

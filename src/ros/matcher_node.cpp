@@ -1,7 +1,6 @@
 #include "matcher_node.h"
 
 #include <cv_bridge/cv_bridge.h>
-#include <sensor_msgs/image_encodings.h>
 #include <tf2_eigen/tf2_eigen.h>
 
 #include <cmath>
@@ -41,29 +40,6 @@ std::string settingsJson(const MatcherSettings& settings) {
       {"magsac_max_epipolar_px", f.magsac.max_epipolar_px},
       {"gms_threshold_factor", f.gms.threshold_factor}};
   return json.dump();
-}
-
-/// An 8-bit image as BGR or grey, or empty with `why_not` set.
-cv::Mat imageOf(const sensor_msgs::ImageConstPtr& image, std::string* why_not) {
-  namespace enc = sensor_msgs::image_encodings;
-  if (image->width == 0 || image->height == 0) {
-    *why_not = "the image is empty";
-    return {};
-  }
-  if (!enc::isColor(image->encoding) && !enc::isMono(image->encoding)) {
-    *why_not = "encoding '" + image->encoding + "' is neither colour nor mono";
-    return {};
-  }
-  if (enc::bitDepth(image->encoding) != 8) {
-    *why_not = "encoding '" + image->encoding + "' is not 8 bits per channel";
-    return {};
-  }
-  try {
-    return cv_bridge::toCvShare(image, enc::isMono(image->encoding) ? "mono8" : "bgr8")->image;
-  } catch (const cv_bridge::Exception& e) {
-    *why_not = e.what();
-    return {};
-  }
 }
 
 sift_hull::Keypoint keypointMessage(const cv::KeyPoint& keypoint) {
@@ -160,8 +136,9 @@ void MatcherNode::onPair(const sensor_msgs::ImageConstPtr& left,
 void MatcherNode::process(const sensor_msgs::ImageConstPtr& left,
                           const sensor_msgs::ImageConstPtr& right, const StereoCameras* cameras) {
   std::string why_not;
-  const cv::Mat left_image = imageOf(left, &why_not);
-  const cv::Mat right_image = left_image.empty() ? cv::Mat() : imageOf(right, &why_not);
+  const cv::Mat left_image = ros_conversions::eightBitImage(left, &why_not);
+  const cv::Mat right_image =
+      left_image.empty() ? cv::Mat() : ros_conversions::eightBitImage(right, &why_not);
   if (left_image.empty() || right_image.empty()) {
     log_.error("matcher: pair ignored: ", why_not);
     return;

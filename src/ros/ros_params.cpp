@@ -5,6 +5,18 @@
 namespace sift_hull {
 namespace ros_params {
 
+SilhouetteConfig readSilhouetteConfig(const ros::NodeHandle& private_nh) {
+  SilhouetteConfig config;
+  private_nh.param("threshold", config.threshold, config.threshold);
+  private_nh.param("dilate_px", config.dilate_px, config.dilate_px);
+  private_nh.param("erode_px", config.erode_px, config.erode_px);
+  if (!(config.threshold >= 0.0 && config.threshold <= 1.0) || config.dilate_px < 0 ||
+      config.erode_px < 0) {
+    throw std::invalid_argument("~threshold must lie in [0, 1], ~dilate_px and ~erode_px >= 0");
+  }
+  return config;
+}
+
 HullConfig readHullConfig(const ros::NodeHandle& private_nh) {
   HullConfig config;
   private_nh.param("depth", config.max_depth, config.max_depth);

@@ -5,10 +5,14 @@
 #include <ros/node_handle.h>
 
 #include "matcher_node.h"
+#include "sift_hull/dataset.h"
 #include "sift_hull/hull_stream.h"
 
 namespace sift_hull {
 namespace ros_params {
+
+/// ~threshold (grey level in [0, 1]), ~dilate_px, ~erode_px: the Middlebury silhouette recipe.
+SilhouetteConfig readSilhouetteConfig(const ros::NodeHandle& private_nh);
 
 /// ~depth, ~carve_outside_image, ~slack_px, ~threads.
 HullConfig readHullConfig(const ros::NodeHandle& private_nh);
