@@ -75,6 +75,10 @@ class HullNodeTest : public ::testing::Test {
       poses.push_back(
           ros_conversions::cameraPoseMessage(views_[v].view.camera, "world", frameOf(v), {}));
     }
+    // A pose that is not a number: tf refuses it, so views in this frame never get a pose.
+    poses.push_back(
+        ros_conversions::cameraPoseMessage(views_[0].view.camera, "world", "camera_nan", {}));
+    poses.back().transform.translation.x = std::nan("");
     tf_.sendTransform(poses);
     silhouette_pub_ = nh_.advertise<sensor_msgs::Image>(fromImage() ? "image" : "silhouette", 20);
     info_pub_ = nh_.advertise<sensor_msgs::CameraInfo>("camera_info", 20);
@@ -85,12 +89,12 @@ class HullNodeTest : public ::testing::Test {
     })) << "the hull node did not subscribe";
   }
 
-  /// Publishes view `v` with a fresh stamp; `change` may spoil the messages first.
+  /// Publishes view `v` with `stamp` (default: now); `change` may spoil the messages first.
   ros::Time publishView(
-      int v,
-      const std::function<void(sensor_msgs::Image*, sensor_msgs::CameraInfo*)>& change = {}) {
+      int v, const std::function<void(sensor_msgs::Image*, sensor_msgs::CameraInfo*)>& change = {},
+      const ros::Time& stamp = {}) {
     std_msgs::Header header;
-    header.stamp = ros::Time::now();
+    header.stamp = stamp.isZero() ? ros::Time::now() : stamp;
     header.frame_id = frameOf(v);
     sensor_msgs::Image image =
         ros_conversions::imageMessage(fromImage() ? views_[v].image : views_[v].mask, header);
@@ -166,6 +170,16 @@ TEST_F(HullNodeTest, CarvesTheSphereResetsAndSurvivesBadInput) {
   publishView(5, [](sensor_msgs::Image* image, sensor_msgs::CameraInfo* info) {
     image->header.frame_id = info->header.frame_id = "camera_without_pose";
   });
+  publishView(6, [](sensor_msgs::Image* image, sensor_msgs::CameraInfo* info) {
+    image->header.frame_id = info->header.frame_id = "camera_nan";
+  });
+  // Out of order: newest first. The node carves them all the same.
+  const ros::Time now = ros::Time::now();
+  for (int v = 0; v < kViews; ++v) publishView(v, {}, now - ros::Duration(0.1 * v));
+  ASSERT_TRUE(waitFor([&] { return occupiedVolume(*last_octomap_) > 0.5 * sphere_m3; }))
+      << "views out of order were not carved";
+  ASSERT_TRUE(ros::service::call("/hull/reset", reset));
+  ASSERT_TRUE(waitFor([&] { return occupiedVolume(*last_octomap_) == 0.0; }));
   for (int v = 0; v < kViews; ++v) last = publishView(v);
   ASSERT_TRUE(octomapStampedAtLeast(last)) << "good views after bad ones were not carved";
   EXPECT_NEAR(occupiedVolume(*last_octomap_), offline_m3, 1e-6 * offline_m3);
