@@ -53,6 +53,9 @@ PutativeMatches putativesOf(const sift_hull::Correspondences& message, cv::Size 
 
 class MatcherNodeTest : public ::testing::Test {
  protected:
+  /// Whether the node takes one `image` topic (matcher_frames.test).
+  virtual bool frameToFrame() const { return false; }
+
   void SetUp() override {
     SceneConfig config;
     config.width_px = 320;
@@ -62,9 +65,12 @@ class MatcherNodeTest : public ::testing::Test {
     left_pub_ = nh_.advertise<sensor_msgs::Image>("left/image", 5);
     right_pub_ = nh_.advertise<sensor_msgs::Image>("right/image", 5);
     sub_ = nh_.subscribe("correspondences", 5, &MatcherNodeTest::onCorrespondences, this);
+    frame_pub_ = nh_.advertise<sensor_msgs::Image>("image", 5);
     ASSERT_TRUE(waitFor([&] {
-      return left_pub_.getNumSubscribers() > 0 && right_pub_.getNumSubscribers() > 0 &&
-             sub_.getNumPublishers() > 0;
+      const bool inputs =
+          frameToFrame() ? frame_pub_.getNumSubscribers() > 0
+                         : left_pub_.getNumSubscribers() > 0 && right_pub_.getNumSubscribers() > 0;
+      return inputs && sub_.getNumPublishers() > 0;
     })) << "the matcher node did not connect";
   }
 
@@ -82,7 +88,7 @@ class MatcherNodeTest : public ::testing::Test {
   void onCorrespondences(const sift_hull::CorrespondencesConstPtr& message) { last_ = message; }
 
   ros::NodeHandle nh_;
-  ros::Publisher left_pub_, right_pub_;
+  ros::Publisher left_pub_, right_pub_, frame_pub_;
   ros::Subscriber sub_;
   RenderedView left_, right_;
   sift_hull::CorrespondencesConstPtr last_;
@@ -126,6 +132,29 @@ TEST_F(MatcherNodeTest, RefusesBadPairsAndCarriesOn) {
   const ros::Time stamp = publishPair(left_.image, right_.image);
   ASSERT_TRUE(answeredAtLeast(stamp)) << "a good pair after bad ones was not matched";
   EXPECT_EQ(last_->header.stamp, stamp);
+}
+
+/// One image topic: each frame is matched with the one before it.
+class FrameToFrameMatcherTest : public MatcherNodeTest {
+ protected:
+  bool frameToFrame() const override { return true; }
+};
+
+TEST_F(FrameToFrameMatcherTest, MatchesEachFrameWithThePreviousOne) {
+  const ros::Time first = ros::Time::now();
+  frame_pub_.publish(bgrImage(left_.image, first, "camera"));
+  ros::WallDuration(0.2).sleep();
+  const ros::Time second = first + ros::Duration(0.5);
+  frame_pub_.publish(bgrImage(right_.image, second, "camera"));
+  ASSERT_TRUE(waitFor([&] { return last_ && last_->right_header.stamp == second; }));
+  EXPECT_EQ(last_->header.stamp, first);  // the earlier frame is the left image
+  EXPECT_GE(last_->matches.size(), 50u);
+  // A frame older than the previous one is refused; the next newer one is matched.
+  frame_pub_.publish(bgrImage(left_.image, first, "camera"));
+  const ros::Time third = second + ros::Duration(0.5);
+  frame_pub_.publish(bgrImage(left_.image, third, "camera"));
+  ASSERT_TRUE(waitFor([&] { return last_->right_header.stamp == third; }));
+  EXPECT_EQ(last_->header.stamp, second);
 }
 
 /// The same pair with camera_info and the right camera's pose relative to the left in tf.

@@ -24,6 +24,9 @@ std::vector<std::unique_ptr<MatchFilter>> makeFilters(const MatcherSettings& set
     filters.push_back(makeFilter(spec, settings.filters));
   }
   if (filters.empty()) throw std::invalid_argument("~filters names no filter");
+  if (settings.node.frame_to_frame && settings.node.calibrated) {
+    throw std::invalid_argument("~frame_to_frame and ~calibrated do not go together yet");
+  }
   return filters;
 }
 
@@ -65,8 +68,6 @@ MatcherNode::MatcherNode(ros::NodeHandle nh, ros::NodeHandle private_nh, Matcher
       filters_(makeFilters(settings_)),
       settings_json_(settingsJson(settings_)),
       transport_(nh_),
-      left_sub_(transport_, "left/image", settings_.node.queue_size),
-      right_sub_(transport_, "right/image", settings_.node.queue_size),
       tf_listener_(tf_buffer_) {
   subscribe();
   correspondences_pub_ =
@@ -77,6 +78,12 @@ MatcherNode::MatcherNode(ros::NodeHandle nh, ros::NodeHandle private_nh, Matcher
 
 void MatcherNode::subscribe() {
   const int queue = settings_.node.queue_size;
+  if (settings_.node.frame_to_frame) {
+    frame_sub_ = transport_.subscribe("image", queue, &MatcherNode::onFrame, this);
+    return;
+  }
+  left_sub_.subscribe(transport_, "left/image", queue);
+  right_sub_.subscribe(transport_, "right/image", queue);
   if (settings_.node.calibrated) {
     left_info_sub_.subscribe(nh_, "left/camera_info", queue);
     right_info_sub_.subscribe(nh_, "right/camera_info", queue);
@@ -126,6 +133,15 @@ bool MatcherNode::stereoCameras(const Image& left, const Image& right, const Inf
     log_.error("matcher: pair ignored: ", why_not);
   }
   return ok;
+}
+
+void MatcherNode::onFrame(const sensor_msgs::ImageConstPtr& frame) {
+  if (previous_frame_ && frame->header.stamp <= previous_frame_->header.stamp) {
+    log_.error("matcher: frame ignored: ", "its stamp is not after the previous frame's");
+    return;
+  }
+  if (previous_frame_) process(previous_frame_, frame, nullptr);
+  previous_frame_ = frame;
 }
 
 void MatcherNode::onPair(const sensor_msgs::ImageConstPtr& left,

@@ -36,6 +36,9 @@ struct MatcherNodeConfig {
   /// and the right camera's pose relative to the left from tf: the epipolar filter's F, and the
   /// `points` of the matches the first filter keeps.
   bool calibrated = false;
+  /// Subscribe one `image` topic instead, and match each frame with the one before it (the
+  /// earlier frame is the left image). Not with `calibrated`.
+  bool frame_to_frame = false;
 };
 
 /// Everything the matcher node is configured with.
@@ -74,6 +77,7 @@ class MatcherNode {
 
   void subscribe();
   void onPair(const sensor_msgs::ImageConstPtr& left, const sensor_msgs::ImageConstPtr& right);
+  void onFrame(const sensor_msgs::ImageConstPtr& frame);
   void onCalibratedPair(const sensor_msgs::ImageConstPtr& left,
                         const sensor_msgs::ImageConstPtr& right,
                         const sensor_msgs::CameraInfoConstPtr& left_info,
@@ -96,6 +100,8 @@ class MatcherNode {
   ThrottledLog log_;
   image_transport::ImageTransport transport_;
   image_transport::SubscriberFilter left_sub_, right_sub_;
+  image_transport::Subscriber frame_sub_;
+  sensor_msgs::ImageConstPtr previous_frame_;
   std::unique_ptr<ExactSync> exact_sync_;
   std::unique_ptr<ApproximateSync> approximate_sync_;
   message_filters::Subscriber<Info> left_info_sub_, right_info_sub_;

@@ -104,6 +104,7 @@ MatcherSettings readMatcherSettings(const ros::NodeHandle& private_nh) {
   private_nh.param("queue_size", node.queue_size, node.queue_size);
   private_nh.param("approximate_sync", node.approximate_sync, node.approximate_sync);
   private_nh.param("calibrated", node.calibrated, node.calibrated);
+  private_nh.param("frame_to_frame", node.frame_to_frame, node.frame_to_frame);
   settings.sift = readSiftConfig(private_nh);
   settings.matching = readMatchConfig(private_nh);
   settings.filters = readFilterConfigs(private_nh);

@@ -33,7 +33,8 @@ MatchConfig readMatchConfig(const ros::NodeHandle& private_nh);
 /// ~gms_with_rotation, ~gms_with_scale.
 FilterConfigs readFilterConfigs(const ros::NodeHandle& private_nh);
 
-/// The readers above and ~filters, ~queue_size, ~approximate_sync, ~calibrated.
+/// The readers above and ~filters, ~queue_size, ~approximate_sync, ~calibrated,
+/// ~frame_to_frame.
 MatcherSettings readMatcherSettings(const ros::NodeHandle& private_nh);
 
 }  // namespace ros_params
