@@ -2,6 +2,7 @@
 // and a precision against the scene's ground truth; bad pairs answered with an error while later
 // good pairs still count. Every wait has a deadline.
 
+#include <dynamic_reconfigure/Reconfigure.h>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <sensor_msgs/Image.h>
@@ -132,6 +133,29 @@ TEST_F(MatcherNodeTest, RefusesBadPairsAndCarriesOn) {
   const ros::Time stamp = publishPair(left_.image, right_.image);
   ASSERT_TRUE(answeredAtLeast(stamp)) << "a good pair after bad ones was not matched";
   EXPECT_EQ(last_->header.stamp, stamp);
+}
+
+TEST_F(MatcherNodeTest, ThresholdsChangeAtRunTime) {
+  const auto keptByGsc = [&] {
+    size_t kept = 0;
+    for (const sift_hull::Correspondence& c : last_->matches) kept += c.kept_by & 1u;
+    return kept;
+  };
+  ros::Time stamp = publishPair(left_.image, right_.image);
+  ASSERT_TRUE(answeredAtLeast(stamp));
+  ASSERT_GT(keptByGsc(), 20u);
+  dynamic_reconfigure::Reconfigure change;
+  dynamic_reconfigure::DoubleParameter threshold;
+  threshold.name = "gsc_max_histogram_distance";
+  threshold.value = 0.0;
+  change.request.config.doubles.push_back(threshold);
+  ASSERT_TRUE(ros::service::waitForService("/matcher/set_parameters", ros::Duration(kDeadline_s)));
+  ASSERT_TRUE(ros::service::call("/matcher/set_parameters", change));
+  stamp = publishPair(left_.image, right_.image);
+  ASSERT_TRUE(answeredAtLeast(stamp));
+  EXPECT_LT(keptByGsc(), 3u);  // histograms equal to the last bin: hardly any
+  EXPECT_NE(last_->filter_settings.find("\"gsc_max_histogram_distance\":0.0"), std::string::npos)
+      << last_->filter_settings;
 }
 
 /// One image topic: each frame is matched with the one before it.

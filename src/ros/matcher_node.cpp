@@ -4,6 +4,7 @@
 #include <tf2_eigen/tf2_eigen.h>
 
 #include <cmath>
+#include <limits>
 #include <nlohmann/json.hpp>
 
 #include "conversions.h"
@@ -70,10 +71,53 @@ MatcherNode::MatcherNode(ros::NodeHandle nh, ros::NodeHandle private_nh, Matcher
       transport_(nh_),
       tf_listener_(tf_buffer_) {
   subscribe();
+  serveReconfigure();
   correspondences_pub_ =
       nh_.advertise<sift_hull::Correspondences>("correspondences", settings_.node.queue_size);
   if (settings_.node.calibrated) points_pub_ = nh_.advertise<sensor_msgs::PointCloud2>("points", 1);
   matches_image_pub_ = transport_.advertise("matches_image", 1);
+}
+
+void MatcherNode::serveReconfigure() {
+  sift_hull::MatcherConfig config;
+  config.ratio = settings_.matching.ratio;
+  const double max_distance = settings_.matching.max_descriptor_distance;
+  config.max_descriptor_distance = std::isfinite(max_distance) ? max_distance : 0.0;
+  config.cross_check = settings_.matching.cross_check;
+  config.gsc_max_histogram_distance = settings_.filters.gsc.max_histogram_distance;
+  config.ransac_max_epipolar_px = settings_.filters.ransac.max_epipolar_px;
+  config.magsac_max_epipolar_px = settings_.filters.magsac.max_epipolar_px;
+  config.max_epipolar_px = settings_.filters.epipolar.max_epipolar_px;
+  config.gms_threshold_factor = settings_.filters.gms.threshold_factor;
+  reconfigure_ =
+      std::make_unique<dynamic_reconfigure::Server<sift_hull::MatcherConfig>>(private_nh_);
+  reconfigure_->updateConfig(config);
+  reconfigure_->setCallback(
+      [this](sift_hull::MatcherConfig& changed, uint32_t level) { onReconfigure(changed, level); });
+}
+
+void MatcherNode::onReconfigure(sift_hull::MatcherConfig& config, uint32_t) {
+  MatcherSettings changed = settings_;
+  changed.matching.ratio = config.ratio;
+  changed.matching.max_descriptor_distance = config.max_descriptor_distance > 0.0
+                                                 ? config.max_descriptor_distance
+                                                 : std::numeric_limits<double>::infinity();
+  changed.matching.cross_check = config.cross_check;
+  changed.filters.gsc.max_histogram_distance = config.gsc_max_histogram_distance;
+  changed.filters.ransac.max_epipolar_px = config.ransac_max_epipolar_px;
+  changed.filters.magsac.max_epipolar_px = config.magsac_max_epipolar_px;
+  changed.filters.epipolar.max_epipolar_px = config.max_epipolar_px;
+  changed.filters.gms.threshold_factor = config.gms_threshold_factor;
+  try {
+    validate(changed.matching);
+    validate(changed.filters);
+    filters_ = makeFilters(changed);
+  } catch (const std::invalid_argument& e) {
+    log_.error("matcher: reconfiguration refused: ", e.what());
+    return;
+  }
+  settings_ = changed;
+  settings_json_ = settingsJson(settings_);
 }
 
 void MatcherNode::subscribe() {

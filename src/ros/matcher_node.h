@@ -1,5 +1,6 @@
 #pragma once
 
+#include <dynamic_reconfigure/server.h>
 #include <image_transport/image_transport.h>
 #include <image_transport/subscriber_filter.h>
 #include <message_filters/subscriber.h>
@@ -17,6 +18,7 @@
 #include <vector>
 
 #include "sift_hull/Correspondences.h"
+#include "sift_hull/MatcherConfig.h"
 #include "sift_hull/camera.h"
 #include "sift_hull/features.h"
 #include "sift_hull/filters.h"
@@ -76,6 +78,9 @@ class MatcherNode {
   };
 
   void subscribe();
+  /// Serves the run-time thresholds (cfg/Matcher.cfg), starting from the node's own settings.
+  void serveReconfigure();
+  void onReconfigure(sift_hull::MatcherConfig& config, uint32_t level);
   void onPair(const sensor_msgs::ImageConstPtr& left, const sensor_msgs::ImageConstPtr& right);
   void onFrame(const sensor_msgs::ImageConstPtr& frame);
   void onCalibratedPair(const sensor_msgs::ImageConstPtr& left,
@@ -98,6 +103,7 @@ class MatcherNode {
   std::vector<std::unique_ptr<MatchFilter>> filters_;
   std::string settings_json_;
   ThrottledLog log_;
+  std::unique_ptr<dynamic_reconfigure::Server<sift_hull::MatcherConfig>> reconfigure_;
   image_transport::ImageTransport transport_;
   image_transport::SubscriberFilter left_sub_, right_sub_;
   image_transport::Subscriber frame_sub_;

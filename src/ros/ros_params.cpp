@@ -82,6 +82,8 @@ void readRobustFit(const ros::NodeHandle& private_nh, const std::string& prefix,
 
 FilterConfigs readFilterConfigs(const ros::NodeHandle& private_nh) {
   FilterConfigs configs;
+  private_nh.param("max_epipolar_px", configs.epipolar.max_epipolar_px,
+                   configs.epipolar.max_epipolar_px);
   GscConfig& gsc = configs.gsc;
   private_nh.param("gsc_max_histogram_distance", gsc.max_histogram_distance,
                    gsc.max_histogram_distance);

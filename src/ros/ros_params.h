@@ -28,9 +28,9 @@ SiftConfig readSiftConfig(const ros::NodeHandle& private_nh);
 /// ~ratio, ~max_descriptor_distance (<= 0: none), ~cross_check, ~matcher.
 MatchConfig readMatchConfig(const ros::NodeHandle& private_nh);
 
-/// ~gsc_max_histogram_distance, ~gsc_threads, ~ransac_max_epipolar_px, ~magsac_max_epipolar_px,
-/// ~robust_confidence, ~robust_max_iterations, ~gms_grid_cells, ~gms_threshold_factor,
-/// ~gms_with_rotation, ~gms_with_scale.
+/// ~max_epipolar_px, ~gsc_max_histogram_distance, ~gsc_threads, ~ransac_max_epipolar_px,
+/// ~magsac_max_epipolar_px, ~robust_confidence, ~robust_max_iterations, ~gms_grid_cells,
+/// ~gms_threshold_factor, ~gms_with_rotation, ~gms_with_scale.
 FilterConfigs readFilterConfigs(const ros::NodeHandle& private_nh);
 
 /// The readers above and ~filters, ~queue_size, ~approximate_sync, ~calibrated,
