@@ -9,8 +9,8 @@
 #include "../ros/conversions.h"
 #include "args.h"
 #include "commands.h"
+#include "hull_options.h"
 #include "sift_hull/hull_pipeline.h"
-#include "silhouette_options.h"
 
 namespace sift_hull {
 namespace cli {
@@ -31,11 +31,7 @@ struct BagView {
 };
 
 std::vector<BagView> loadViews(const ArgParser& parser) {
-  const std::string masks = parser.has("silhouettes") ? parser.get("silhouettes") : "";
-  std::vector<std::string> names;
-  if (parser.has("views-file")) names = readViewList(parser.get("views-file"));
-  const HullInput input = loadHullInput(parser.get("calib"), parser.get("images"), masks,
-                                        silhouetteConfigFromArgs(parser), names);
+  const HullInput input = viewSetFromArgs(parser);
   std::vector<BagView> views;
   for (size_t v = 0; v < input.names.size(); ++v) {
     views.push_back({input.names[v], input.cameras[v],
@@ -74,10 +70,7 @@ int runBag(const std::vector<std::string>& args) {
                    "Writes calibrated views as a ROS bag for `rosbag play`: per view, tf\n"
                    "(world -> camera), /camera/image, /camera/silhouette, /camera/camera_info,\n"
                    "and the pair (view, next view) on /stereo/left/image and /stereo/right/image.");
-  parser.addOption("calib", "FILE", "Middlebury par file or projection list");
-  parser.addOption("images", "DIR", "directory of the images the calibration names");
-  addSilhouetteOptions(&parser);
-  parser.addOption("views-file", "FILE", "file of image names to use, one per line");
+  addViewSetOptions(&parser);
   parser.addOption("out", "BAG", "bag file to write");
   parser.addOption("rate", "HZ", "views per second", "2");
   parser.addOption("world-frame", "FRAME", "frame of the camera poses", "world");

@@ -8,36 +8,10 @@
 #include "commands.h"
 #include "hull_options.h"
 #include "sift_hull/hull_octomap.h"
-#include "silhouette_options.h"
 
 namespace sift_hull {
 namespace cli {
 namespace {
-
-std::vector<std::string> splitList(const std::string& text) {
-  std::vector<std::string> items;
-  std::istringstream in(text);
-  std::string item;
-  while (std::getline(in, item, ',')) {
-    if (!item.empty()) items.push_back(item);
-  }
-  return items;
-}
-
-std::vector<std::string> viewNamesFromArgs(const ArgParser& parser) {
-  if (parser.has("views") && parser.has("views-file")) {
-    throw UsageError("give --views or --views-file, not both");
-  }
-  if (parser.has("views")) return splitList(parser.get("views"));
-  if (parser.has("views-file")) return readViewList(parser.get("views-file"));
-  return {};
-}
-
-HullInput inputFromArgs(const ArgParser& parser) {
-  const std::string masks = parser.has("silhouettes") ? parser.get("silhouettes") : "";
-  return loadHullInput(parser.get("calib"), parser.get("images"), masks,
-                       silhouetteConfigFromArgs(parser), viewNamesFromArgs(parser));
-}
 
 void writeOutputs(const ArgParser& parser, const HullResult& result,
                   const octomap::OcTree& octree) {
@@ -69,11 +43,7 @@ int runHull(const std::vector<std::string>& args) {
   ArgParser parser("hull",
                    "Visual hull of calibrated silhouettes: bounding box by linear programming,\n"
                    "octree carving with signed distances, marching cubes.");
-  parser.addOption("calib", "FILE", "Middlebury par file or projection list");
-  parser.addOption("images", "DIR", "directory of the images the calibration names");
-  addSilhouetteOptions(&parser);
-  parser.addOption("views", "LIST", "comma-separated image names to use (default: all)");
-  parser.addOption("views-file", "FILE", "file of image names to use, one per line");
+  addViewSetOptions(&parser);
   addHullOptions(&parser);
   parser.addOption("out-mesh", "PLY", "write the mesh (binary PLY, world coordinates)");
   parser.addOption("out-octree", "BT", "write the OctoMap (.bt)");
@@ -82,7 +52,7 @@ int runHull(const std::vector<std::string>& args) {
   if (!parser.parse(args)) return 0;
 
   const HullConfig config = hullConfigFromArgs(parser);
-  const HullResult result = buildHull(inputFromArgs(parser), config, boxFromArgs(parser));
+  const HullResult result = buildHull(viewSetFromArgs(parser), config, boxFromArgs(parser));
   const double hull_peak_mib = peakMemoryMiB();
   const std::unique_ptr<octomap::OcTree> octree = toOctomap(result.hull);
   const ReprojectionIoU iou = reprojectionIoU(result.mesh, result.hull.views());

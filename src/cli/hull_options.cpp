@@ -2,13 +2,48 @@
 
 #include <sstream>
 
+#include "silhouette_options.h"
+
 namespace sift_hull {
 namespace cli {
 namespace {
 
 nlohmann::json vectorJson(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 
+std::vector<std::string> splitList(const std::string& text) {
+  std::vector<std::string> items;
+  std::istringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    if (!item.empty()) items.push_back(item);
+  }
+  return items;
+}
+
+std::vector<std::string> viewNamesFromArgs(const ArgParser& parser) {
+  if (parser.has("views") && parser.has("views-file")) {
+    throw UsageError("give --views or --views-file, not both");
+  }
+  if (parser.has("views")) return splitList(parser.get("views"));
+  if (parser.has("views-file")) return readViewList(parser.get("views-file"));
+  return {};
+}
+
 }  // namespace
+
+void addViewSetOptions(ArgParser* parser) {
+  parser->addOption("calib", "FILE", "Middlebury par file or projection list");
+  parser->addOption("images", "DIR", "directory of the images the calibration names");
+  addSilhouetteOptions(parser);
+  parser->addOption("views", "LIST", "comma-separated image names to use (default: all)");
+  parser->addOption("views-file", "FILE", "file of image names to use, one per line");
+}
+
+HullInput viewSetFromArgs(const ArgParser& parser) {
+  const std::string masks = parser.has("silhouettes") ? parser.get("silhouettes") : "";
+  return loadHullInput(parser.get("calib"), parser.get("images"), masks,
+                       silhouetteConfigFromArgs(parser), viewNamesFromArgs(parser));
+}
 
 void addHullOptions(ArgParser* parser) {
   const HullConfig defaults;

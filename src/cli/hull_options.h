@@ -10,6 +10,12 @@
 namespace sift_hull {
 namespace cli {
 
+/// --calib, --images, the silhouette options and --views / --views-file: a calibrated view set
+/// with silhouettes, as `hull` and `bag` take it.
+void addViewSetOptions(ArgParser* parser);
+/// The views those options name (all when neither --views nor --views-file is given).
+HullInput viewSetFromArgs(const ArgParser& parser);
+
 /// --depth, --carve-outside-image, --slack, --threads, with HullConfig's defaults.
 void addHullOptions(ArgParser* parser);
 HullConfig hullConfigFromArgs(const ArgParser& parser);
