@@ -23,13 +23,7 @@ HullInput sceneInput(const std::string& shape, int views, const std::string& lay
   config.layout = layout;
   config.width_px = 320;
   config.height_px = 240;
-  HullInput input;
-  for (const RenderedView& view : renderScene(config)) {
-    input.names.push_back(view.view.name);
-    input.cameras.push_back(view.view.camera);
-    input.masks.push_back(view.mask);
-  }
-  return input;
+  return hullInputOf(renderScene(config));
 }
 
 HullConfig depth(int max_depth) {
@@ -57,8 +51,8 @@ TEST(SignedDistanceMap, FollowsTheDiscsDistanceNearItAndBoundsItFarAway) {
   for (double u = -20; u < 140; u += 3.7) {
     for (double v = -20; v < 120; v += 2.9) {
       const double expected = std::hypot(u - centre.x, v - centre.y) - radius;
-      const bool near = std::abs(u - centre.x) < radius + padding &&
-                        std::abs(v - centre.y) < radius + padding;
+      const bool near =
+          std::abs(u - centre.x) < radius + padding && std::abs(v - centre.y) < radius + padding;
       if (near) {
         EXPECT_NEAR(map.at(u, v), expected, 1.0) << "at " << u << ", " << v;
       } else {  // a lower bound, and outside

@@ -18,6 +18,7 @@
 #include <sstream>
 
 #include "../src/ros/conversions.h"
+#include "ros_wait.h"
 #include "sift_hull/Octomap.h"
 #include "sift_hull/hull_octomap.h"
 #include "sift_hull/hull_pipeline.h"
@@ -26,18 +27,10 @@
 namespace sift_hull {
 namespace {
 
-constexpr double kDeadline_s = 30.0;
-constexpr int kViews = 8;
+using test::kDeadline_s;
+using test::waitFor;
 
-bool waitFor(const std::function<bool()>& done, double seconds = kDeadline_s) {
-  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(seconds);
-  while (ros::ok() && ros::WallTime::now() < deadline) {
-    ros::spinOnce();
-    if (done()) return true;
-    ros::WallDuration(0.01).sleep();
-  }
-  return done();
-}
+constexpr int kViews = 8;
 
 std::vector<RenderedView> sphereViews() {
   SceneConfig config;
@@ -130,12 +123,7 @@ TEST_F(HullNodeTest, CarvesTheSphereResetsAndSurvivesBadInput) {
 
   // The node's hull equals the offline one of the same views in the box of the first two (the
   // first views whose LP bounds a box), and is near the sphere.
-  HullInput input;
-  for (const RenderedView& view : views_) {
-    input.names.push_back(view.view.name);
-    input.cameras.push_back(view.view.camera);
-    input.masks.push_back(view.mask);
-  }
+  const HullInput input = hullInputOf(views_);
   HullConfig config;
   config.max_depth = 6;
   const std::vector<HullView> first_two =

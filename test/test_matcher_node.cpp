@@ -13,6 +13,7 @@
 #include <functional>
 
 #include "../src/ros/conversions.h"
+#include "ros_wait.h"
 #include "sift_hull/Correspondences.h"
 #include "sift_hull/evaluation.h"
 #include "sift_hull/scene.h"
@@ -20,17 +21,8 @@
 namespace sift_hull {
 namespace {
 
-constexpr double kDeadline_s = 30.0;
-
-bool waitFor(const std::function<bool()>& done, double seconds = kDeadline_s) {
-  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(seconds);
-  while (ros::ok() && ros::WallTime::now() < deadline) {
-    ros::spinOnce();
-    if (done()) return true;
-    ros::WallDuration(0.01).sleep();
-  }
-  return done();
-}
+using test::kDeadline_s;
+using test::waitFor;
 
 sensor_msgs::Image bgrImage(const cv::Mat& image, const ros::Time& stamp,
                             const std::string& frame) {

@@ -6,6 +6,7 @@
 
 #include "sift_hull/dataset.h"
 #include "sift_hull/mesh.h"
+#include "sift_hull/scene.h"
 #include "sift_hull/visual_hull.h"
 
 namespace sift_hull {
@@ -23,6 +24,9 @@ struct HullInput {
 HullInput loadHullInput(const std::string& calibration_path, const std::string& image_directory,
                         const std::string& mask_directory, const SilhouetteConfig& recipe,
                         const std::vector<std::string>& view_names);
+
+/// The names, cameras and masks of rendered views.
+HullInput hullInputOf(const std::vector<RenderedView>& views);
 
 /// Image names listed in a file, one per line; blank lines and '#' comments skipped.
 std::vector<std::string> readViewList(const std::string& path);

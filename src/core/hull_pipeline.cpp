@@ -49,6 +49,16 @@ HullInput loadHullInput(const std::string& calibration_path, const std::string& 
   return input;
 }
 
+HullInput hullInputOf(const std::vector<RenderedView>& views) {
+  HullInput input;
+  for (const RenderedView& view : views) {
+    input.names.push_back(view.view.name);
+    input.cameras.push_back(view.view.camera);
+    input.masks.push_back(view.mask);
+  }
+  return input;
+}
+
 std::vector<std::string> readViewList(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw std::runtime_error(path + ": view list missing or unreadable");
