@@ -29,6 +29,10 @@ struct DenseGrid {
   Eigen::Vector3d centre(int i, int j, int k) const {
     return origin_W + (Eigen::Vector3d(i, j, k) + Eigen::Vector3d::Constant(0.5)) * voxel_m;
   }
+  /// Position of voxel (i, j, k) in `occupied`.
+  size_t index(int i, int j, int k) const {
+    return (static_cast<size_t>(k) * cells + j) * cells + i;
+  }
   size_t occupiedCount() const;
   /// Bounds of the occupied voxels (whole voxels); an empty box at the origin when none is.
   Box3d occupiedBounds() const;

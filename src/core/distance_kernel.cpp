@@ -41,14 +41,16 @@ Projected project(const DistanceKernel& k, float X, float Y, float Z) {
 
 /// |d(K x/z)| <= ||K_2x2|| |X_C| r / (z (z - r)) for any offset of length <= r: the ball's image
 /// lies in this disc around the projected centre, and the distance is 1-Lipschitz in pixels.
-uint32_t judgeBall(const DistanceKernel& k, const Projected& p, float radius, bool want_out) {
+/// Sets bit `i` of `out_bits` / `in_bits` when all of the ball is outside / inside.
+void judgeBall(const DistanceKernel& k, const Projected& p, float radius, size_t i,
+               uint32_t* out_bits, uint32_t* in_bits) {
   const float clearance = p.z - radius;
   const bool ahead = clearance > 0.0f;
   const float norm = std::sqrt(p.x * p.x + p.y * p.y + p.z * p.z);
   const float projected_radius =
       k.k_norm * norm * radius / (ahead ? p.z * clearance : 1.0f) + k.slack_px;
-  return want_out ? ahead && p.value - projected_radius > 0.0f
-                  : ahead && p.value + projected_radius < 0.0f;
+  *out_bits |= static_cast<uint32_t>(ahead && p.value - projected_radius > 0.0f) << i;
+  *in_bits |= static_cast<uint32_t>(ahead && p.value + projected_radius < 0.0f) << i;
 }
 
 /// Scalar verdicts of centres [first, count), as bits from `first` on.
@@ -57,8 +59,7 @@ void classifyBallsScalar(const DistanceKernel& k, const PointBatch& centres, siz
   for (size_t i = first; i < centres.count; ++i) {
     const Projected p = project(k, centres.x[i], centres.y[i], centres.z[i]);
     values[i] = std::max(values[i], p.value);
-    *out_bits |= judgeBall(k, p, radius, true) << i;
-    *in_bits |= judgeBall(k, p, radius, false) << i;
+    judgeBall(k, p, radius, i, out_bits, in_bits);
   }
 }
 

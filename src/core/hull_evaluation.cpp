@@ -16,7 +16,7 @@ void carveSlice(const std::vector<HullView>& views, int k, DenseGrid* grid) {
       const Eigen::Vector3d centre = grid->centre(i, j, k);
       const bool kept = std::all_of(views.begin(), views.end(),
                                     [&](const HullView& view) { return view.keeps(centre); });
-      grid->occupied[(static_cast<size_t>(k) * grid->cells + j) * grid->cells + i] = kept;
+      grid->occupied[grid->index(i, j, k)] = kept;
     }
   }
 }
@@ -53,7 +53,7 @@ Box3d DenseGrid::occupiedBounds() const {
   for (int k = 0; k < cells; ++k) {
     for (int j = 0; j < cells; ++j) {
       for (int i = 0; i < cells; ++i) {
-        if (!occupied[(static_cast<size_t>(k) * cells + j) * cells + i]) continue;
+        if (!occupied[index(i, j, k)]) continue;
         low = low.cwiseMin(Eigen::Vector3i(i, j, k));
         high = high.cwiseMax(Eigen::Vector3i(i, j, k));
       }
@@ -93,8 +93,7 @@ double volumeIoU(const VisualHull& hull, const DenseGrid& dense) {
         const CellState state = hull.leafAt(centre).state;
         const bool in_hull = state == CellState::kIn ||
                              (state == CellState::kSurface && hull.valueAt(centre) <= 0.0f);
-        const bool in_dense =
-            dense.occupied[(static_cast<size_t>(k) * dense.cells + j) * dense.cells + i];
+        const bool in_dense = dense.occupied[dense.index(i, j, k)];
         both += in_hull && in_dense;
         either += in_hull || in_dense;
       }
