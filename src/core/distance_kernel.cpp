@@ -27,15 +27,10 @@ Projected project(const DistanceKernel& k, float X, float Y, float Z) {
   const bool in_front = p.z > 0.0f;
   const float inverse_depth = 1.0f / (in_front ? p.z : 1.0f);
   const float x = p.x * inverse_depth, y = p.y * inverse_depth;
-  const float u = std::min(std::max(k.fx * x + k.skew * y + k.cx + k.offset_u, 0.0f), k.u_high);
-  const float v = std::min(std::max(k.fy * y + k.cy + k.offset_v, 0.0f), k.v_high);
-  const int u0 = static_cast<int>(u), v0 = static_cast<int>(v);
-  const float fu = u - u0, fv = v - v0;
-  const float* top = k.map + v0 * k.stride + u0;
-  const float* bottom = top + k.stride;
-  const float upper = top[0] + fu * (top[1] - top[0]);
-  const float lower = bottom[0] + fu * (bottom[1] - bottom[0]);
-  p.value = in_front ? upper + fv * (lower - upper) : k.behind_value;
+  const float value =
+      lookUp(k.map, k.stride, k.u_high, k.v_high, k.fx * x + k.skew * y + k.cx + k.offset_u,
+             k.fy * y + k.cy + k.offset_v);
+  p.value = in_front ? value : k.behind_value;
   return p;
 }
 

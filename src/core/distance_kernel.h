@@ -1,11 +1,30 @@
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 
 #include "sift_hull/visual_hull.h"
 
 namespace sift_hull {
 namespace detail {
+
+/// The highest map coordinate a look-up uses: short of the last column / row, so that the next
+/// one exists.
+inline float lookUpLimit(int size) { return size - 1 - 1.0f / 512; }
+
+/// Bilinear look-up of a row-major float map at map coordinates (u, v), clamped to
+/// [0, u_high] x [0, v_high]. The AVX2 path (distance_kernel.cpp) does the same operations.
+inline float lookUp(const float* map, int stride, float u_high, float v_high, float u, float v) {
+  u = std::min(std::max(u, 0.0f), u_high);
+  v = std::min(std::max(v, 0.0f), v_high);
+  const int u0 = static_cast<int>(u), v0 = static_cast<int>(v);
+  const float fu = u - u0, fv = v - v0;
+  const float* top = map + v0 * stride + u0;
+  const float* bottom = top + stride;
+  const float upper = top[0] + fu * (top[1] - top[0]);
+  const float lower = bottom[0] + fu * (bottom[1] - bottom[0]);
+  return upper + fv * (lower - upper);
+}
 
 /// values[i] = max(values[i], distance look-up of point i) for one view (HullView::maxInto).
 void maxDistances(const DistanceKernel& kernel, const PointBatch& points, float* values);

@@ -98,16 +98,10 @@ SignedDistanceMap::SignedDistanceMap(const cv::Mat& mask, const SilhouetteBounds
 }
 
 float SignedDistanceMap::at(double u_px, double v_px) const {
-  const double u = std::clamp(u_px - origin_.x, 0.0, distance_px_.cols - 1.0);
-  const double v = std::clamp(v_px - origin_.y, 0.0, distance_px_.rows - 1.0);
-  const int u0 = std::min(static_cast<int>(u), distance_px_.cols - 2);
-  const int v0 = std::min(static_cast<int>(v), distance_px_.rows - 2);
-  const float fu = static_cast<float>(u - u0), fv = static_cast<float>(v - v0);
-  const float* top = distance_px_.ptr<float>(v0) + u0;
-  const float* bottom = distance_px_.ptr<float>(v0 + 1) + u0;
-  const float upper = top[0] + fu * (top[1] - top[0]);
-  const float lower = bottom[0] + fu * (bottom[1] - bottom[0]);
-  return upper + fv * (lower - upper);
+  return detail::lookUp(distance_px_.ptr<float>(), distance_px_.cols,
+                        detail::lookUpLimit(distance_px_.cols),
+                        detail::lookUpLimit(distance_px_.rows),
+                        static_cast<float>(u_px - origin_.x), static_cast<float>(v_px - origin_.y));
 }
 
 void validate(const HullConfig& config) {
@@ -147,8 +141,7 @@ detail::DistanceKernel HullView::makeKernel(const HullConfig& config) const {
   kernel.stride = map.cols;
   kernel.offset_u = static_cast<float>(-distance_.origin().x);
   kernel.offset_v = static_cast<float>(-distance_.origin().y);
-  // Short of the last column / row, so that the right / lower neighbour of a look-up exists.
-  kernel.u_high = map.cols - 1 - 1.0f / 512, kernel.v_high = map.rows - 1 - 1.0f / 512;
+  kernel.u_high = detail::lookUpLimit(map.cols), kernel.v_high = detail::lookUpLimit(map.rows);
   return kernel;
 }
 
