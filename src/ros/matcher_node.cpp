@@ -3,6 +3,7 @@
 #include <cv_bridge/cv_bridge.h>
 #include <tf2_eigen/tf2_eigen.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <nlohmann/json.hpp>
@@ -247,16 +248,17 @@ sift_hull::Correspondences MatcherNode::message(const sensor_msgs::Image& left,
   out.right_header = right.header;
   for (const auto& filter : filters_) out.filters.push_back(filter->name());
   out.filter_settings = settings_json_;
+  const auto gsc = std::find(out.filters.begin(), out.filters.end(), "gsc");
+  const FilterResult* gsc_result =
+      gsc == out.filters.end() ? nullptr : &results[gsc - out.filters.begin()];
   for (size_t m = 0; m < matches.matches.size(); ++m) {
-    const cv::DMatch& match = matches.matches[m];
     sift_hull::Correspondence correspondence;
-    correspondence.left = keypointMessage(matches.left_keypoints[match.queryIdx]);
-    correspondence.right = keypointMessage(matches.right_keypoints[match.trainIdx]);
-    correspondence.descriptor_distance = match.distance;
-    correspondence.gsc_score = std::nanf("");
+    correspondence.left = keypointMessage(matches.left(m));
+    correspondence.right = keypointMessage(matches.right(m));
+    correspondence.descriptor_distance = matches.matches[m].distance;
+    correspondence.gsc_score = gsc_result ? gsc_result->score[m] : std::nanf("");
     for (size_t f = 0; f < results.size(); ++f) {
       if (results[f].keep[m]) correspondence.kept_by |= 1u << f;
-      if (out.filters[f] == "gsc") correspondence.gsc_score = results[f].score[m];
     }
     out.matches.push_back(correspondence);
   }
