@@ -6,6 +6,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
+#include "../ros/bag_topics.h"
 #include "../ros/conversions.h"
 #include "args.h"
 #include "commands.h"
@@ -16,13 +17,7 @@ namespace sift_hull {
 namespace cli {
 namespace {
 
-/// Topics and frames of the bags this command writes.
-constexpr const char* kCameraFrame = "camera";
-constexpr const char* kImageTopic = "/camera/image";
-constexpr const char* kSilhouetteTopic = "/camera/silhouette";
-constexpr const char* kInfoTopic = "/camera/camera_info";
-constexpr const char* kLeftTopic = "/stereo/left/image";
-constexpr const char* kRightTopic = "/stereo/right/image";
+using bag_topics::kCameraFrame;
 
 struct BagView {
   std::string name;
@@ -51,15 +46,15 @@ void writeView(rosbag::Bag* bag, const std::vector<BagView>& views, size_t v,
   std_msgs::Header header;
   header.stamp = stamp;
   header.frame_id = kCameraFrame;
-  bag->write(kImageTopic, stamp, ros_conversions::imageMessage(view.image, header));
-  bag->write(kSilhouetteTopic, stamp, ros_conversions::imageMessage(view.mask, header));
-  bag->write(kInfoTopic, stamp,
+  bag->write(bag_topics::kImage, stamp, ros_conversions::imageMessage(view.image, header));
+  bag->write(bag_topics::kSilhouette, stamp, ros_conversions::imageMessage(view.mask, header));
+  bag->write(bag_topics::kCameraInfo, stamp,
              ros_conversions::cameraInfoMessage(view.camera, view.mask.size(), header));
   // The stereo pair for the matcher: this view and the next one round the ring.
   header.frame_id = "left";
-  bag->write(kLeftTopic, stamp, ros_conversions::imageMessage(view.image, header));
+  bag->write(bag_topics::kLeftImage, stamp, ros_conversions::imageMessage(view.image, header));
   header.frame_id = "right";
-  bag->write(kRightTopic, stamp,
+  bag->write(bag_topics::kRightImage, stamp,
              ros_conversions::imageMessage(views[(v + 1) % views.size()].image, header));
 }
 

@@ -90,8 +90,8 @@ void MatcherNode::serveReconfigure() {
   config.magsac_max_epipolar_px = settings_.filters.magsac.max_epipolar_px;
   config.max_epipolar_px = settings_.filters.epipolar.max_epipolar_px;
   config.gms_threshold_factor = settings_.filters.gms.threshold_factor;
-  reconfigure_ =
-      std::make_unique<dynamic_reconfigure::Server<sift_hull::MatcherConfig>>(private_nh_);
+  reconfigure_ = std::make_unique<dynamic_reconfigure::Server<sift_hull::MatcherConfig>>(
+      reconfigure_mutex_, private_nh_);
   reconfigure_->updateConfig(config);
   reconfigure_->setCallback(
       [this](sift_hull::MatcherConfig& changed, uint32_t level) { onReconfigure(changed, level); });

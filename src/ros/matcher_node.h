@@ -13,6 +13,7 @@
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
 
+#include <boost/thread/recursive_mutex.hpp>
 #include <memory>
 #include <string>
 #include <vector>
@@ -103,6 +104,7 @@ class MatcherNode {
   std::vector<std::unique_ptr<MatchFilter>> filters_;
   std::string settings_json_;
   ThrottledLog log_;
+  boost::recursive_mutex reconfigure_mutex_;  // the server's, so updateConfig cannot race it
   std::unique_ptr<dynamic_reconfigure::Server<sift_hull::MatcherConfig>> reconfigure_;
   image_transport::ImageTransport transport_;
   image_transport::SubscriberFilter left_sub_, right_sub_;

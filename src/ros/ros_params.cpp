@@ -113,5 +113,17 @@ MatcherSettings readMatcherSettings(const ros::NodeHandle& private_nh) {
   return settings;
 }
 
+ResultSaverConfig readResultSaverConfig(const ros::NodeHandle& private_nh) {
+  ResultSaverConfig config;
+  private_nh.param("bag", config.bag, config.bag);
+  private_nh.param("out_dir", config.out_dir, config.out_dir);
+  private_nh.param("hull_save_service", config.hull_save_service, config.hull_save_service);
+  private_nh.param("timeout_s", config.timeout_s, config.timeout_s);
+  if (config.bag.empty() || config.out_dir.empty()) {
+    throw std::invalid_argument("~bag and ~out_dir are required");
+  }
+  return config;
+}
+
 }  // namespace ros_params
 }  // namespace sift_hull

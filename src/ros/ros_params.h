@@ -5,6 +5,7 @@
 #include <ros/node_handle.h>
 
 #include "matcher_node.h"
+#include "result_saver.h"
 #include "sift_hull/dataset.h"
 #include "sift_hull/hull_stream.h"
 
@@ -36,6 +37,10 @@ FilterConfigs readFilterConfigs(const ros::NodeHandle& private_nh);
 /// The readers above and ~filters, ~queue_size, ~approximate_sync, ~calibrated,
 /// ~frame_to_frame.
 MatcherSettings readMatcherSettings(const ros::NodeHandle& private_nh);
+
+/// ~bag, ~out_dir (both required: throws std::invalid_argument without them),
+/// ~hull_save_service, ~timeout_s.
+ResultSaverConfig readResultSaverConfig(const ros::NodeHandle& private_nh);
 
 }  // namespace ros_params
 }  // namespace sift_hull

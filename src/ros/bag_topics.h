@@ -1,0 +1,15 @@
+#pragma once
+
+namespace sift_hull {
+
+/// Topics and frames of the bags `sift_hull bag` writes, which launch/demo.launch plays.
+namespace bag_topics {
+constexpr const char* kCameraFrame = "camera";
+constexpr const char* kImage = "/camera/image";
+constexpr const char* kSilhouette = "/camera/silhouette";
+constexpr const char* kCameraInfo = "/camera/camera_info";
+constexpr const char* kLeftImage = "/stereo/left/image";
+constexpr const char* kRightImage = "/stereo/right/image";
+}  // namespace bag_topics
+
+}  // namespace sift_hull

@@ -1,0 +1,36 @@
+// save_results: waits until the hull and matcher nodes have processed every view of a bag being
+// played, saves what they made of it into ~out_dir, and exits (0 when everything arrived).
+
+#include <ros/ros.h>
+
+#include "result_saver.h"
+#include "ros_params.h"
+
+int main(int argc, char** argv) {
+  ros::init(argc, argv, "save_results");
+  ros::NodeHandle nh, private_nh("~");
+  try {
+    const sift_hull::ResultSaverConfig config =
+        sift_hull::ros_params::readResultSaverConfig(private_nh);
+    sift_hull::ResultSaver saver(nh, config, sift_hull::readBagEnd(config.bag));
+    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(config.timeout_s);
+    ros::WallRate rate(20.0);
+    while (ros::ok() && !saver.complete() && ros::WallTime::now() < deadline) {
+      ros::spinOnce();
+      rate.sleep();
+    }
+    if (!ros::ok()) return 1;
+    if (!saver.complete()) {
+      ROS_ERROR(
+          "save_results: the bag's last view or pair did not come through in %.0f s; "
+          "saving what there is",
+          config.timeout_s);
+    }
+    const nlohmann::json summary = saver.save();
+    ROS_INFO("save_results: wrote %s/summary.json", config.out_dir.c_str());
+    return summary["complete"].get<bool>() ? 0 : 1;
+  } catch (const std::exception& e) {
+    ROS_FATAL("save_results: %s", e.what());
+    return 1;
+  }
+}
