@@ -53,12 +53,10 @@ inline std::string temporaryDirectory() {
   return pattern;
 }
 
-/// Runs the sift_hull program with `arguments` (shell words); returns its exit code, its stdout in
-/// `out` and its stderr in `err`.
-inline int runProgram(const std::string& arguments, std::string* out, std::string* err) {
+/// Runs a shell command line; returns its exit code, its stdout in `out` and its stderr in `err`.
+inline int runCommand(const std::string& command_line, std::string* out, std::string* err) {
   const std::string dir = temporaryDirectory();
-  const std::string command =
-      std::string(SIFT_HULL_EXECUTABLE) + " " + arguments + " >" + dir + "/out 2>" + dir + "/err";
+  const std::string command = command_line + " >" + dir + "/out 2>" + dir + "/err";
   const int status = std::system(command.c_str());
   const auto slurp = [](const std::string& path) {
     std::ifstream in(path);
@@ -67,6 +65,11 @@ inline int runProgram(const std::string& arguments, std::string* out, std::strin
   *out = slurp(dir + "/out");
   *err = slurp(dir + "/err");
   return WEXITSTATUS(status);
+}
+
+/// Runs the sift_hull program with `arguments` (shell words), as runCommand.
+inline int runProgram(const std::string& arguments, std::string* out, std::string* err) {
+  return runCommand(std::string(SIFT_HULL_EXECUTABLE) + " " + arguments, out, err);
 }
 
 }  // namespace test

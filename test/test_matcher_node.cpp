@@ -111,8 +111,14 @@ TEST_F(MatcherNodeTest, MatchesAPairWithTheInputStampsAndGoodPrecision) {
 
 TEST_F(MatcherNodeTest, RefusesBadPairsAndCarriesOn) {
   const cv::Mat black = cv::Mat::zeros(left_.image.size(), CV_8UC3);
-  publishPair(black, black);            // fewer than two keypoints
-  publishPair(left_.image, cv::Mat());  // a left image without its right partner
+  publishPair(black, black);             // fewer than two keypoints
+  publishPair(left_.image, cv::Mat());   // a left image without its right partner
+  publishPair(cv::Mat(), right_.image);  // a right image without its left partner
+  sensor_msgs::Image empty = bgrImage(left_.image, ros::Time::now(), "left");
+  empty.width = empty.height = empty.step = 0;  // an empty image
+  empty.data.clear();
+  left_pub_.publish(empty);
+  right_pub_.publish(bgrImage(right_.image, empty.header.stamp, "right"));
   sensor_msgs::Image depth = bgrImage(right_.image, ros::Time::now(), "right");
   depth.encoding = "16UC1";  // not an 8-bit image
   depth.step = right_.image.cols * 2;
