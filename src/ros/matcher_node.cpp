@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "conversions.h"
+#include "node_diagnostics.h"
 #include "ros_params.h"
 #include "sift_hull/match_drawing.h"
 
@@ -67,16 +68,33 @@ MatcherNode::MatcherNode(ros::NodeHandle nh, ros::NodeHandle private_nh, Matcher
     : nh_(nh),
       private_nh_(private_nh),
       settings_(std::move(settings)),
-      filters_(makeFilters(settings_)),
-      settings_json_(settingsJson(settings_)),
+      pipeline_(std::make_shared<const Pipeline>(
+          Pipeline{settings_, makeFilters(settings_), settingsJson(settings_)})),
       transport_(nh_),
-      tf_listener_(tf_buffer_) {
-  subscribe();
-  serveReconfigure();
-  correspondences_pub_ =
-      nh_.advertise<sift_hull::Correspondences>("correspondences", settings_.node.queue_size);
+      correspondences_pub_(
+          nh_.advertise<sift_hull::Correspondences>("correspondences", settings_.node.queue_size)),
+      matches_image_pub_(transport_.advertise("matches_image", 1)),
+      tf_listener_(tf_buffer_),
+      work_(settings_.node.max_waiting_pairs, settings_.node.workers,
+            [this](Pair& pair) { matchPair(pair); }),
+      diagnostics_(nh_, private_nh_, private_nh_.getNamespace()) {
   if (settings_.node.calibrated) points_pub_ = nh_.advertise<sensor_msgs::PointCloud2>("points", 1);
-  matches_image_pub_ = transport_.advertise("matches_image", 1);
+  diagnostics_.setHardwareID("none");
+  diagnostics_.add("matcher", this, &MatcherNode::reportDiagnostics);
+  diagnostics_timer_ = nh_.createWallTimer(
+      ros::WallDuration(1.0), [this](const ros::WallTimerEvent&) { diagnostics_.update(); });
+  serveReconfigure();
+  subscribe();
+}
+
+std::shared_ptr<const MatcherNode::Pipeline> MatcherNode::pipeline() const {
+  std::lock_guard<std::mutex> lock(pipeline_mutex_);
+  return pipeline_;
+}
+
+void MatcherNode::reportDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  reportQueue(work_.counts(), "pairs", &status);
+  status.add("last pair ms", last_pair_ms_.load());
 }
 
 void MatcherNode::serveReconfigure() {
@@ -98,7 +116,7 @@ void MatcherNode::serveReconfigure() {
 }
 
 void MatcherNode::onReconfigure(sift_hull::MatcherConfig& config, uint32_t) {
-  MatcherSettings changed = settings_;
+  MatcherSettings changed = pipeline()->settings;
   changed.matching.ratio = config.ratio;
   changed.matching.max_descriptor_distance = config.max_descriptor_distance > 0.0
                                                  ? config.max_descriptor_distance
@@ -109,16 +127,18 @@ void MatcherNode::onReconfigure(sift_hull::MatcherConfig& config, uint32_t) {
   changed.filters.magsac.max_epipolar_px = config.magsac_max_epipolar_px;
   changed.filters.epipolar.max_epipolar_px = config.max_epipolar_px;
   changed.filters.gms.threshold_factor = config.gms_threshold_factor;
+  std::shared_ptr<const Pipeline> replacement;
   try {
     validate(changed.matching);
     validate(changed.filters);
-    filters_ = makeFilters(changed);
+    replacement = std::make_shared<const Pipeline>(
+        Pipeline{changed, makeFilters(changed), settingsJson(changed)});
   } catch (const std::invalid_argument& e) {
     log_.error("matcher: reconfiguration refused: ", e.what());
     return;
   }
-  settings_ = changed;
-  settings_json_ = settingsJson(settings_);
+  std::lock_guard<std::mutex> lock(pipeline_mutex_);
+  pipeline_ = std::move(replacement);
 }
 
 void MatcherNode::subscribe() {
@@ -152,9 +172,7 @@ void MatcherNode::onCalibratedPair(const sensor_msgs::ImageConstPtr& left,
                                    const sensor_msgs::ImageConstPtr& right,
                                    const sensor_msgs::CameraInfoConstPtr& left_info,
                                    const sensor_msgs::CameraInfoConstPtr& right_info) {
-  StereoCameras cameras;
-  if (!stereoCameras(*left, *right, *left_info, *right_info, &cameras)) return;
-  process(left, right, &cameras);
+  enqueue({left, right, left_info, right_info});
 }
 
 bool MatcherNode::stereoCameras(const Image& left, const Image& right, const Info& left_info,
@@ -185,16 +203,42 @@ void MatcherNode::onFrame(const sensor_msgs::ImageConstPtr& frame) {
     log_.error("matcher: frame ignored: ", "its stamp is not after the previous frame's");
     return;
   }
-  if (previous_frame_) process(previous_frame_, frame, nullptr);
+  if (previous_frame_) enqueue({previous_frame_, frame, nullptr, nullptr});
   previous_frame_ = frame;
 }
 
 void MatcherNode::onPair(const sensor_msgs::ImageConstPtr& left,
                          const sensor_msgs::ImageConstPtr& right) {
-  process(left, right, nullptr);
+  enqueue({left, right, nullptr, nullptr});
 }
 
-void MatcherNode::process(const sensor_msgs::ImageConstPtr& left,
+void MatcherNode::enqueue(Pair pair) {
+  if (!work_.push(std::move(pair))) {
+    ROS_WARN_THROTTLE(5.0,
+                      "matcher: %llu pair(s) dropped so far: pairs come faster than %d "
+                      "worker(s) match them (~max_waiting_pairs: %d)",
+                      static_cast<unsigned long long>(work_.counts().dropped),
+                      settings_.node.workers, settings_.node.max_waiting_pairs);
+  }
+}
+
+void MatcherNode::matchPair(Pair& pair) {
+  const ros::WallTime start = ros::WallTime::now();
+  try {
+    StereoCameras cameras;
+    const bool calibrated = pair.left_info && pair.right_info;
+    if (calibrated &&
+        !stereoCameras(*pair.left, *pair.right, *pair.left_info, *pair.right_info, &cameras)) {
+      return;
+    }
+    process(*pipeline(), pair.left, pair.right, calibrated ? &cameras : nullptr);
+  } catch (const std::exception& e) {
+    log_.error("matcher: pair failed: ", e.what());
+  }
+  last_pair_ms_ = (ros::WallTime::now() - start).toSec() * 1e3;
+}
+
+void MatcherNode::process(const Pipeline& pipeline, const sensor_msgs::ImageConstPtr& left,
                           const sensor_msgs::ImageConstPtr& right, const StereoCameras* cameras) {
   std::string why_not;
   const cv::Mat left_image = ros_conversions::eightBitImage(left, &why_not);
@@ -205,7 +249,7 @@ void MatcherNode::process(const sensor_msgs::ImageConstPtr& left,
     return;
   }
   PutativeMatches matches =
-      matchImages(left_image, right_image, settings_.sift, settings_.matching);
+      matchImages(left_image, right_image, pipeline.settings.sift, pipeline.settings.matching);
   if (matches.left_keypoints.size() < 2 || matches.right_keypoints.size() < 2) {
     log_.error("matcher: pair ignored: ", "fewer than two keypoints in an image (" +
                                               std::to_string(matches.left_keypoints.size()) +
@@ -215,8 +259,8 @@ void MatcherNode::process(const sensor_msgs::ImageConstPtr& left,
   }
   if (cameras != nullptr) matches.F_right_left = fundamentalMatrix(cameras->left, cameras->right);
   std::vector<FilterResult> results;
-  for (const auto& filter : filters_) results.push_back(filter->apply(matches));
-  correspondences_pub_.publish(message(*left, *right, matches, results));
+  for (const auto& filter : pipeline.filters) results.push_back(filter->apply(matches));
+  correspondences_pub_.publish(message(pipeline, *left, *right, matches, results));
   if (cameras != nullptr) publishPoints(left->header, *cameras, matches, results.front());
   if (matches_image_pub_.getNumSubscribers() > 0) {
     const cv::Mat drawing = drawMatchDecisions(left_image, right_image, matches, results.front());
@@ -239,15 +283,16 @@ void MatcherNode::publishPoints(const std_msgs::Header& header, const StereoCame
   points_pub_.publish(ros_conversions::pointCloudMessage(points_L, header));
 }
 
-sift_hull::Correspondences MatcherNode::message(const sensor_msgs::Image& left,
+sift_hull::Correspondences MatcherNode::message(const Pipeline& pipeline,
+                                                const sensor_msgs::Image& left,
                                                 const sensor_msgs::Image& right,
                                                 const PutativeMatches& matches,
-                                                const std::vector<FilterResult>& results) const {
+                                                const std::vector<FilterResult>& results) {
   sift_hull::Correspondences out;
   out.header = left.header;
   out.right_header = right.header;
-  for (const auto& filter : filters_) out.filters.push_back(filter->name());
-  out.filter_settings = settings_json_;
+  for (const auto& filter : pipeline.filters) out.filters.push_back(filter->name());
+  out.filter_settings = pipeline.settings_json;
   const auto gsc = std::find(out.filters.begin(), out.filters.end(), "gsc");
   const FilterResult* gsc_result =
       gsc == out.filters.end() ? nullptr : &results[gsc - out.filters.begin()];

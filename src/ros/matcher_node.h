@@ -1,5 +1,6 @@
 #pragma once
 
+#include <diagnostic_updater/diagnostic_updater.h>
 #include <dynamic_reconfigure/server.h>
 #include <image_transport/image_transport.h>
 #include <image_transport/subscriber_filter.h>
@@ -13,8 +14,10 @@
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
 
+#include <atomic>
 #include <boost/thread/recursive_mutex.hpp>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -25,6 +28,7 @@
 #include "sift_hull/filters.h"
 #include "sift_hull/matching.h"
 #include "throttled_log.h"
+#include "work_queue.h"
 
 namespace sift_hull {
 
@@ -33,7 +37,13 @@ struct MatcherNodeConfig {
   /// Filters to run, by makeFilter name ("gsc", "magsac", "epipolar+gsc", ...). The epipolar
   /// filter needs `calibrated`.
   std::vector<std::string> filters = {"gsc"};
-  int queue_size = 10;            ///< image pairs waiting for their partner
+  int queue_size = 10;  ///< images waiting for their partner
+  /// Paired images waiting for a worker; when more come, the oldest pair is dropped (counted in
+  /// /diagnostics), so a stream faster than matching costs neither memory nor latency.
+  int max_waiting_pairs = 2;
+  /// Threads matching pairs side by side; with more than one, correspondences of pairs close in
+  /// time may be published out of stamp order.
+  int workers = 2;
   bool approximate_sync = false;  ///< pair images by nearest stamps instead of equal ones
   /// Also take left/camera_info and right/camera_info (paired by equal stamps with the images)
   /// and the right camera's pose relative to the left from tf: the epipolar filter's F, and the
@@ -77,6 +87,18 @@ class MatcherNode {
   struct StereoCameras {
     PinholeCamera left, right;
   };
+  /// What pairs are matched with. dynamic_reconfigure replaces it whole, so a pair is matched
+  /// with one consistent set of settings even while they change.
+  struct Pipeline {
+    MatcherSettings settings;
+    std::vector<std::unique_ptr<MatchFilter>> filters;
+    std::string settings_json;
+  };
+  /// A pair waiting for a worker; the camera_infos only with ~calibrated.
+  struct Pair {
+    sensor_msgs::ImageConstPtr left, right;
+    sensor_msgs::CameraInfoConstPtr left_info, right_info;
+  };
 
   void subscribe();
   /// Serves the run-time thresholds (cfg/Matcher.cfg), starting from the node's own settings.
@@ -88,25 +110,39 @@ class MatcherNode {
                         const sensor_msgs::ImageConstPtr& right,
                         const sensor_msgs::CameraInfoConstPtr& left_info,
                         const sensor_msgs::CameraInfoConstPtr& right_info);
-  void process(const sensor_msgs::ImageConstPtr& left, const sensor_msgs::ImageConstPtr& right,
-               const StereoCameras* cameras);
+  void enqueue(Pair pair);
+  void matchPair(Pair& pair);
+  void process(const Pipeline& pipeline, const sensor_msgs::ImageConstPtr& left,
+               const sensor_msgs::ImageConstPtr& right, const StereoCameras* cameras);
+  std::shared_ptr<const Pipeline> pipeline() const;
+  void reportDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& status);
   bool stereoCameras(const Image& left, const Image& right, const Info& left_info,
                      const Info& right_info, StereoCameras* cameras);
   void publishPoints(const std_msgs::Header& header, const StereoCameras& cameras,
                      const PutativeMatches& matches, const FilterResult& kept);
-  sift_hull::Correspondences message(const sensor_msgs::Image& left,
-                                     const sensor_msgs::Image& right,
-                                     const PutativeMatches& matches,
-                                     const std::vector<FilterResult>& results) const;
+  static sift_hull::Correspondences message(const Pipeline& pipeline,
+                                            const sensor_msgs::Image& left,
+                                            const sensor_msgs::Image& right,
+                                            const PutativeMatches& matches,
+                                            const std::vector<FilterResult>& results);
 
+  // Destroyed bottom up: subscriptions first, then the workers, then what they publish with.
   ros::NodeHandle nh_, private_nh_;
-  MatcherSettings settings_;
-  std::vector<std::unique_ptr<MatchFilter>> filters_;
-  std::string settings_json_;
+  const MatcherSettings settings_;  ///< as started; the reconfigurable part lives in pipeline_
+  mutable std::mutex pipeline_mutex_;
+  std::shared_ptr<const Pipeline> pipeline_;
   ThrottledLog log_;
+  image_transport::ImageTransport transport_;
+  ros::Publisher correspondences_pub_, points_pub_;
+  image_transport::Publisher matches_image_pub_;
+  tf2_ros::Buffer tf_buffer_;
+  tf2_ros::TransformListener tf_listener_;
+  std::atomic<double> last_pair_ms_{0.0};
+  WorkQueue<Pair> work_;
+  diagnostic_updater::Updater diagnostics_;
+  ros::WallTimer diagnostics_timer_;
   boost::recursive_mutex reconfigure_mutex_;  // the server's, so updateConfig cannot race it
   std::unique_ptr<dynamic_reconfigure::Server<sift_hull::MatcherConfig>> reconfigure_;
-  image_transport::ImageTransport transport_;
   image_transport::SubscriberFilter left_sub_, right_sub_;
   image_transport::Subscriber frame_sub_;
   sensor_msgs::ImageConstPtr previous_frame_;
@@ -114,10 +150,6 @@ class MatcherNode {
   std::unique_ptr<ApproximateSync> approximate_sync_;
   message_filters::Subscriber<Info> left_info_sub_, right_info_sub_;
   std::unique_ptr<CalibratedSync> calibrated_sync_;
-  tf2_ros::Buffer tf_buffer_;
-  tf2_ros::TransformListener tf_listener_;
-  ros::Publisher correspondences_pub_, points_pub_;
-  image_transport::Publisher matches_image_pub_;
 };
 
 }  // namespace sift_hull

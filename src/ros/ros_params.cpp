@@ -104,6 +104,8 @@ MatcherSettings readMatcherSettings(const ros::NodeHandle& private_nh) {
   MatcherNodeConfig& node = settings.node;
   private_nh.param("filters", node.filters, node.filters);
   private_nh.param("queue_size", node.queue_size, node.queue_size);
+  private_nh.param("max_waiting_pairs", node.max_waiting_pairs, node.max_waiting_pairs);
+  private_nh.param("workers", node.workers, node.workers);
   private_nh.param("approximate_sync", node.approximate_sync, node.approximate_sync);
   private_nh.param("calibrated", node.calibrated, node.calibrated);
   private_nh.param("frame_to_frame", node.frame_to_frame, node.frame_to_frame);

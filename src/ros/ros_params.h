@@ -34,8 +34,8 @@ MatchConfig readMatchConfig(const ros::NodeHandle& private_nh);
 /// ~gms_threshold_factor, ~gms_with_rotation, ~gms_with_scale.
 FilterConfigs readFilterConfigs(const ros::NodeHandle& private_nh);
 
-/// The readers above and ~filters, ~queue_size, ~approximate_sync, ~calibrated,
-/// ~frame_to_frame.
+/// The readers above and ~filters, ~queue_size, ~max_waiting_pairs, ~workers, ~approximate_sync,
+/// ~calibrated, ~frame_to_frame.
 MatcherSettings readMatcherSettings(const ros::NodeHandle& private_nh);
 
 /// ~bag, ~out_dir (both required: throws std::invalid_argument without them),

@@ -1,0 +1,109 @@
+#pragma once
+
+#include <algorithm>
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+namespace sift_hull {
+
+/// What a WorkQueue has seen so far.
+struct WorkCounts {
+  uint64_t pushed = 0;   ///< items queued
+  uint64_t dropped = 0;  ///< items dropped from a full queue, unprocessed
+  uint64_t done = 0;     ///< items processed
+  size_t waiting = 0;    ///< items in the queue now
+};
+
+/// Work handed from subscriber callbacks to worker threads through a queue of bounded length.
+/// When the queue is full, the oldest waiting item is dropped and counted: a callback never waits
+/// for the work, and memory stays bounded however fast the input comes.
+template <typename Item>
+class WorkQueue {
+ public:
+  /// `process` runs on one of `workers` threads; it must not throw.
+  WorkQueue(size_t capacity, int workers, std::function<void(Item&)> process)
+      : capacity_(std::max<size_t>(capacity, 1)), process_(std::move(process)) {
+    for (int i = 0; i < std::max(workers, 1); ++i) workers_.emplace_back([this] { work(); });
+  }
+  WorkQueue(const WorkQueue&) = delete;
+  WorkQueue& operator=(const WorkQueue&) = delete;
+  ~WorkQueue() { stop(); }
+
+  /// Queues `item`; returns false when the oldest waiting item was dropped to make room for it.
+  bool push(Item item) {
+    bool made_room = false;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (queue_.size() >= capacity_) {
+        queue_.pop_front();
+        ++counts_.dropped;
+        made_room = true;
+      }
+      queue_.push_back(std::move(item));
+      ++counts_.pushed;
+    }
+    ready_.notify_one();
+    return !made_room;
+  }
+
+  WorkCounts counts() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    WorkCounts counts = counts_;
+    counts.waiting = queue_.size();
+    return counts;
+  }
+
+  /// Blocks until no item waits and no worker is busy.
+  void waitIdle() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    idle_.wait(lock, [this] { return queue_.empty() && busy_ == 0; });
+  }
+
+  /// Lets the workers finish the items in hand, discards the waiting ones and joins the workers.
+  void stop() {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stopping_ = true;
+      queue_.clear();
+    }
+    ready_.notify_all();
+    for (std::thread& worker : workers_) {
+      if (worker.joinable()) worker.join();
+    }
+  }
+
+ private:
+  void work() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    while (true) {
+      ready_.wait(lock, [this] { return stopping_ || !queue_.empty(); });
+      if (stopping_) return;
+      Item item = std::move(queue_.front());
+      queue_.pop_front();
+      ++busy_;
+      lock.unlock();
+      process_(item);
+      lock.lock();
+      --busy_;
+      ++counts_.done;
+      idle_.notify_all();
+    }
+  }
+
+  const size_t capacity_;
+  const std::function<void(Item&)> process_;
+  mutable std::mutex mutex_;
+  std::condition_variable ready_, idle_;
+  std::deque<Item> queue_;
+  WorkCounts counts_;
+  int busy_ = 0;
+  bool stopping_ = false;
+  std::vector<std::thread> workers_;  // last: started once everything above exists
+};
+
+}  // namespace sift_hull
