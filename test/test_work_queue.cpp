@@ -57,11 +57,36 @@ TEST(WorkQueue, DropsTheOldestWaitingItemsWhenFullAndCountsThem) {
   release.set_value();
   queue.waitIdle();
   EXPECT_EQ(processed, (std::vector<int>{0, 8, 9, 10}));  // the newest survive
+  EXPECT_EQ(queue.clear(), 0u);
   const auto counts = queue.counts();
   EXPECT_EQ(counts.pushed, 11u);
   EXPECT_EQ(counts.dropped, 7u);
   EXPECT_EQ(counts.done, 4u);
   EXPECT_EQ(counts.waiting, 0u);
+}
+
+TEST(WorkQueue, ClearDiscardsTheWaitingItemsWithoutCountingThemDropped) {
+  std::promise<void> release;
+  std::shared_future<void> released = release.get_future().share();
+  std::promise<void> first_taken;
+  std::vector<int> processed;
+  WorkQueue<int> queue(5, 1, [&](int& item) {
+    if (item == 0) {
+      first_taken.set_value();
+      released.wait();
+    }
+    processed.push_back(item);
+  });
+  queue.push(0);
+  first_taken.get_future().wait();
+  queue.push(1);
+  queue.push(2);
+  EXPECT_EQ(queue.clear(), 2u);
+  queue.push(3);
+  release.set_value();
+  queue.waitIdle();
+  EXPECT_EQ(processed, (std::vector<int>{0, 3}));
+  EXPECT_EQ(queue.counts().dropped, 0u);
 }
 
 TEST(WorkQueue, StopsWithItemsWaiting) {

@@ -3,6 +3,7 @@
 #include <tf2_eigen/tf2_eigen.h>
 
 #include "conversions.h"
+#include "node_diagnostics.h"
 #include "ros_params.h"
 #include "sift_hull/hull_octomap.h"
 
@@ -32,6 +33,13 @@ HullNode::HullNode(ros::NodeHandle nh, ros::NodeHandle private_nh, HullNodeConfi
       private_nh_(private_nh),
       config_(std::move(node_config)),
       stream_(std::move(hull_config)),
+      octomap_pub_(nh_.advertise<sift_hull::Octomap>("octomap_binary", 1, true)),
+      cloud_pub_(nh_.advertise<sensor_msgs::PointCloud2>("occupied_cells", 1, true)),
+      markers_pub_(
+          nh_.advertise<visualization_msgs::MarkerArray>("occupied_cells_vis_array", 1, true)),
+      mesh_pub_(nh_.advertise<visualization_msgs::Marker>("mesh", 1, true)),
+      work_(config_.queue_size, 1, [this](View& view) { integrate(view); }),
+      diagnostics_(nh_, private_nh_, private_nh_.getNamespace()),
       tf_listener_(tf_buffer_),
       silhouette_sub_(nh_, config_.from_image ? "image" : "silhouette", config_.queue_size),
       info_sub_(nh_, "camera_info", config_.queue_size),
@@ -44,11 +52,10 @@ HullNode::HullNode(ros::NodeHandle nh, ros::NodeHandle private_nh, HullNodeConfi
         onPoseMissing(image, reason);
       });
   sync_.registerCallback(&HullNode::onView, this);
-  octomap_pub_ = nh_.advertise<sift_hull::Octomap>("octomap_binary", 1, true);
-  cloud_pub_ = nh_.advertise<sensor_msgs::PointCloud2>("occupied_cells", 1, true);
-  markers_pub_ =
-      nh_.advertise<visualization_msgs::MarkerArray>("occupied_cells_vis_array", 1, true);
-  mesh_pub_ = nh_.advertise<visualization_msgs::Marker>("mesh", 1, true);
+  diagnostics_.setHardwareID("none");
+  diagnostics_.add("hull", this, &HullNode::reportDiagnostics);
+  diagnostics_timer_ = nh_.createWallTimer(
+      ros::WallDuration(1.0), [this](const ros::WallTimerEvent&) { diagnostics_.update(); });
   reset_srv_ = private_nh_.advertiseService("reset", &HullNode::reset, this);
   save_srv_ = private_nh_.advertiseService("save", &HullNode::save, this);
 }
@@ -91,10 +98,31 @@ void HullNode::onView(const sensor_msgs::ImageConstPtr& silhouette,
     log_.error("hull: view '" + silhouette->header.frame_id + "' ignored: ", why_not);
     return;
   }
-  PinholeCamera camera;
-  if (!cameraOf(*silhouette, *info, &camera)) return;
-  carve(silhouette->header.frame_id, camera, mask);
-  if (stream_.hasHull()) publish(silhouette->header.stamp);
+  View view{silhouette->header.frame_id, {}, mask, silhouette->header.stamp};
+  if (!cameraOf(*silhouette, *info, &view.camera)) return;
+  if (!work_.push(std::move(view))) {
+    ROS_WARN_THROTTLE(kThrottle_s,
+                      "hull: %llu view(s) dropped so far: views come faster than they are "
+                      "carved (~queue_size: %d)",
+                      static_cast<unsigned long long>(work_.counts().dropped), config_.queue_size);
+  }
+}
+
+void HullNode::integrate(View& view) {
+  std::lock_guard<std::mutex> lock(hull_mutex_);
+  const ros::WallTime start = ros::WallTime::now();
+  carve(view);
+  const ros::WallTime carved = ros::WallTime::now();
+  last_carve_ms_ = (carved - start).toSec() * 1e3;
+  if (!stream_.hasHull()) return;
+  publish(view.stamp);
+  last_publish_ms_ = (ros::WallTime::now() - carved).toSec() * 1e3;
+}
+
+void HullNode::reportDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  reportQueue(work_.counts(), "views", &status);
+  status.add("last view carve ms", last_carve_ms_.load());
+  status.add("last view publish ms", last_publish_ms_.load());
 }
 
 cv::Mat HullNode::maskOf(const sensor_msgs::ImageConstPtr& message, std::string* why_not) const {
@@ -103,9 +131,10 @@ cv::Mat HullNode::maskOf(const sensor_msgs::ImageConstPtr& message, std::string*
   return image.empty() ? image : silhouetteFromImage(image, config_.recipe);
 }
 
-void HullNode::carve(const std::string& name, const PinholeCamera& camera, const cv::Mat& mask) {
+void HullNode::carve(const View& view) {
+  const std::string& name = view.name;
   try {
-    const HullStream::Outcome outcome = stream_.add(name, camera, mask);
+    const HullStream::Outcome outcome = stream_.add(name, view.camera, view.mask);
     if (outcome == HullStream::Outcome::kWaiting) {
       ROS_INFO_THROTTLE(kThrottle_s, "hull: %zu view(s) waiting for a bounding box: %s",
                         stream_.waitingViews(), stream_.whyNoBox().c_str());
@@ -132,6 +161,8 @@ void HullNode::publish(const ros::Time& stamp) {
 }
 
 bool HullNode::reset(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
+  const size_t discarded = work_.clear();  // views from before the reset
+  std::lock_guard<std::mutex> lock(hull_mutex_);
   stream_.reset();
   octree_.reset();
   std_msgs::Header header;
@@ -140,11 +171,12 @@ bool HullNode::reset(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
   const octomap::OcTree empty(0.1);
   octomap_pub_.publish(ros_conversions::octomapMessage(empty, header));
   cloud_pub_.publish(ros_conversions::occupiedCellsCloud(empty, header));
-  ROS_INFO("hull: reset");
+  ROS_INFO("hull: reset (%zu view(s) waiting to be carved discarded)", discarded);
   return true;
 }
 
 bool HullNode::save(sift_hull::Save::Request& request, sift_hull::Save::Response& response) {
+  std::lock_guard<std::mutex> lock(hull_mutex_);
   if (!stream_.hasHull() || !octree_) {
     response.success = false;
     response.message = "no hull yet";

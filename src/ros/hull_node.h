@@ -1,5 +1,6 @@
 #pragma once
 
+#include <diagnostic_updater/diagnostic_updater.h>
 #include <message_filters/subscriber.h>
 #include <message_filters/time_synchronizer.h>
 #include <octomap/OcTree.h>
@@ -11,13 +12,16 @@
 #include <tf2_ros/message_filter.h>
 #include <tf2_ros/transform_listener.h>
 
+#include <atomic>
 #include <memory>
+#include <mutex>
 #include <string>
 
 #include "sift_hull/Save.h"
 #include "sift_hull/dataset.h"
 #include "sift_hull/hull_stream.h"
 #include "throttled_log.h"
+#include "work_queue.h"
 
 namespace sift_hull {
 
@@ -25,7 +29,8 @@ namespace sift_hull {
 struct HullNodeConfig {
   std::string world_frame = "world";
   /// Silhouettes waiting for their camera_info or their pose; when more wait, the oldest is
-  /// dropped with an error (a pose that never arrives).
+  /// dropped with an error (a pose that never arrives). Also the views waiting to be carved:
+  /// when more come, the oldest is dropped and counted in /diagnostics.
   int queue_size = 10;
   /// Subscribe `image` (8-bit colour or mono) instead of `silhouette`, and extract each
   /// silhouette by `recipe` (the Middlebury threshold, dilation and erosion).
@@ -45,6 +50,13 @@ class HullNode {
 
  private:
   using Sync = message_filters::TimeSynchronizer<sensor_msgs::Image, sensor_msgs::CameraInfo>;
+  /// A checked view waiting to be carved.
+  struct View {
+    std::string name;
+    PinholeCamera camera;
+    cv::Mat mask;
+    ros::Time stamp;
+  };
 
   void onView(const sensor_msgs::ImageConstPtr& silhouette,
               const sensor_msgs::CameraInfoConstPtr& info);
@@ -52,25 +64,33 @@ class HullNode {
   cv::Mat maskOf(const sensor_msgs::ImageConstPtr& message, std::string* why_not) const;
   bool cameraOf(const sensor_msgs::Image& silhouette, const sensor_msgs::CameraInfo& info,
                 PinholeCamera* camera);
-  void carve(const std::string& name, const PinholeCamera& camera, const cv::Mat& mask);
+  void integrate(View& view);
+  void carve(const View& view);
   void publish(const ros::Time& stamp);
+  void reportDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& status);
   void onPoseMissing(const sensor_msgs::ImageConstPtr& silhouette,
                      tf2_ros::filter_failure_reasons::FilterFailureReason reason);
   bool reset(std_srvs::Empty::Request& request, std_srvs::Empty::Response& response);
   bool save(sift_hull::Save::Request& request, sift_hull::Save::Response& response);
 
+  // Destroyed bottom up: subscriptions and services first, then the worker, then what it uses.
   ros::NodeHandle nh_, private_nh_;
   HullNodeConfig config_;
+  std::mutex hull_mutex_;  ///< guards stream_ and octree_ (the worker, ~reset, ~save)
   HullStream stream_;
-  ThrottledLog log_;
   std::unique_ptr<octomap::OcTree> octree_;
+  ThrottledLog log_;
+  ros::Publisher octomap_pub_, cloud_pub_, markers_pub_, mesh_pub_;
+  std::atomic<double> last_carve_ms_{0.0}, last_publish_ms_{0.0};
+  WorkQueue<View> work_;
+  diagnostic_updater::Updater diagnostics_;
+  ros::WallTimer diagnostics_timer_;
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
   message_filters::Subscriber<sensor_msgs::Image> silhouette_sub_;
   message_filters::Subscriber<sensor_msgs::CameraInfo> info_sub_;
   tf2_ros::MessageFilter<sensor_msgs::Image> pose_filter_;
   Sync sync_;
-  ros::Publisher octomap_pub_, cloud_pub_, markers_pub_, mesh_pub_;
   ros::ServiceServer reset_srv_, save_srv_;
 };
 

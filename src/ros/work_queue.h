@@ -58,6 +58,14 @@ class WorkQueue {
     return counts;
   }
 
+  /// Discards the waiting items (not counted as dropped); returns how many there were.
+  size_t clear() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const size_t waiting = queue_.size();
+    queue_.clear();
+    return waiting;
+  }
+
   /// Blocks until no item waits and no worker is busy.
   void waitIdle() {
     std::unique_lock<std::mutex> lock(mutex_);
