@@ -41,6 +41,8 @@ const std::vector<Command>& commands() {
       {"hull", "visual hull of calibrated silhouettes: octree, OctoMap and mesh", runHull},
       {"bench-hull", "time the visual hull against dense carving on dino and temple", runBenchHull},
       {"bag", "write calibrated views as a ROS bag that drives both nodes", runBag},
+      {"bench-nodes", "time the matcher and hull nodes as processes on topic streams",
+       runBenchNodes},
   };
   return all;
 }

@@ -29,6 +29,7 @@ int runEvaluateFilters(const std::vector<std::string>& args);
 int runHull(const std::vector<std::string>& args);
 int runBenchHull(const std::vector<std::string>& args);
 int runBag(const std::vector<std::string>& args);
+int runBenchNodes(const std::vector<std::string>& args);
 
 /// Parses the command line and runs the chosen command.
 int runMain(int argc, char** argv);

@@ -38,10 +38,30 @@ class BlockOcTree : public octomap::OcTree {
       root = new octomap::OcTreeNode();
       ++tree_size;
     }
+    if (isAligned(block)) return insertAligned(block);
     insert(root, 0, Eigen::Vector3i::Zero(), block);
   }
 
  private:
+  static bool isAligned(const KeyBlock& block) {
+    const Eigen::Vector3i& key = block.min_key;
+    return key.x() % block.edge == 0 && key.y() % block.edge == 0 && key.z() % block.edge == 0;
+  }
+
+  /// A block that is one octree node (most of them: the hull's cells are octree cells): the path
+  /// to it is read off its key bits, with no overlap tests.
+  void insertAligned(const KeyBlock& block) {
+    octomap::OcTreeNode* node = root;
+    for (int level = 0; (1 << (kKeyDepth - level)) > block.edge; ++level) {
+      const int bit = kKeyDepth - 1 - level;
+      const unsigned int c = ((block.min_key.x() >> bit) & 1) |
+                             (((block.min_key.y() >> bit) & 1) << 1) |
+                             (((block.min_key.z() >> bit) & 1) << 2);
+      node = nodeChildExists(node, c) ? getNodeChild(node, c) : createNodeChild(node, c);
+    }
+    makeOccupiedLeaf(node);
+  }
+
   void insert(octomap::OcTreeNode* node, int level, const Eigen::Vector3i& min_key,
               const KeyBlock& block) {
     const int edge = 1 << (kKeyDepth - level);

@@ -55,7 +55,7 @@ HullNode::HullNode(ros::NodeHandle nh, ros::NodeHandle private_nh, HullNodeConfi
   diagnostics_.setHardwareID("none");
   diagnostics_.add("hull", this, &HullNode::reportDiagnostics);
   diagnostics_timer_ = nh_.createWallTimer(
-      ros::WallDuration(1.0), [this](const ros::WallTimerEvent&) { diagnostics_.update(); });
+      ros::WallDuration(0.1), [this](const ros::WallTimerEvent&) { diagnostics_.update(); });
   reset_srv_ = private_nh_.advertiseService("reset", &HullNode::reset, this);
   save_srv_ = private_nh_.advertiseService("save", &HullNode::save, this);
 }

@@ -82,7 +82,7 @@ MatcherNode::MatcherNode(ros::NodeHandle nh, ros::NodeHandle private_nh, Matcher
   diagnostics_.setHardwareID("none");
   diagnostics_.add("matcher", this, &MatcherNode::reportDiagnostics);
   diagnostics_timer_ = nh_.createWallTimer(
-      ros::WallDuration(1.0), [this](const ros::WallTimerEvent&) { diagnostics_.update(); });
+      ros::WallDuration(0.1), [this](const ros::WallTimerEvent&) { diagnostics_.update(); });
   serveReconfigure();
   subscribe();
 }
