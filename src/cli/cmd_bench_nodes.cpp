@@ -456,6 +456,7 @@ int runBenchNodes(const std::vector<std::string>& args) {
   if (!(seconds > 0.0)) throw UsageError("--seconds must be positive");
 
   RosHarness harness;
+  std::cerr << "bench-nodes: the nodes' output goes to " << harness.logPath() << '\n';
   int argc = 0;
   ros::init(argc, nullptr, "bench_nodes", ros::init_options::NoSigintHandler);
   ros::AsyncSpinner spinner(2);

@@ -1,6 +1,7 @@
 #include "ros_harness.h"
 
 #include <arpa/inet.h>
+#include <fcntl.h>
 #include <netinet/in.h>
 #include <signal.h>
 #include <spawn.h>
@@ -22,14 +23,20 @@ namespace sift_hull {
 namespace cli {
 namespace {
 
-pid_t spawn(const std::vector<std::string>& command) {
+/// Starts `command` with its stdout and stderr appended to `log_path`.
+pid_t spawn(const std::vector<std::string>& command, const std::string& log_path) {
   std::vector<char*> argv;
   for (const std::string& word : command) argv.push_back(const_cast<char*>(word.c_str()));
   argv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log_path.c_str(),
+                                   O_WRONLY | O_CREAT | O_APPEND, 0644);
+  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
   pid_t pid = -1;
-  if (posix_spawnp(&pid, argv[0], nullptr, nullptr, argv.data(), environ) != 0) {
-    throw std::runtime_error("cannot start " + command.front());
-  }
+  const int failed = posix_spawnp(&pid, argv[0], &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (failed != 0) throw std::runtime_error("cannot start " + command.front());
   return pid;
 }
 
@@ -80,7 +87,10 @@ RosHarness::RosHarness() {
   const int port = 21000 + static_cast<int>(getpid() % 20000);
   const std::string uri = "http://localhost:" + std::to_string(port) + "/";
   setenv("ROS_MASTER_URI", uri.c_str(), 1);
-  master_ = spawn({"rosmaster", "--core", "-p", std::to_string(port)});
+  log_path_ = (std::filesystem::temp_directory_path() /
+               ("sift_hull_ros_harness_" + std::to_string(getpid()) + ".log"))
+                  .string();
+  master_ = spawn({"rosmaster", "--core", "-p", std::to_string(port)}, log_path_);
   if (!waitForPort(port, std::chrono::seconds(20))) {
     interrupt(master_);
     throw std::runtime_error("no ROS master at " + uri + " after 20 s");
@@ -96,7 +106,7 @@ pid_t RosHarness::startNode(const std::string& executable,
                             const std::vector<std::string>& arguments) {
   std::vector<std::string> command = {executableDirectory() + "/" + executable};
   command.insert(command.end(), arguments.begin(), arguments.end());
-  nodes_.push_back(spawn(command));
+  nodes_.push_back(spawn(command, log_path_));
   return nodes_.back();
 }
 

@@ -25,8 +25,11 @@ class RosHarness {
   pid_t startNode(const std::string& executable, const std::vector<std::string>& arguments);
   /// Interrupts a node started here and waits for it (killed after 10 s).
   void stopNode(pid_t pid);
+  /// Where the master and the nodes write their output.
+  const std::string& logPath() const { return log_path_; }
 
  private:
+  std::string log_path_;
   pid_t master_ = -1;
   std::vector<pid_t> nodes_;
 };
