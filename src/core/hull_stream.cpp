@@ -1,20 +1,46 @@
 #include "sift_hull/hull_stream.h"
 
 #include <algorithm>
+#include <cmath>
+#include <stdexcept>
 
 #include "sift_hull/hull_pipeline.h"
 
 namespace sift_hull {
 
-HullStream::HullStream(HullStreamConfig config) : config_(std::move(config)) {
-  validate(config_.hull);
+void validate(const HullStreamConfig& config) {
+  validate(config.hull);
+  if (!(config.min_view_distance_m >= 0.0) || !std::isfinite(config.min_view_distance_m)) {
+    throw std::invalid_argument("min_view_distance_m must be finite and at least 0");
+  }
+  if (!(config.min_view_angle_deg >= 0.0) || !std::isfinite(config.min_view_angle_deg)) {
+    throw std::invalid_argument("min_view_angle_deg must be finite and at least 0");
+  }
+}
+
+HullStream::HullStream(HullStreamConfig config) : config_(std::move(config)) { validate(config_); }
+
+bool HullStream::isRedundant(const PinholeCamera& camera) const {
+  if (config_.min_view_distance_m <= 0.0) return false;
+  const double min_cos = std::cos(config_.min_view_angle_deg * M_PI / 180.0);
+  const Eigen::Vector3d centre = camera.centre();
+  const Eigen::Vector3d axis = camera.opticalAxis();
+  return std::any_of(taken_.begin(), taken_.end(), [&](const Viewpoint& taken) {
+    return (taken.centre - centre).norm() <= config_.min_view_distance_m &&
+           taken.axis.dot(axis) >= min_cos;
+  });
 }
 
 HullStream::Outcome HullStream::add(const std::string& name, const PinholeCamera& camera,
                                     const cv::Mat& mask) {
   const auto& skip = config_.skip_views;
   if (std::find(skip.begin(), skip.end(), name) != skip.end()) return Outcome::kSkipped;
+  if (isRedundant(camera)) {
+    ++redundant_views_;
+    return Outcome::kRedundant;
+  }
   HullView view(name, camera, mask, config_.hull);
+  taken_.push_back({camera.centre(), camera.opticalAxis()});
   if (hull_) {
     hull_->addView(std::move(view));
     return Outcome::kCarved;
@@ -42,6 +68,8 @@ void HullStream::tryToStart() {
 }
 
 void HullStream::reset() {
+  taken_.clear();
+  redundant_views_ = 0;
   waiting_.clear();
   hull_.reset();
   why_no_box_ = "no view yet";

@@ -114,6 +114,7 @@ void HullNode::integrate(View& view) {
   carve(view);
   const ros::WallTime carved = ros::WallTime::now();
   last_carve_ms_ = (carved - start).toSec() * 1e3;
+  redundant_views_ = stream_.redundantViews();
   if (!stream_.hasHull()) return;
   publish(view.stamp);
   last_publish_ms_ = (ros::WallTime::now() - carved).toSec() * 1e3;
@@ -121,6 +122,7 @@ void HullNode::integrate(View& view) {
 
 void HullNode::reportDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& status) {
   reportQueue(work_.counts(), "views", &status);
+  status.add("views redundant", redundant_views_.load());
   status.add("last view carve ms", last_carve_ms_.load());
   status.add("last view publish ms", last_publish_ms_.load());
 }
@@ -140,6 +142,12 @@ void HullNode::carve(const View& view) {
                         stream_.waitingViews(), stream_.whyNoBox().c_str());
     }
     if (outcome == HullStream::Outcome::kSkipped) ROS_INFO("hull: view '%s' skipped", name.c_str());
+    if (outcome == HullStream::Outcome::kRedundant) {
+      ROS_INFO_THROTTLE(kThrottle_s,
+                        "hull: %zu view(s) left out so far: seen from where a view already taken "
+                        "was (~min_view_distance_m, ~min_view_angle_deg)",
+                        stream_.redundantViews());
+    }
   } catch (const std::exception& e) {
     log_.error("hull: view '" + name + "' ignored: ", e.what());
   }

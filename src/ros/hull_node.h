@@ -82,6 +82,7 @@ class HullNode {
   ThrottledLog log_;
   ros::Publisher octomap_pub_, cloud_pub_, markers_pub_, mesh_pub_;
   std::atomic<double> last_carve_ms_{0.0}, last_publish_ms_{0.0};
+  std::atomic<size_t> redundant_views_{0};
   WorkQueue<View> work_;
   diagnostic_updater::Updater diagnostics_;
   ros::WallTimer diagnostics_timer_;

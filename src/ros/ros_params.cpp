@@ -43,6 +43,9 @@ HullStreamConfig readHullStreamConfig(const ros::NodeHandle& private_nh) {
     config.box = given;
   }
   private_nh.param("skip_views", config.skip_views, config.skip_views);
+  private_nh.param("min_view_distance_m", config.min_view_distance_m, config.min_view_distance_m);
+  private_nh.param("min_view_angle_deg", config.min_view_angle_deg, config.min_view_angle_deg);
+  validate(config);
   return config;
 }
 

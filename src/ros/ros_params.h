@@ -19,8 +19,9 @@ SilhouetteConfig readSilhouetteConfig(const ros::NodeHandle& private_nh);
 HullConfig readHullConfig(const ros::NodeHandle& private_nh);
 
 /// The hull config, ~box ([xmin, ymin, zmin, xmax, ymax, zmax] in the world frame, metres; empty
-/// or absent: automatic) and ~skip_views (frame ids of silhouettes to leave out). Throws
-/// std::invalid_argument for a box that is not six numbers with max > min.
+/// or absent: automatic), ~skip_views (frame ids of silhouettes to leave out),
+/// ~min_view_distance_m and ~min_view_angle_deg. Throws std::invalid_argument for a box that is not
+/// six numbers with max > min, or a negative view separation.
 HullStreamConfig readHullStreamConfig(const ros::NodeHandle& private_nh);
 
 /// ~max_features, ~octave_layers, ~contrast_threshold, ~edge_threshold, ~sigma_px.
