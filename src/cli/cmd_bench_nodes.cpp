@@ -233,7 +233,7 @@ struct HullRun {
   // Overload: the views again and again, faster than they are carved.
   double overload_hz = 0.0;
   int overload_published = 0;
-  double overload_processed = 0.0, overload_dropped = 0.0;
+  double overload_processed = 0.0, overload_redundant = 0.0, overload_dropped = 0.0;
   double rss_first_mib = 0.0, rss_last_mib = 0.0;
 };
 
@@ -300,6 +300,7 @@ void measureViews(HullFeed& feed, const ArrivalLog<sift_hull::Octomap>& octomaps
 void overload(HullFeed& feed, const DiagnosticsListener& diagnostics, pid_t pid, HullRun* run) {
   run->overload_hz = 100.0;
   const double processed_before = diagnostics.value("views processed");
+  const double redundant_before = diagnostics.value("views redundant");
   const ros::WallTime start = ros::WallTime::now();
   for (int k = 0; (ros::WallTime::now() - start).toSec() < 5.0; ++k) {
     const ros::WallTime due = start + ros::WallDuration(k / run->overload_hz);
@@ -318,6 +319,7 @@ void overload(HullFeed& feed, const DiagnosticsListener& diagnostics, pid_t pid,
       20.0);
   run->rss_last_mib = residentMiB(pid);
   run->overload_processed = diagnostics.value("views processed") - processed_before;
+  run->overload_redundant = diagnostics.value("views redundant") - redundant_before;
   run->overload_dropped = diagnostics.value("views dropped");
 }
 
@@ -367,6 +369,7 @@ nlohmann::json hullJson(const HullRun& r) {
            {{"input_hz", r.overload_hz},
             {"published", r.overload_published},
             {"processed", r.overload_processed},
+            {"redundant", r.overload_redundant},
             {"dropped", r.overload_dropped},
             {"rss_first_mib", r.rss_first_mib},
             {"rss_last_mib", r.rss_last_mib}}}};
@@ -408,16 +411,20 @@ std::string markdownReport(const std::vector<MatcherRun>& matcher,
   out << "\nHull node, one view at a time (the next sent once /diagnostics counts the view "
       << "processed). Medians over the views that refine an existing hull: carving (`HullStream` "
       << "add), publishing (OctoMap conversion, octomap_binary and occupied_cells), and the "
-      << "latency from sending a view to receiving its octomap. Then the views again at "
-      << "100 Hz for 5 s (`~queue_size` 10).\n\n"
-      << "| data | views | depth | carve ms | publish ms | latency ms | 100 Hz: sent / carved / "
-         "dropped | memory MiB |\n|---|---|---|---|---|---|---|---|\n";
+      << "latency from sending a view to receiving its octomap. Then the same views again and "
+      << "again at 100 Hz for 5 s (`~queue_size` 10): processed counts the views the worker took, "
+      << "redundant those of them left out because a view was already taken from there "
+      << "(`~min_view_distance_m`, `~min_view_angle_deg`), dropped those the full queue lost; "
+      << "memory is the node's resident set after 1 s / at the end.\n\n"
+      << "| data | views | depth | carve ms | publish ms | latency ms | 100 Hz: sent / processed / "
+         "redundant / dropped | memory MiB |\n|---|---|---|---|---|---|---|---|\n";
   for (const HullRun& r : hulls) {
     out << "| " << r.name << " | " << r.views << " (" << r.incremental_views << " refining) | "
         << r.depth << " | " << fixed(r.carve_ms, 1) << " | " << fixed(r.publish_ms, 1) << " | "
         << fixed(r.latency_ms, 1) << " | " << r.overload_published << " / "
-        << fixed(r.overload_processed, 0) << " / " << fixed(r.overload_dropped, 0) << " | "
-        << fixed(r.rss_first_mib, 0) << " / " << fixed(r.rss_last_mib, 0) << " |\n";
+        << fixed(r.overload_processed, 0) << " / " << fixed(r.overload_redundant, 0) << " / "
+        << fixed(r.overload_dropped, 0) << " | " << fixed(r.rss_first_mib, 0) << " / "
+        << fixed(r.rss_last_mib, 0) << " |\n";
   }
   out << "\n### Targets\n\n";
   for (const auto& [name, value] : targets.items()) {

@@ -111,11 +111,11 @@ void HullNode::onView(const sensor_msgs::ImageConstPtr& silhouette,
 void HullNode::integrate(View& view) {
   std::lock_guard<std::mutex> lock(hull_mutex_);
   const ros::WallTime start = ros::WallTime::now();
-  carve(view);
+  const bool changed = carve(view);
   const ros::WallTime carved = ros::WallTime::now();
   last_carve_ms_ = (carved - start).toSec() * 1e3;
   redundant_views_ = stream_.redundantViews();
-  if (!stream_.hasHull()) return;
+  if (!changed) return;  // waiting, skipped or redundant: the published hull stands
   publish(view.stamp);
   last_publish_ms_ = (ros::WallTime::now() - carved).toSec() * 1e3;
 }
@@ -133,7 +133,7 @@ cv::Mat HullNode::maskOf(const sensor_msgs::ImageConstPtr& message, std::string*
   return image.empty() ? image : silhouetteFromImage(image, config_.recipe);
 }
 
-void HullNode::carve(const View& view) {
+bool HullNode::carve(const View& view) {
   const std::string& name = view.name;
   try {
     const HullStream::Outcome outcome = stream_.add(name, view.camera, view.mask);
@@ -148,8 +148,10 @@ void HullNode::carve(const View& view) {
                         "was (~min_view_distance_m, ~min_view_angle_deg)",
                         stream_.redundantViews());
     }
+    return outcome == HullStream::Outcome::kCarved;
   } catch (const std::exception& e) {
     log_.error("hull: view '" + name + "' ignored: ", e.what());
+    return false;
   }
 }
 

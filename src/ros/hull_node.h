@@ -65,7 +65,8 @@ class HullNode {
   bool cameraOf(const sensor_msgs::Image& silhouette, const sensor_msgs::CameraInfo& info,
                 PinholeCamera* camera);
   void integrate(View& view);
-  void carve(const View& view);
+  /// Whether the view changed the hull.
+  bool carve(const View& view);
   void publish(const ros::Time& stamp);
   void reportDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& status);
   void onPoseMissing(const sensor_msgs::ImageConstPtr& silhouette,
