@@ -11,6 +11,7 @@
 #include "args.h"
 #include "bench_timing.h"
 #include "commands.h"
+#include "hull_options.h"
 #include "pair_data.h"
 #include "sift_hull/hull_evaluation.h"
 #include "sift_hull/hull_pipeline.h"
@@ -20,19 +21,6 @@ namespace cli {
 namespace {
 
 const std::vector<int> kDepths = {7, 8, 9};
-
-struct HullDataset {
-  std::string name, directory, calibration, view_list;  ///< view_list empty: all views
-  double threshold;  ///< silhouette threshold; dilation and erosion as SilhouetteConfig
-};
-
-// Dino: the Middlebury recipe (0.19) and its good-silhouette list. Temple: a dark cloth behind
-// the object passes 0.19 in several views (mean reprojection IoU 0.956 at depth 7), 0.25 does not.
-const std::vector<HullDataset> kDatasets = {
-    {"dino", "middlebury_mvs_dinoSparseRing", "dinoSR_par.txt", "dinoSR_good_silhouette_images.txt",
-     0.19},
-    {"temple", "middlebury_mvs_templeSparseRing", "templeSR_par.txt", "", 0.25},
-};
 
 /// One data set at one depth: the hull's stage times (medians), its quality, and dense carving.
 struct DepthRun {
@@ -127,16 +115,6 @@ nlohmann::json hullCommandPeakMiB(const std::string& directory, const HullDatase
   while (size_t read = fread(buffer, 1, sizeof buffer, pipe)) output.append(buffer, read);
   if (pclose(pipe) != 0) throw std::runtime_error("failed: " + command);
   return nlohmann::json::parse(output).at("peak_memory_mib");
-}
-
-HullInput loadDataset(const std::string& root, const HullDataset& dataset) {
-  const std::string directory = root + "/" + dataset.directory;
-  const std::vector<std::string> names = dataset.view_list.empty()
-                                             ? std::vector<std::string>{}
-                                             : readViewList(directory + "/" + dataset.view_list);
-  SilhouetteConfig recipe;
-  recipe.threshold = dataset.threshold;
-  return loadHullInput(directory + "/" + dataset.calibration, directory, "", recipe, names);
 }
 
 nlohmann::json depthJson(const DepthRun& run) {
@@ -250,13 +228,13 @@ int runBenchHull(const std::vector<std::string>& args) {
   const std::string root = parser.has("data") ? parser.get("data") : defaultDataRoot();
 
   std::vector<DatasetRuns> all;
-  for (const HullDataset& dataset : kDatasets) {
+  for (const HullDataset& dataset : hullDatasets()) {
     const std::string directory = root + "/" + dataset.directory;
     if (root.empty() || !std::filesystem::exists(directory)) {
       std::cerr << "bench-hull: skipping " << dataset.name << ": no " << directory << '\n';
       continue;
     }
-    all.push_back(benchDataset(loadDataset(root, dataset), dataset.name));
+    all.push_back(benchDataset(loadHullDataset(root, dataset), dataset.name));
     const nlohmann::json peak = hullCommandPeakMiB(directory, dataset);
     all.back().peak_mib_depth9 = peak.at("through_hull").get<double>();
     all.back().command_peak_mib_depth9 = peak.at("total").get<double>();

@@ -22,6 +22,7 @@
 #include "../ros/matcher_node.h"
 #include "args.h"
 #include "commands.h"
+#include "hull_options.h"
 #include "pair_data.h"
 #include "ros_harness.h"
 #include "sift_hull/Correspondences.h"
@@ -436,14 +437,13 @@ std::string markdownReport(const std::vector<MatcherRun>& matcher,
 std::vector<HullRun> benchHulls(RosHarness& harness, const std::string& data_root) {
   std::vector<HullRun> runs;
   runs.push_back(runHull(harness, "synthetic", hullInputOf(renderScene(SceneConfig())), 8));
-  const std::string dino = data_root + "/middlebury_mvs_dinoSparseRing";
-  if (data_root.empty() || !std::filesystem::exists(dino)) {
-    std::cerr << "bench-nodes: skipping dino: no " << dino << '\n';
+  const HullDataset& dino = hullDatasets().front();
+  const std::string directory = data_root + "/" + dino.directory;
+  if (data_root.empty() || !std::filesystem::exists(directory)) {
+    std::cerr << "bench-nodes: skipping dino: no " << directory << '\n';
     return runs;
   }
-  const HullInput input = loadHullInput(dino + "/dinoSR_par.txt", dino, "", SilhouetteConfig(),
-                                        readViewList(dino + "/dinoSR_good_silhouette_images.txt"));
-  runs.push_back(runHull(harness, "dino", input, 8));
+  runs.push_back(runHull(harness, dino.name, loadHullDataset(data_root, dino), 8));
   return runs;
 }
 

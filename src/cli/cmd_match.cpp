@@ -3,11 +3,11 @@
 
 #include "args.h"
 #include "commands.h"
-#include "sift_hull/match_drawing.h"
 #include "match_eval.h"
 #include "match_options.h"
 #include "sift_hull/camera.h"
 #include "sift_hull/dataset.h"
+#include "sift_hull/match_drawing.h"
 #include "sift_hull/scene.h"
 
 namespace sift_hull {

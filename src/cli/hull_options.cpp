@@ -112,5 +112,25 @@ nlohmann::json hullJson(const HullResult& result, size_t occupied_leaves,
           {"reprojection_iou", {{"min", iou.min}, {"mean", iou.mean}}}};
 }
 
+const std::vector<HullDataset>& hullDatasets() {
+  // Temple at 0.19: mean reprojection IoU 0.956 at depth 7; at 0.25, 0.982.
+  static const std::vector<HullDataset> datasets = {
+      {"dino", "middlebury_mvs_dinoSparseRing", "dinoSR_par.txt",
+       "dinoSR_good_silhouette_images.txt", 0.19},
+      {"temple", "middlebury_mvs_templeSparseRing", "templeSR_par.txt", "", 0.25},
+  };
+  return datasets;
+}
+
+HullInput loadHullDataset(const std::string& root, const HullDataset& dataset) {
+  const std::string directory = root + "/" + dataset.directory;
+  const std::vector<std::string> names = dataset.view_list.empty()
+                                             ? std::vector<std::string>{}
+                                             : readViewList(directory + "/" + dataset.view_list);
+  SilhouetteConfig recipe;
+  recipe.threshold = dataset.threshold;
+  return loadHullInput(directory + "/" + dataset.calibration, directory, "", recipe, names);
+}
+
 }  // namespace cli
 }  // namespace sift_hull

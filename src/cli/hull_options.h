@@ -2,6 +2,8 @@
 
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <string>
+#include <vector>
 
 #include "args.h"
 #include "sift_hull/hull_evaluation.h"
@@ -22,6 +24,19 @@ HullConfig hullConfigFromArgs(const ArgParser& parser);
 
 /// --box "XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX" when given.
 std::optional<Box3d> boxFromArgs(const ArgParser& parser);
+
+/// A real data set of the hull benchmarks, in a data root.
+struct HullDataset {
+  std::string name, directory, calibration, view_list;  ///< view_list empty: all views
+  double threshold;  ///< silhouette threshold; dilation and erosion as SilhouetteConfig
+};
+
+/// Dino (the Middlebury recipe, 0.19, and its good-silhouette list) and temple (0.25: a dark
+/// cloth behind the object passes 0.19 in several views).
+const std::vector<HullDataset>& hullDatasets();
+
+/// The data set's views and silhouettes under `root`.
+HullInput loadHullDataset(const std::string& root, const HullDataset& dataset);
 
 /// The object `sift_hull hull --json` prints.
 nlohmann::json hullJson(const HullResult& result, size_t occupied_leaves,
