@@ -25,6 +25,7 @@ cleanup() {
 trap cleanup EXIT
 
 echo "playing $out/scene.bag through both nodes with rviz on display $display ..."
+rm -rf "$out/nodes"  # its summary.json is the signal below, so none may be left from before
 DISPLAY="$display" run_demo_launch "$out" rviz:=true >"$out/launch.log" 2>&1 &
 launch=$!
 # With rviz open the launch stays up after saving; the summary tells that the last view is in.
