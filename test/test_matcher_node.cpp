@@ -5,12 +5,14 @@
 #include <dynamic_reconfigure/Reconfigure.h>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
+#include <sensor_msgs/CompressedImage.h>
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <sensor_msgs/point_cloud2_iterator.h>
 #include <tf2_ros/static_transform_broadcaster.h>
 
 #include <functional>
+#include <opencv2/imgcodecs.hpp>
 
 #include "../src/ros/conversions.h"
 #include "ros_wait.h"
@@ -46,8 +48,14 @@ PutativeMatches putativesOf(const sift_hull::Correspondences& message, cv::Size 
 
 class MatcherNodeTest : public ::testing::Test {
  protected:
-  /// Whether the node takes one `image` topic (matcher_frames.test).
-  virtual bool frameToFrame() const { return false; }
+  /// Whether the node subscribes the inputs this test publishes.
+  virtual bool inputsConnected() const {
+    return left_pub_.getNumSubscribers() > 0 && right_pub_.getNumSubscribers() > 0;
+  }
+  virtual void advertise() {
+    left_pub_ = nh_.advertise<sensor_msgs::Image>("left/image", 5);
+    right_pub_ = nh_.advertise<sensor_msgs::Image>("right/image", 5);
+  }
 
   void SetUp() override {
     SceneConfig config;
@@ -55,16 +63,10 @@ class MatcherNodeTest : public ::testing::Test {
     config.height_px = 240;
     left_ = renderSceneView(config, 0);
     right_ = renderSceneView(config, 1);
-    left_pub_ = nh_.advertise<sensor_msgs::Image>("left/image", 5);
-    right_pub_ = nh_.advertise<sensor_msgs::Image>("right/image", 5);
+    advertise();
     sub_ = nh_.subscribe("correspondences", 5, &MatcherNodeTest::onCorrespondences, this);
-    frame_pub_ = nh_.advertise<sensor_msgs::Image>("image", 5);
-    ASSERT_TRUE(waitFor([&] {
-      const bool inputs =
-          frameToFrame() ? frame_pub_.getNumSubscribers() > 0
-                         : left_pub_.getNumSubscribers() > 0 && right_pub_.getNumSubscribers() > 0;
-      return inputs && sub_.getNumPublishers() > 0;
-    })) << "the matcher node did not connect";
+    ASSERT_TRUE(waitFor([&] { return inputsConnected() && sub_.getNumPublishers() > 0; }))
+        << "the matcher node did not connect";
   }
 
   ros::Time publishPair(const cv::Mat& left, const cv::Mat& right) {
@@ -159,8 +161,55 @@ TEST_F(MatcherNodeTest, ThresholdsChangeAtRunTime) {
 /// One image topic: each frame is matched with the one before it.
 class FrameToFrameMatcherTest : public MatcherNodeTest {
  protected:
-  bool frameToFrame() const override { return true; }
+  bool inputsConnected() const override { return frame_pub_.getNumSubscribers() > 0; }
+  void advertise() override { frame_pub_ = nh_.advertise<sensor_msgs::Image>("image", 5); }
 };
+
+/// Compressed images (PNG and JPEG) on left/image/compressed and right/image/compressed, with
+/// ~image_transport: compressed: decoded by the node when no image_transport plugin does it.
+class CompressedMatcherTest : public MatcherNodeTest {
+ protected:
+  bool inputsConnected() const override {
+    return left_compressed_pub_.getNumSubscribers() > 0 &&
+           right_compressed_pub_.getNumSubscribers() > 0;
+  }
+  void advertise() override {
+    left_compressed_pub_ = nh_.advertise<sensor_msgs::CompressedImage>("left/image/compressed", 5);
+    right_compressed_pub_ =
+        nh_.advertise<sensor_msgs::CompressedImage>("right/image/compressed", 5);
+  }
+  static sensor_msgs::CompressedImage compressed(const cv::Mat& image, const ros::Time& stamp,
+                                                 const std::string& frame,
+                                                 const std::string& format) {
+    sensor_msgs::CompressedImage message;
+    message.header.stamp = stamp;
+    message.header.frame_id = frame;
+    message.format = "bgr8; " + format + " compressed bgr8";
+    cv::imencode("." + format, image, message.data);
+    return message;
+  }
+
+  ros::Publisher left_compressed_pub_, right_compressed_pub_;
+};
+
+TEST_F(CompressedMatcherTest, DecodesCompressedPairsAndRefusesUndecodableOnes) {
+  sensor_msgs::CompressedImage garbage = compressed(left_.image, ros::Time::now(), "left", "png");
+  garbage.data.resize(100);  // truncated: not decodable
+  left_compressed_pub_.publish(garbage);
+  right_compressed_pub_.publish(compressed(right_.image, garbage.header.stamp, "right", "png"));
+  ros::WallDuration(0.5).sleep();
+  ros::spinOnce();
+  EXPECT_FALSE(last_) << "an undecodable pair was answered";
+  for (const char* format : {"png", "jpg"}) {
+    const ros::Time stamp = ros::Time::now();
+    left_compressed_pub_.publish(compressed(left_.image, stamp, "left", format));
+    right_compressed_pub_.publish(compressed(right_.image, stamp, "right", format));
+    ASSERT_TRUE(answeredAtLeast(stamp)) << format << ": no correspondences";
+    EXPECT_EQ(last_->header.stamp, stamp);
+    EXPECT_EQ(last_->right_header.frame_id, "right");
+    EXPECT_GE(last_->matches.size(), 50u) << format;
+  }
+}
 
 TEST_F(FrameToFrameMatcherTest, MatchesEachFrameWithThePreviousOne) {
   const ros::Time first = ros::Time::now();

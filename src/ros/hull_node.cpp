@@ -12,19 +12,10 @@ namespace {
 
 constexpr double kThrottle_s = 5.0;
 
-HullNodeConfig readNodeConfig(const ros::NodeHandle& private_nh) {
-  HullNodeConfig config;
-  private_nh.param("world_frame", config.world_frame, config.world_frame);
-  private_nh.param("queue_size", config.queue_size, config.queue_size);
-  private_nh.param("from_image", config.from_image, config.from_image);
-  config.recipe = ros_params::readSilhouetteConfig(private_nh);
-  return config;
-}
-
 }  // namespace
 
 HullNode::HullNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
-    : HullNode(nh, private_nh, readNodeConfig(private_nh),
+    : HullNode(nh, private_nh, ros_params::readHullNodeConfig(private_nh),
                ros_params::readHullStreamConfig(private_nh)) {}
 
 HullNode::HullNode(ros::NodeHandle nh, ros::NodeHandle private_nh, HullNodeConfig node_config,

@@ -141,29 +141,35 @@ void MatcherNode::onReconfigure(sift_hull::MatcherConfig& config, uint32_t) {
   pipeline_ = std::move(replacement);
 }
 
+std::unique_ptr<ImageInput> MatcherNode::imageInput(const std::string& topic) {
+  return std::make_unique<ImageInput>(transport_, nh_, private_nh_, topic,
+                                      settings_.node.queue_size, settings_.node.image_transport);
+}
+
 void MatcherNode::subscribe() {
   const int queue = settings_.node.queue_size;
   if (settings_.node.frame_to_frame) {
-    frame_sub_ = transport_.subscribe("image", queue, &MatcherNode::onFrame, this);
+    frame_sub_ = imageInput("image");
+    frame_sub_->registerCallback(&MatcherNode::onFrame, this);
     return;
   }
-  left_sub_.subscribe(transport_, "left/image", queue);
-  right_sub_.subscribe(transport_, "right/image", queue);
+  left_sub_ = imageInput("left/image");
+  right_sub_ = imageInput("right/image");
   if (settings_.node.calibrated) {
     left_info_sub_.subscribe(nh_, "left/camera_info", queue);
     right_info_sub_.subscribe(nh_, "right/camera_info", queue);
     calibrated_sync_ = std::make_unique<CalibratedSync>(
-        message_filters::sync_policies::ExactTime<Image, Image, Info, Info>(queue), left_sub_,
-        right_sub_, left_info_sub_, right_info_sub_);
+        message_filters::sync_policies::ExactTime<Image, Image, Info, Info>(queue), *left_sub_,
+        *right_sub_, left_info_sub_, right_info_sub_);
     calibrated_sync_->registerCallback(&MatcherNode::onCalibratedPair, this);
   } else if (settings_.node.approximate_sync) {
     approximate_sync_ = std::make_unique<ApproximateSync>(
-        message_filters::sync_policies::ApproximateTime<Image, Image>(queue), left_sub_,
-        right_sub_);
+        message_filters::sync_policies::ApproximateTime<Image, Image>(queue), *left_sub_,
+        *right_sub_);
     approximate_sync_->registerCallback(&MatcherNode::onPair, this);
   } else {
     exact_sync_ = std::make_unique<ExactSync>(
-        message_filters::sync_policies::ExactTime<Image, Image>(queue), left_sub_, right_sub_);
+        message_filters::sync_policies::ExactTime<Image, Image>(queue), *left_sub_, *right_sub_);
     exact_sync_->registerCallback(&MatcherNode::onPair, this);
   }
 }

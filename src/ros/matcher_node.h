@@ -3,7 +3,6 @@
 #include <diagnostic_updater/diagnostic_updater.h>
 #include <dynamic_reconfigure/server.h>
 #include <image_transport/image_transport.h>
-#include <image_transport/subscriber_filter.h>
 #include <message_filters/subscriber.h>
 #include <message_filters/sync_policies/approximate_time.h>
 #include <message_filters/sync_policies/exact_time.h>
@@ -21,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "image_input.h"
 #include "sift_hull/Correspondences.h"
 #include "sift_hull/MatcherConfig.h"
 #include "sift_hull/camera.h"
@@ -52,6 +52,9 @@ struct MatcherNodeConfig {
   /// Subscribe one `image` topic instead, and match each frame with the one before it (the
   /// earlier frame is the left image). Not with `calibrated`.
   bool frame_to_frame = false;
+  /// How the images arrive: "raw", "compressed" (decoded here when no plugin provides it), or
+  /// another installed image_transport plugin.
+  std::string image_transport = "raw";
 };
 
 /// Everything the matcher node is configured with.
@@ -101,6 +104,7 @@ class MatcherNode {
   };
 
   void subscribe();
+  std::unique_ptr<ImageInput> imageInput(const std::string& topic);
   /// Serves the run-time thresholds (cfg/Matcher.cfg), starting from the node's own settings.
   void serveReconfigure();
   void onReconfigure(sift_hull::MatcherConfig& config, uint32_t level);
@@ -143,8 +147,7 @@ class MatcherNode {
   ros::WallTimer diagnostics_timer_;
   boost::recursive_mutex reconfigure_mutex_;  // the server's, so updateConfig cannot race it
   std::unique_ptr<dynamic_reconfigure::Server<sift_hull::MatcherConfig>> reconfigure_;
-  image_transport::SubscriberFilter left_sub_, right_sub_;
-  image_transport::Subscriber frame_sub_;
+  std::unique_ptr<ImageInput> left_sub_, right_sub_, frame_sub_;
   sensor_msgs::ImageConstPtr previous_frame_;
   std::unique_ptr<ExactSync> exact_sync_;
   std::unique_ptr<ApproximateSync> approximate_sync_;

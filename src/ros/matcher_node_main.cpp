@@ -4,8 +4,10 @@
 
 int main(int argc, char** argv) {
   ros::init(argc, argv, "matcher_node");
+  // Outlive the node: ROS shuts down with the last NodeHandle, and the error below would be lost.
+  ros::NodeHandle nh, private_nh("~");
   try {
-    sift_hull::MatcherNode node(ros::NodeHandle(), ros::NodeHandle("~"));
+    sift_hull::MatcherNode node(nh, private_nh);
     ros::spin();
   } catch (const std::exception& e) {
     ROS_FATAL("matcher_node: %s", e.what());

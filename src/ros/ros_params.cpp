@@ -1,15 +1,46 @@
 #include "ros_params.h"
 
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 namespace sift_hull {
 namespace ros_params {
+namespace {
+
+const char* typeName(bool) { return "boolean"; }
+const char* typeName(double) { return "number"; }
+const char* typeName(const std::string&) { return "string"; }
+const char* typeName(const std::vector<double>&) { return "list of numbers"; }
+const char* typeName(const std::vector<std::string>&) { return "list of strings"; }
+
+/// The parameter's value when it is set; throws std::invalid_argument when it is set with another
+/// type (e.g. a string where a list is expected), rather than quietly keeping the default.
+template <typename T>
+void read(const ros::NodeHandle& private_nh, const std::string& name, T* value) {
+  if (!private_nh.hasParam(name)) return;
+  if (!private_nh.getParam(name, *value)) {
+    throw std::invalid_argument("~" + name + " is set, but not as a " + typeName(*value));
+  }
+}
+
+/// roscpp would truncate 2.5 to 2 for an integer; here that is a wrong type too.
+void read(const ros::NodeHandle& private_nh, const std::string& name, int* value) {
+  XmlRpc::XmlRpcValue raw;
+  if (!private_nh.getParam(name, raw)) return;
+  if (raw.getType() != XmlRpc::XmlRpcValue::TypeInt) {
+    throw std::invalid_argument("~" + name + " is set, but not as an integer");
+  }
+  *value = static_cast<int>(raw);
+}
+
+}  // namespace
 
 SilhouetteConfig readSilhouetteConfig(const ros::NodeHandle& private_nh) {
   SilhouetteConfig config;
-  private_nh.param("threshold", config.threshold, config.threshold);
-  private_nh.param("dilate_px", config.dilate_px, config.dilate_px);
-  private_nh.param("erode_px", config.erode_px, config.erode_px);
+  read(private_nh, "threshold", &config.threshold);
+  read(private_nh, "dilate_px", &config.dilate_px);
+  read(private_nh, "erode_px", &config.erode_px);
   if (!(config.threshold >= 0.0 && config.threshold <= 1.0) || config.dilate_px < 0 ||
       config.erode_px < 0) {
     throw std::invalid_argument("~threshold must lie in [0, 1], ~dilate_px and ~erode_px >= 0");
@@ -19,10 +50,10 @@ SilhouetteConfig readSilhouetteConfig(const ros::NodeHandle& private_nh) {
 
 HullConfig readHullConfig(const ros::NodeHandle& private_nh) {
   HullConfig config;
-  private_nh.param("depth", config.max_depth, config.max_depth);
-  private_nh.param("carve_outside_image", config.carve_outside_image, config.carve_outside_image);
-  private_nh.param("slack_px", config.distance_slack_px, config.distance_slack_px);
-  private_nh.param("threads", config.threads, config.threads);
+  read(private_nh, "depth", &config.max_depth);
+  read(private_nh, "carve_outside_image", &config.carve_outside_image);
+  read(private_nh, "slack_px", &config.distance_slack_px);
+  read(private_nh, "threads", &config.threads);
   validate(config);
   return config;
 }
@@ -31,7 +62,7 @@ HullStreamConfig readHullStreamConfig(const ros::NodeHandle& private_nh) {
   HullStreamConfig config;
   config.hull = readHullConfig(private_nh);
   std::vector<double> box;
-  private_nh.param("box", box, box);
+  read(private_nh, "box", &box);
   if (!box.empty()) {
     if (box.size() != 6) throw std::invalid_argument("~box must hold six numbers or none");
     Box3d given;
@@ -42,32 +73,32 @@ HullStreamConfig readHullStreamConfig(const ros::NodeHandle& private_nh) {
     }
     config.box = given;
   }
-  private_nh.param("skip_views", config.skip_views, config.skip_views);
-  private_nh.param("min_view_distance_m", config.min_view_distance_m, config.min_view_distance_m);
-  private_nh.param("min_view_angle_deg", config.min_view_angle_deg, config.min_view_angle_deg);
+  read(private_nh, "skip_views", &config.skip_views);
+  read(private_nh, "min_view_distance_m", &config.min_view_distance_m);
+  read(private_nh, "min_view_angle_deg", &config.min_view_angle_deg);
   validate(config);
   return config;
 }
 
 SiftConfig readSiftConfig(const ros::NodeHandle& private_nh) {
   SiftConfig config;
-  private_nh.param("max_features", config.max_features, config.max_features);
-  private_nh.param("octave_layers", config.octave_layers, config.octave_layers);
-  private_nh.param("contrast_threshold", config.contrast_threshold, config.contrast_threshold);
-  private_nh.param("edge_threshold", config.edge_threshold, config.edge_threshold);
-  private_nh.param("sigma_px", config.sigma_px, config.sigma_px);
+  read(private_nh, "max_features", &config.max_features);
+  read(private_nh, "octave_layers", &config.octave_layers);
+  read(private_nh, "contrast_threshold", &config.contrast_threshold);
+  read(private_nh, "edge_threshold", &config.edge_threshold);
+  read(private_nh, "sigma_px", &config.sigma_px);
   validate(config);
   return config;
 }
 
 MatchConfig readMatchConfig(const ros::NodeHandle& private_nh) {
   MatchConfig config;
-  private_nh.param("ratio", config.ratio, config.ratio);
+  read(private_nh, "ratio", &config.ratio);
   double max_distance = 0.0;
-  private_nh.param("max_descriptor_distance", max_distance, max_distance);
+  read(private_nh, "max_descriptor_distance", &max_distance);
   if (max_distance > 0.0) config.max_descriptor_distance = max_distance;
-  private_nh.param("cross_check", config.cross_check, config.cross_check);
-  private_nh.param("matcher", config.backend, config.backend);
+  read(private_nh, "cross_check", &config.cross_check);
+  read(private_nh, "matcher", &config.backend);
   validate(config);
   return config;
 }
@@ -76,28 +107,26 @@ namespace {
 
 void readRobustFit(const ros::NodeHandle& private_nh, const std::string& prefix,
                    RobustFitConfig* config) {
-  private_nh.param(prefix + "_max_epipolar_px", config->max_epipolar_px, config->max_epipolar_px);
-  private_nh.param("robust_confidence", config->confidence, config->confidence);
-  private_nh.param("robust_max_iterations", config->max_iterations, config->max_iterations);
+  read(private_nh, prefix + "_max_epipolar_px", &config->max_epipolar_px);
+  read(private_nh, "robust_confidence", &config->confidence);
+  read(private_nh, "robust_max_iterations", &config->max_iterations);
 }
 
 }  // namespace
 
 FilterConfigs readFilterConfigs(const ros::NodeHandle& private_nh) {
   FilterConfigs configs;
-  private_nh.param("max_epipolar_px", configs.epipolar.max_epipolar_px,
-                   configs.epipolar.max_epipolar_px);
+  read(private_nh, "max_epipolar_px", &configs.epipolar.max_epipolar_px);
   GscConfig& gsc = configs.gsc;
-  private_nh.param("gsc_max_histogram_distance", gsc.max_histogram_distance,
-                   gsc.max_histogram_distance);
-  private_nh.param("gsc_threads", gsc.threads, gsc.threads);
+  read(private_nh, "gsc_max_histogram_distance", &gsc.max_histogram_distance);
+  read(private_nh, "gsc_threads", &gsc.threads);
   readRobustFit(private_nh, "ransac", &configs.ransac);
   readRobustFit(private_nh, "magsac", &configs.magsac);
   GmsConfig& gms = configs.gms;
-  private_nh.param("gms_grid_cells", gms.grid_cells, gms.grid_cells);
-  private_nh.param("gms_threshold_factor", gms.threshold_factor, gms.threshold_factor);
-  private_nh.param("gms_with_rotation", gms.with_rotation, gms.with_rotation);
-  private_nh.param("gms_with_scale", gms.with_scale, gms.with_scale);
+  read(private_nh, "gms_grid_cells", &gms.grid_cells);
+  read(private_nh, "gms_threshold_factor", &gms.threshold_factor);
+  read(private_nh, "gms_with_rotation", &gms.with_rotation);
+  read(private_nh, "gms_with_scale", &gms.with_scale);
   validate(configs);
   return configs;
 }
@@ -105,25 +134,35 @@ FilterConfigs readFilterConfigs(const ros::NodeHandle& private_nh) {
 MatcherSettings readMatcherSettings(const ros::NodeHandle& private_nh) {
   MatcherSettings settings;
   MatcherNodeConfig& node = settings.node;
-  private_nh.param("filters", node.filters, node.filters);
-  private_nh.param("queue_size", node.queue_size, node.queue_size);
-  private_nh.param("max_waiting_pairs", node.max_waiting_pairs, node.max_waiting_pairs);
-  private_nh.param("workers", node.workers, node.workers);
-  private_nh.param("approximate_sync", node.approximate_sync, node.approximate_sync);
-  private_nh.param("calibrated", node.calibrated, node.calibrated);
-  private_nh.param("frame_to_frame", node.frame_to_frame, node.frame_to_frame);
+  read(private_nh, "filters", &node.filters);
+  read(private_nh, "queue_size", &node.queue_size);
+  read(private_nh, "max_waiting_pairs", &node.max_waiting_pairs);
+  read(private_nh, "workers", &node.workers);
+  read(private_nh, "approximate_sync", &node.approximate_sync);
+  read(private_nh, "calibrated", &node.calibrated);
+  read(private_nh, "frame_to_frame", &node.frame_to_frame);
+  read(private_nh, "image_transport", &node.image_transport);
   settings.sift = readSiftConfig(private_nh);
   settings.matching = readMatchConfig(private_nh);
   settings.filters = readFilterConfigs(private_nh);
   return settings;
 }
 
+HullNodeConfig readHullNodeConfig(const ros::NodeHandle& private_nh) {
+  HullNodeConfig config;
+  read(private_nh, "world_frame", &config.world_frame);
+  read(private_nh, "queue_size", &config.queue_size);
+  read(private_nh, "from_image", &config.from_image);
+  config.recipe = readSilhouetteConfig(private_nh);
+  return config;
+}
+
 ResultSaverConfig readResultSaverConfig(const ros::NodeHandle& private_nh) {
   ResultSaverConfig config;
-  private_nh.param("bag", config.bag, config.bag);
-  private_nh.param("out_dir", config.out_dir, config.out_dir);
-  private_nh.param("hull_save_service", config.hull_save_service, config.hull_save_service);
-  private_nh.param("timeout_s", config.timeout_s, config.timeout_s);
+  read(private_nh, "bag", &config.bag);
+  read(private_nh, "out_dir", &config.out_dir);
+  read(private_nh, "hull_save_service", &config.hull_save_service);
+  read(private_nh, "timeout_s", &config.timeout_s);
   if (config.bag.empty() || config.out_dir.empty()) {
     throw std::invalid_argument("~bag and ~out_dir are required");
   }

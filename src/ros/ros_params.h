@@ -1,9 +1,12 @@
 #pragma once
 
-// One reader per config struct; every fallback is the struct's own default.
+// One reader per config struct; every fallback is the struct's own default. A parameter that is
+// set with the wrong type (a string where a list is expected, 2.5 for an integer) is an error
+// (std::invalid_argument), not a silent default.
 
 #include <ros/node_handle.h>
 
+#include "hull_node.h"
 #include "matcher_node.h"
 #include "result_saver.h"
 #include "sift_hull/dataset.h"
@@ -36,8 +39,11 @@ MatchConfig readMatchConfig(const ros::NodeHandle& private_nh);
 FilterConfigs readFilterConfigs(const ros::NodeHandle& private_nh);
 
 /// The readers above and ~filters, ~queue_size, ~max_waiting_pairs, ~workers, ~approximate_sync,
-/// ~calibrated, ~frame_to_frame.
+/// ~calibrated, ~frame_to_frame, ~image_transport.
 MatcherSettings readMatcherSettings(const ros::NodeHandle& private_nh);
+
+/// ~world_frame, ~queue_size, ~from_image and the silhouette recipe.
+HullNodeConfig readHullNodeConfig(const ros::NodeHandle& private_nh);
 
 /// ~bag, ~out_dir (both required: throws std::invalid_argument without them),
 /// ~hull_save_service, ~timeout_s.
