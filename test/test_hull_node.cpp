@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <octomap/OcTree.h>
 #include <ros/ros.h>
+#include <rosgraph_msgs/Log.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/PointCloud2.h>
@@ -13,8 +14,10 @@
 #include <tf2_eigen/tf2_eigen.h>
 #include <tf2_ros/static_transform_broadcaster.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
+#include <mutex>
 #include <sstream>
 
 #include "../src/ros/conversions.h"
@@ -171,6 +174,54 @@ TEST_F(HullNodeTest, CarvesTheSphereResetsAndSurvivesBadInput) {
   for (int v = 0; v < kViews; ++v) last = publishView(v);
   ASSERT_TRUE(octomapStampedAtLeast(last)) << "good views after bad ones were not carved";
   EXPECT_NEAR(occupiedVolume(*last_octomap_), offline_m3, 1e-6 * offline_m3);
+}
+
+/// The camera of view 0 turned by 40 degrees about the world's z axis through the origin: a
+/// viewpoint none of the views has.
+PinholeCamera turnedCamera(const PinholeCamera& camera) {
+  const Eigen::Matrix3d turn =
+      Eigen::AngleAxisd(40.0 * M_PI / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  return PinholeCamera::fromCentre(camera.K(), camera.R() * turn.transpose(),
+                                   turn * camera.centre());
+}
+
+TEST_F(HullNodeTest, ASilhouetteWhosePoseComesAfterTheTimeoutIsReportedAndNotCarved) {
+  std::vector<std::string> errors;
+  std::mutex errors_mutex;
+  ros::Subscriber rosout =
+      nh_.subscribe<rosgraph_msgs::Log>("/rosout", 50, [&](const rosgraph_msgs::LogConstPtr& log) {
+        std::lock_guard<std::mutex> lock(errors_mutex);
+        if (log->level == rosgraph_msgs::Log::ERROR) errors.push_back(log->msg);
+      });
+  std_srvs::Empty reset;  // views the node has already taken would be left out as redundant
+  ASSERT_TRUE(ros::service::waitForService("/hull/reset", ros::Duration(kDeadline_s)));
+  ASSERT_TRUE(ros::service::call("/hull/reset", reset));
+  ros::Time last;
+  for (int v = 0; v < kViews; ++v) last = publishView(v);
+  ASSERT_TRUE(octomapStampedAtLeast(last));
+  const ros::Time late =
+      publishView(0, [](sensor_msgs::Image* image, sensor_msgs::CameraInfo* info) {
+        image->header.frame_id = info->header.frame_id = "camera_late";
+      });
+  // hull_node.test sets ~pose_timeout_s to 1 s.
+  ASSERT_TRUE(waitFor([&] {
+    std::lock_guard<std::mutex> lock(errors_mutex);
+    return std::any_of(errors.begin(), errors.end(), [](const std::string& error) {
+      return error.find("no pose of 'camera_late'") != std::string::npos &&
+             error.find("pose_timeout_s") != std::string::npos;
+    });
+  })) << "no error for a pose that did not come in time";
+  const PinholeCamera camera = turnedCamera(views_[0].view.camera);
+  tf_.sendTransform(ros_conversions::cameraPoseMessage(camera, "world", "camera_late", {}));
+  ros::WallDuration(2.0).sleep();  // the pose is in tf now: the view would be carved by then
+  ros::spinOnce();
+  EXPECT_LT(last_octomap_->header.stamp, late) << "a view whose pose came too late was carved";
+  // The same viewpoint in time is carved.
+  const ros::Time timely =
+      publishView(0, [](sensor_msgs::Image* image, sensor_msgs::CameraInfo* info) {
+        image->header.frame_id = info->header.frame_id = "camera_late";
+      });
+  EXPECT_TRUE(octomapStampedAtLeast(timely)) << "a view with its pose in time was not carved";
 }
 
 class HullFromImageTest : public HullNodeTest {

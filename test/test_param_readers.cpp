@@ -18,6 +18,7 @@ void expectDefaultHull(const ros::NodeHandle& nh) {
   const HullNodeConfig node = readHullNodeConfig(nh), node_default;
   EXPECT_EQ(node.world_frame, node_default.world_frame);
   EXPECT_EQ(node.queue_size, node_default.queue_size);
+  EXPECT_EQ(node.pose_timeout_s, node_default.pose_timeout_s);
   EXPECT_EQ(node.from_image, node_default.from_image);
   EXPECT_EQ(node.recipe.threshold, node_default.recipe.threshold);
   EXPECT_EQ(node.recipe.dilate_px, node_default.recipe.dilate_px);

@@ -2,6 +2,8 @@
 
 #include <tf2_eigen/tf2_eigen.h>
 
+#include <sstream>
+
 #include "conversions.h"
 #include "node_diagnostics.h"
 #include "ros_params.h"
@@ -11,6 +13,12 @@ namespace sift_hull {
 namespace {
 
 constexpr double kThrottle_s = 5.0;
+
+std::string seconds(double value) {
+  std::ostringstream out;
+  out << value;
+  return out.str();
+}
 
 }  // namespace
 
@@ -31,6 +39,7 @@ HullNode::HullNode(ros::NodeHandle nh, ros::NodeHandle private_nh, HullNodeConfi
       mesh_pub_(nh_.advertise<visualization_msgs::Marker>("mesh", 1, true)),
       work_(config_.queue_size, 1, [this](View& view) { integrate(view); }),
       diagnostics_(nh_, private_nh_, private_nh_.getNamespace()),
+      pose_waits_(config_.pose_timeout_s, 4 * static_cast<size_t>(config_.queue_size)),
       tf_listener_(tf_buffer_),
       silhouette_sub_(nh_, config_.from_image ? "image" : "silhouette", config_.queue_size),
       info_sub_(nh_, "camera_info", config_.queue_size),
@@ -43,6 +52,9 @@ HullNode::HullNode(ros::NodeHandle nh, ros::NodeHandle private_nh, HullNodeConfi
         onPoseMissing(image, reason);
       });
   sync_.registerCallback(&HullNode::onView, this);
+  silhouette_sub_.registerCallback(&HullNode::onArrival, this);
+  pose_timer_ = nh_.createWallTimer(ros::WallDuration(0.2),
+                                    [this](const ros::WallTimerEvent&) { reportPoseTimeouts(); });
   diagnostics_.setHardwareID("none");
   diagnostics_.add("hull", this, &HullNode::reportDiagnostics);
   diagnostics_timer_ = nh_.createWallTimer(
@@ -51,8 +63,22 @@ HullNode::HullNode(ros::NodeHandle nh, ros::NodeHandle private_nh, HullNodeConfi
   save_srv_ = private_nh_.advertiseService("save", &HullNode::save, this);
 }
 
+void HullNode::onArrival(const sensor_msgs::ImageConstPtr& silhouette) {
+  pose_waits_.arrived(silhouette->header.frame_id, silhouette->header.stamp.toSec(),
+                      PoseWaits::Clock::now());
+}
+
+void HullNode::reportPoseTimeouts() {
+  for (const std::string& frame : pose_waits_.expire(PoseWaits::Clock::now())) {
+    log_.error("hull: dropped a silhouette: ",
+               "no pose of '" + frame + "' in '" + config_.world_frame + "' within " +
+                   seconds(config_.pose_timeout_s) + " s (~pose_timeout_s)");
+  }
+}
+
 void HullNode::onPoseMissing(const sensor_msgs::ImageConstPtr& silhouette,
                              tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
+  pose_waits_.forget(silhouette->header.frame_id, silhouette->header.stamp.toSec());
   const char* why = reason == tf2_ros::filter_failure_reasons::EmptyFrameID ? "empty frame id"
                     : reason == tf2_ros::filter_failure_reasons::OutTheBack
                         ? "older than the transforms tf keeps"
@@ -83,6 +109,11 @@ bool HullNode::cameraOf(const sensor_msgs::Image& silhouette, const sensor_msgs:
 
 void HullNode::onView(const sensor_msgs::ImageConstPtr& silhouette,
                       const sensor_msgs::CameraInfoConstPtr& info) {
+  if (!pose_waits_.posed(silhouette->header.frame_id, silhouette->header.stamp.toSec())) {
+    log_.error("hull: view '" + silhouette->header.frame_id + "' ignored: ",
+               "its pose came after ~pose_timeout_s");
+    return;
+  }
   std::string why_not;
   const cv::Mat mask = maskOf(silhouette, &why_not);
   if (mask.empty()) {

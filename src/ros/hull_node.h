@@ -17,6 +17,7 @@
 #include <mutex>
 #include <string>
 
+#include "pose_waits.h"
 #include "sift_hull/Save.h"
 #include "sift_hull/dataset.h"
 #include "sift_hull/hull_stream.h"
@@ -32,6 +33,9 @@ struct HullNodeConfig {
   /// dropped with an error (a pose that never arrives). Also the views waiting to be carved:
   /// when more come, the oldest is dropped and counted in /diagnostics.
   int queue_size = 10;
+  /// A silhouette whose pose is not in tf this long after it arrived is reported and, should the
+  /// pose come later still, not carved. <= 0: wait as long as the queue allows.
+  double pose_timeout_s = 5.0;
   /// Subscribe `image` (8-bit colour or mono) instead of `silhouette`, and extract each
   /// silhouette by `recipe` (the Middlebury threshold, dilation and erosion).
   bool from_image = false;
@@ -71,6 +75,8 @@ class HullNode {
   void reportDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& status);
   void onPoseMissing(const sensor_msgs::ImageConstPtr& silhouette,
                      tf2_ros::filter_failure_reasons::FilterFailureReason reason);
+  void onArrival(const sensor_msgs::ImageConstPtr& silhouette);
+  void reportPoseTimeouts();
   bool reset(std_srvs::Empty::Request& request, std_srvs::Empty::Response& response);
   bool save(sift_hull::Save::Request& request, sift_hull::Save::Response& response);
 
@@ -87,6 +93,8 @@ class HullNode {
   WorkQueue<View> work_;
   diagnostic_updater::Updater diagnostics_;
   ros::WallTimer diagnostics_timer_;
+  PoseWaits pose_waits_;
+  ros::WallTimer pose_timer_;
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
   message_filters::Subscriber<sensor_msgs::Image> silhouette_sub_;

@@ -152,6 +152,7 @@ HullNodeConfig readHullNodeConfig(const ros::NodeHandle& private_nh) {
   HullNodeConfig config;
   read(private_nh, "world_frame", &config.world_frame);
   read(private_nh, "queue_size", &config.queue_size);
+  read(private_nh, "pose_timeout_s", &config.pose_timeout_s);
   read(private_nh, "from_image", &config.from_image);
   config.recipe = readSilhouetteConfig(private_nh);
   return config;

@@ -42,7 +42,7 @@ FilterConfigs readFilterConfigs(const ros::NodeHandle& private_nh);
 /// ~calibrated, ~frame_to_frame, ~image_transport.
 MatcherSettings readMatcherSettings(const ros::NodeHandle& private_nh);
 
-/// ~world_frame, ~queue_size, ~from_image and the silhouette recipe.
+/// ~world_frame, ~queue_size, ~pose_timeout_s, ~from_image and the silhouette recipe.
 HullNodeConfig readHullNodeConfig(const ros::NodeHandle& private_nh);
 
 /// ~bag, ~out_dir (both required: throws std::invalid_argument without them),

@@ -1,0 +1,88 @@
+#pragma once
+
+#include <chrono>
+#include <map>
+#include <mutex>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace sift_hull {
+
+/// Silhouettes waiting for their camera's pose in tf, by frame id and stamp: a silhouette whose
+/// pose has not come within the timeout is reported once, and is not carved even if the pose
+/// comes later. At most `capacity` waits are remembered (the oldest are forgotten first).
+class PoseWaits {
+ public:
+  using Clock = std::chrono::steady_clock;
+
+  /// timeout_s <= 0: no timeout.
+  PoseWaits(double timeout_s, size_t capacity)
+      : timeout_(toDuration(timeout_s)), capacity_(capacity) {}
+
+  void arrived(const std::string& frame, double stamp_s, Clock::time_point now) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    waits_[{frame, stamp_s}] = {now, false};
+    while (waits_.size() > capacity_) waits_.erase(oldest());
+  }
+
+  /// The pose came: forgets the wait; false when it had timed out (the view must not be carved).
+  bool posed(const std::string& frame, double stamp_s) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const auto found = waits_.find({frame, stamp_s});
+    if (found == waits_.end()) return true;
+    const bool in_time = !found->second.expired;
+    waits_.erase(found);
+    return in_time;
+  }
+
+  /// tf gave up on it (dropped from its queue): forgets the wait.
+  void forget(const std::string& frame, double stamp_s) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    waits_.erase({frame, stamp_s});
+  }
+
+  /// The frame ids of the waits that passed the timeout since the last call, each once.
+  std::vector<std::string> expire(Clock::time_point now) {
+    std::vector<std::string> frames;
+    if (timeout_ <= Clock::duration::zero()) return frames;
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (auto& [key, wait] : waits_) {
+      if (wait.expired || now - wait.since < timeout_) continue;
+      wait.expired = true;
+      frames.push_back(key.first);
+    }
+    return frames;
+  }
+
+  size_t size() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return waits_.size();
+  }
+
+ private:
+  struct Wait {
+    Clock::time_point since;
+    bool expired = false;
+  };
+  using Key = std::pair<std::string, double>;
+
+  static Clock::duration toDuration(double seconds) {
+    return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds));
+  }
+
+  std::map<Key, Wait>::iterator oldest() {
+    auto oldest = waits_.begin();
+    for (auto it = waits_.begin(); it != waits_.end(); ++it) {
+      if (it->second.since < oldest->second.since) oldest = it;
+    }
+    return oldest;
+  }
+
+  const Clock::duration timeout_;
+  const size_t capacity_;
+  mutable std::mutex mutex_;
+  std::map<Key, Wait> waits_;
+};
+
+}  // namespace sift_hull
