@@ -8,6 +8,7 @@
 #include <iterator>
 #include <string>
 
+#include "sift_hull/hull_pipeline.h"
 #include "sift_hull/scene.h"
 
 namespace sift_hull {
@@ -20,6 +21,19 @@ inline SceneConfig smallRing() {
   config.width_px = 320;
   config.height_px = 240;
   return config;
+}
+
+/// A shape seen by `views` cameras of the given layout ("ring" or "sphere"), 320x240, as the
+/// hull's input.
+inline HullInput sceneHullInput(const std::string& shape, int views,
+                                const std::string& layout = "sphere") {
+  SceneConfig config;
+  config.shape = shape;
+  config.views = views;
+  config.layout = layout;
+  config.width_px = 320;
+  config.height_px = 240;
+  return hullInputOf(renderScene(config));
 }
 
 /// Root of the real data sets: $SIFT_HULL_DATA, else ../shared/data beside the repository when it

@@ -15,17 +15,6 @@
 namespace sift_hull {
 namespace {
 
-/// A shape seen by `views` cameras spread over a sphere, 320x240.
-HullInput sceneInput(const std::string& shape, int views, const std::string& layout = "sphere") {
-  SceneConfig config;
-  config.shape = shape;
-  config.views = views;
-  config.layout = layout;
-  config.width_px = 320;
-  config.height_px = 240;
-  return hullInputOf(renderScene(config));
-}
-
 HullConfig depth(int max_depth) {
   HullConfig config;
   config.max_depth = max_depth;
@@ -92,7 +81,7 @@ TEST(HullCube, HoldsTheBoxWithAVoxelOfMarginOnTheVoxelGrid) {
 class SphereHull : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    result_ = new HullResult(buildHull(sceneInput("sphere", 12), depth(7)));
+    result_ = new HullResult(buildHull(test::sceneHullInput("sphere", 12), depth(7)));
     dense_ = new DenseGrid(denseCarving(result_->hull.views(), result_->hull.cube().box(), 256, 2));
   }
   static void TearDownTestSuite() {
@@ -173,7 +162,7 @@ std::vector<HullCell> leavesOf(const VisualHull& hull) {
 }
 
 TEST(VisualHull, AddingViewsOneAtATimeGivesTheSameTreeAsAllAtOnce) {
-  const HullInput input = sceneInput("sculpture", 8, "ring");
+  const HullInput input = test::sceneHullInput("sculpture", 8, "ring");
   const HullConfig config = depth(6);
   std::vector<HullView> views = makeHullViews(input.names, input.cameras, input.masks, config);
   const Box3d box = boundingBoxOf(views);
@@ -193,7 +182,7 @@ TEST(VisualHull, AddingViewsOneAtATimeGivesTheSameTreeAsAllAtOnce) {
 }
 
 TEST(VisualHull, BoxShapeMatchesDenseCarving) {
-  const HullResult result = buildHull(sceneInput("box", 10), depth(7));
+  const HullResult result = buildHull(test::sceneHullInput("box", 10), depth(7));
   const DenseGrid dense = denseCarving(result.hull.views(), result.hull.cube().box(), 256, 2);
   EXPECT_GE(volumeIoU(result.hull, dense), 0.99);
   EXPECT_TRUE(result.mesh_check.watertight);
@@ -215,7 +204,7 @@ HullInput withFirstViewCutByTheBorder(HullInput input) {
 }
 
 TEST(VisualHull, ViewsCarveOutsideTheirImageOnlyWhenAsked) {
-  const HullInput full = sceneInput("sphere", 8);
+  const HullInput full = test::sceneHullInput("sphere", 8);
   const HullInput cut = withFirstViewCutByTheBorder(full);
   HullInput without_first = full;
   without_first.names.erase(without_first.names.begin());
@@ -236,7 +225,7 @@ TEST(VisualHull, ViewsCarveOutsideTheirImageOnlyWhenAsked) {
 }
 
 TEST(VisualHull, ResetLeavesOneInCellAndNoViews) {
-  HullResult result = buildHull(sceneInput("sphere", 6), depth(5));
+  HullResult result = buildHull(test::sceneHullInput("sphere", 6), depth(5));
   result.hull.reset();
   EXPECT_TRUE(result.hull.views().empty());
   const HullStats stats = result.hull.stats();

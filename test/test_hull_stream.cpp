@@ -8,18 +8,12 @@
 #include "sift_hull/hull_pipeline.h"
 #include "sift_hull/hull_stream.h"
 #include "sift_hull/scene.h"
+#include "test_data.h"
 
 namespace sift_hull {
 namespace {
 
-HullInput ring(int views) {
-  SceneConfig config;
-  config.shape = "sphere";
-  config.views = views;
-  config.width_px = 320;
-  config.height_px = 240;
-  return hullInputOf(renderScene(config));
-}
+HullInput ring(int views) { return test::sceneHullInput("sphere", views, "ring"); }
 
 HullStreamConfig streamConfig(int depth) {
   HullStreamConfig config;
