@@ -96,6 +96,8 @@ TEST(HullStream, SkipsNamedViewsAndRefusesBadSettings) {
   config.min_view_distance_m = 0.01;
   config.min_view_angle_deg = std::nan("");
   EXPECT_THROW(HullStream{config}, std::invalid_argument);
+  config.min_view_angle_deg = 200.0;
+  EXPECT_THROW(HullStream{config}, std::invalid_argument);
 }
 
 }  // namespace

@@ -121,6 +121,9 @@ TEST(ParameterReaders, WrongTypesAndValuesAreErrors) {
   EXPECT_THROW(readMatcherSettings(hull_with("filters", std::string("gsc"))),
                std::invalid_argument);
   EXPECT_THROW(readMatcherSettings(hull_with("ratio", std::string("0.8"))), std::invalid_argument);
+  EXPECT_THROW(readHullNodeConfig(hull_with("queue_size", 0)), std::invalid_argument);
+  EXPECT_THROW(readMatcherSettings(hull_with("max_waiting_pairs", -1)), std::invalid_argument);
+  EXPECT_THROW(readMatcherSettings(hull_with("workers", 0)), std::invalid_argument);
 }
 
 }  // namespace

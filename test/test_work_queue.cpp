@@ -7,6 +7,7 @@
 #include <chrono>
 #include <future>
 #include <set>
+#include <stdexcept>
 
 #include "../src/ros/work_queue.h"
 
@@ -87,6 +88,21 @@ TEST(WorkQueue, ClearDiscardsTheWaitingItemsWithoutCountingThemDropped) {
   queue.waitIdle();
   EXPECT_EQ(processed, (std::vector<int>{0, 3}));
   EXPECT_EQ(queue.counts().dropped, 0u);
+}
+
+TEST(WorkQueue, CountsAThrowingItemAsFailedAndGoesOn) {
+  std::vector<int> processed;
+  WorkQueue<int> queue(4, 1, [&](int& item) {
+    if (item == 1) throw std::runtime_error("bad item");
+    processed.push_back(item);
+  });
+  for (int i = 0; i < 3; ++i) {
+    queue.push(i);
+    queue.waitIdle();
+  }
+  EXPECT_EQ(processed, (std::vector<int>{0, 2}));
+  EXPECT_EQ(queue.counts().failed, 1u);
+  EXPECT_EQ(queue.counts().done, 3u);
 }
 
 TEST(WorkQueue, StopsWithItemsWaiting) {

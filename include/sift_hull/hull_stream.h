@@ -23,7 +23,8 @@ struct HullStreamConfig {
   double min_view_angle_deg = 1.0;
 };
 
-/// Throws std::invalid_argument for a negative or non-finite view separation.
+/// Throws std::invalid_argument for a negative or non-finite distance, or an angle outside
+/// [0, 180] degrees.
 void validate(const HullStreamConfig& config);
 
 /// A visual hull that views refine as they arrive (the hull node's worker). Until a box exists,

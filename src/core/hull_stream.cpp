@@ -13,8 +13,8 @@ void validate(const HullStreamConfig& config) {
   if (!(config.min_view_distance_m >= 0.0) || !std::isfinite(config.min_view_distance_m)) {
     throw std::invalid_argument("min_view_distance_m must be finite and at least 0");
   }
-  if (!(config.min_view_angle_deg >= 0.0) || !std::isfinite(config.min_view_angle_deg)) {
-    throw std::invalid_argument("min_view_angle_deg must be finite and at least 0");
+  if (!(config.min_view_angle_deg >= 0.0 && config.min_view_angle_deg <= 180.0)) {
+    throw std::invalid_argument("min_view_angle_deg must lie in [0, 180]");
   }
 }
 
@@ -22,7 +22,8 @@ HullStream::HullStream(HullStreamConfig config) : config_(std::move(config)) { v
 
 bool HullStream::isRedundant(const PinholeCamera& camera) const {
   if (config_.min_view_distance_m <= 0.0) return false;
-  const double min_cos = std::cos(config_.min_view_angle_deg * M_PI / 180.0);
+  // The tolerance keeps a camera standing still redundant at 0 degrees despite rounding.
+  const double min_cos = std::cos(config_.min_view_angle_deg * M_PI / 180.0) - 1e-12;
   const Eigen::Vector3d centre = camera.centre();
   const Eigen::Vector3d axis = camera.opticalAxis();
   return std::any_of(taken_.begin(), taken_.end(), [&](const Viewpoint& taken) {
@@ -40,12 +41,14 @@ HullStream::Outcome HullStream::add(const std::string& name, const PinholeCamera
     return Outcome::kRedundant;
   }
   HullView view(name, camera, mask, config_.hull);
-  taken_.push_back({camera.centre(), camera.opticalAxis()});
+  const Viewpoint viewpoint{camera.centre(), camera.opticalAxis()};
   if (hull_) {
     hull_->addView(std::move(view));
+    taken_.push_back(viewpoint);
     return Outcome::kCarved;
   }
   waiting_.push_back(std::move(view));
+  taken_.push_back(viewpoint);
   tryToStart();
   return hull_ ? Outcome::kCarved : Outcome::kWaiting;
 }

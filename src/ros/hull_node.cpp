@@ -14,7 +14,7 @@ namespace {
 
 constexpr double kThrottle_s = 5.0;
 
-std::string seconds(double value) {
+std::string shortNumber(double value) {
   std::ostringstream out;
   out << value;
   return out.str();
@@ -34,33 +34,45 @@ HullNode::HullNode(ros::NodeHandle nh, ros::NodeHandle private_nh, HullNodeConfi
       stream_(std::move(hull_config)),
       octomap_pub_(nh_.advertise<sift_hull::Octomap>("octomap_binary", 1, true)),
       cloud_pub_(nh_.advertise<sensor_msgs::PointCloud2>("occupied_cells", 1, true)),
-      markers_pub_(
-          nh_.advertise<visualization_msgs::MarkerArray>("occupied_cells_vis_array", 1, true)),
-      mesh_pub_(nh_.advertise<visualization_msgs::Marker>("mesh", 1, true)),
+      markers_pub_(nh_.advertise<visualization_msgs::MarkerArray>(
+          "occupied_cells_vis_array", 1,
+          [this](const ros::SingleSubscriberPublisher&) { publishMarkersNow(); },
+          ros::SubscriberStatusCallback(), ros::VoidConstPtr(), true)),
+      mesh_pub_(nh_.advertise<visualization_msgs::Marker>(
+          "mesh", 1, [this](const ros::SingleSubscriberPublisher&) { publishMeshNow(); },
+          ros::SubscriberStatusCallback(), ros::VoidConstPtr(), true)),
       work_(config_.queue_size, 1, [this](View& view) { integrate(view); }),
-      diagnostics_(nh_, private_nh_, private_nh_.getNamespace()),
+      diagnostics_(nh_, private_nh_, "hull",
+                   [this](diagnostic_updater::DiagnosticStatusWrapper& status) {
+                     reportDiagnostics(status);
+                   }),
       pose_waits_(config_.pose_timeout_s, 4 * static_cast<size_t>(config_.queue_size)),
       tf_listener_(tf_buffer_),
-      silhouette_sub_(nh_, config_.from_image ? "image" : "silhouette", config_.queue_size),
-      info_sub_(nh_, "camera_info", config_.queue_size),
-      pose_filter_(silhouette_sub_, tf_buffer_, config_.world_frame, config_.queue_size, nh_),
-      sync_(pose_filter_, info_sub_, config_.queue_size) {
+      pose_filter_(tf_buffer_, config_.world_frame, config_.queue_size, nh_),
+      pose_gate_(&pose_waits_,
+                 [this](const sensor_msgs::ImageConstPtr& late) { onPoseTooLate(late); }),
+      sync_(config_.queue_size) {
+  pose_timer_ = nh_.createWallTimer(ros::WallDuration(0.2),
+                                    [this](const ros::WallTimerEvent&) { reportPoseTimeouts(); });
+  reset_srv_ = private_nh_.advertiseService("reset", &HullNode::reset, this);
+  save_srv_ = private_nh_.advertiseService("save", &HullNode::save, this);
+  subscribe();
+}
+
+void HullNode::subscribe() {
   pose_filter_.setTolerance(ros::Duration(0.0));
   pose_filter_.registerFailureCallback(
       [this](const sensor_msgs::ImageConstPtr& image,
              tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
         onPoseMissing(image, reason);
       });
-  sync_.registerCallback(&HullNode::onView, this);
   silhouette_sub_.registerCallback(&HullNode::onArrival, this);
-  pose_timer_ = nh_.createWallTimer(ros::WallDuration(0.2),
-                                    [this](const ros::WallTimerEvent&) { reportPoseTimeouts(); });
-  diagnostics_.setHardwareID("none");
-  diagnostics_.add("hull", this, &HullNode::reportDiagnostics);
-  diagnostics_timer_ = nh_.createWallTimer(
-      ros::WallDuration(0.1), [this](const ros::WallTimerEvent&) { diagnostics_.update(); });
-  reset_srv_ = private_nh_.advertiseService("reset", &HullNode::reset, this);
-  save_srv_ = private_nh_.advertiseService("save", &HullNode::save, this);
+  pose_filter_.connectInput(silhouette_sub_);
+  pose_gate_.connectInput(pose_filter_);
+  sync_.connectInput(pose_gate_, info_sub_);
+  sync_.registerCallback(&HullNode::onView, this);
+  info_sub_.subscribe(nh_, "camera_info", config_.queue_size);
+  silhouette_sub_.subscribe(nh_, config_.from_image ? "image" : "silhouette", config_.queue_size);
 }
 
 void HullNode::onArrival(const sensor_msgs::ImageConstPtr& silhouette) {
@@ -72,8 +84,13 @@ void HullNode::reportPoseTimeouts() {
   for (const std::string& frame : pose_waits_.expire(PoseWaits::Clock::now())) {
     log_.error("hull: dropped a silhouette: ",
                "no pose of '" + frame + "' in '" + config_.world_frame + "' within " +
-                   seconds(config_.pose_timeout_s) + " s (~pose_timeout_s)");
+                   shortNumber(config_.pose_timeout_s) + " s (~pose_timeout_s)");
   }
+}
+
+void HullNode::onPoseTooLate(const sensor_msgs::ImageConstPtr& silhouette) {
+  log_.error("hull: view '" + silhouette->header.frame_id + "' ignored: ",
+             "its pose came after ~pose_timeout_s");
 }
 
 void HullNode::onPoseMissing(const sensor_msgs::ImageConstPtr& silhouette,
@@ -109,36 +126,32 @@ bool HullNode::cameraOf(const sensor_msgs::Image& silhouette, const sensor_msgs:
 
 void HullNode::onView(const sensor_msgs::ImageConstPtr& silhouette,
                       const sensor_msgs::CameraInfoConstPtr& info) {
-  if (!pose_waits_.posed(silhouette->header.frame_id, silhouette->header.stamp.toSec())) {
-    log_.error("hull: view '" + silhouette->header.frame_id + "' ignored: ",
-               "its pose came after ~pose_timeout_s");
-    return;
-  }
   std::string why_not;
   const cv::Mat mask = maskOf(silhouette, &why_not);
   if (mask.empty()) {
     log_.error("hull: view '" + silhouette->header.frame_id + "' ignored: ", why_not);
     return;
   }
-  View view{silhouette->header.frame_id, {}, mask, silhouette->header.stamp};
+  View view{silhouette->header.frame_id, {}, mask, silhouette->header.stamp, generation_};
   if (!cameraOf(*silhouette, *info, &view.camera)) return;
-  if (!work_.push(std::move(view))) {
-    ROS_WARN_THROTTLE(kThrottle_s,
-                      "hull: %llu view(s) dropped so far: views come faster than they are "
-                      "carved (~queue_size: %d)",
-                      static_cast<unsigned long long>(work_.counts().dropped), config_.queue_size);
-  }
+  pushCounted(&work_, std::move(view), "hull: views waiting to be carved (~queue_size)");
 }
 
 void HullNode::integrate(View& view) {
   std::lock_guard<std::mutex> lock(hull_mutex_);
+  if (view.generation != generation_) return;  // queued before a ~reset
   const ros::WallTime start = ros::WallTime::now();
   const bool changed = carve(view);
   const ros::WallTime carved = ros::WallTime::now();
   last_carve_ms_ = (carved - start).toSec() * 1e3;
   redundant_views_ = stream_.redundantViews();
+  last_view_stamp_ = view.stamp.toSec();
   if (!changed) return;  // waiting, skipped or redundant: the published hull stands
-  publish(view.stamp);
+  try {
+    publish(view.stamp);
+  } catch (const std::exception& e) {  // e.g. a hull beyond OctoMap's key range
+    log_.error("hull: cannot publish the hull: ", e.what());
+  }
   last_publish_ms_ = (ros::WallTime::now() - carved).toSec() * 1e3;
 }
 
@@ -147,6 +160,7 @@ void HullNode::reportDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& st
   status.add("views redundant", redundant_views_.load());
   status.add("last view carve ms", last_carve_ms_.load());
   status.add("last view publish ms", last_publish_ms_.load());
+  status.add("last view stamp", last_view_stamp_.load());
 }
 
 cv::Mat HullNode::maskOf(const sensor_msgs::ImageConstPtr& message, std::string* why_not) const {
@@ -178,31 +192,52 @@ bool HullNode::carve(const View& view) {
 }
 
 void HullNode::publish(const ros::Time& stamp) {
-  std_msgs::Header header;
-  header.stamp = stamp;
-  header.frame_id = config_.world_frame;
+  header_.stamp = stamp;
+  header_.frame_id = config_.world_frame;
   octree_ = toOctomap(stream_.hull());
-  octomap_pub_.publish(ros_conversions::octomapMessage(*octree_, header));
-  cloud_pub_.publish(ros_conversions::occupiedCellsCloud(*octree_, header));
+  octomap_pub_.publish(ros_conversions::octomapMessage(*octree_, header_));
+  cloud_pub_.publish(ros_conversions::occupiedCellsCloud(*octree_, header_));
   if (markers_pub_.getNumSubscribers() > 0) {
-    markers_pub_.publish(ros_conversions::occupiedCellsMarkers(*octree_, header));
+    markers_pub_.publish(ros_conversions::occupiedCellsMarkers(*octree_, header_));
   }
   if (mesh_pub_.getNumSubscribers() > 0) {
-    mesh_pub_.publish(ros_conversions::meshMarker(stream_.hull().mesh(), header));
+    mesh_pub_.publish(ros_conversions::meshMarker(stream_.hull().mesh(), header_));
   }
 }
 
-bool HullNode::reset(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
-  const size_t discarded = work_.clear();  // views from before the reset
+void HullNode::publishMarkersNow() {
   std::lock_guard<std::mutex> lock(hull_mutex_);
+  if (octree_) markers_pub_.publish(ros_conversions::occupiedCellsMarkers(*octree_, header_));
+}
+
+void HullNode::publishMeshNow() {
+  std::lock_guard<std::mutex> lock(hull_mutex_);
+  if (octree_) mesh_pub_.publish(ros_conversions::meshMarker(stream_.hull().mesh(), header_));
+}
+
+/// An empty map at the last resolution, and markers deleted.
+void HullNode::publishEmpty() {
+  header_.stamp = ros::Time::now();
+  header_.frame_id = config_.world_frame;
+  const octomap::OcTree empty(octree_ ? octree_->getResolution() : 0.1);
+  octomap_pub_.publish(ros_conversions::octomapMessage(empty, header_));
+  cloud_pub_.publish(ros_conversions::occupiedCellsCloud(empty, header_));
+  visualization_msgs::Marker delete_all;
+  delete_all.header = header_;
+  delete_all.action = visualization_msgs::Marker::DELETEALL;
+  visualization_msgs::MarkerArray markers;
+  markers.markers.push_back(delete_all);
+  markers_pub_.publish(markers);
+  mesh_pub_.publish(delete_all);
+}
+
+bool HullNode::reset(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
+  std::lock_guard<std::mutex> lock(hull_mutex_);
+  ++generation_;
+  const size_t discarded = work_.clear();  // views from before the reset
   stream_.reset();
+  publishEmpty();
   octree_.reset();
-  std_msgs::Header header;
-  header.stamp = ros::Time::now();
-  header.frame_id = config_.world_frame;
-  const octomap::OcTree empty(0.1);
-  octomap_pub_.publish(ros_conversions::octomapMessage(empty, header));
-  cloud_pub_.publish(ros_conversions::occupiedCellsCloud(empty, header));
   ROS_INFO("hull: reset (%zu view(s) waiting to be carved discarded)", discarded);
   return true;
 }

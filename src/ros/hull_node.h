@@ -1,6 +1,5 @@
 #pragma once
 
-#include <diagnostic_updater/diagnostic_updater.h>
 #include <message_filters/subscriber.h>
 #include <message_filters/time_synchronizer.h>
 #include <octomap/OcTree.h>
@@ -17,6 +16,8 @@
 #include <mutex>
 #include <string>
 
+#include "node_diagnostics.h"
+#include "pose_gate.h"
 #include "pose_waits.h"
 #include "sift_hull/Save.h"
 #include "sift_hull/dataset.h"
@@ -60,6 +61,7 @@ class HullNode {
     PinholeCamera camera;
     cv::Mat mask;
     ros::Time stamp;
+    uint64_t generation = 0;  ///< of ~reset, so that views from before one are not carved
   };
 
   void onView(const sensor_msgs::ImageConstPtr& silhouette,
@@ -72,34 +74,45 @@ class HullNode {
   /// Whether the view changed the hull.
   bool carve(const View& view);
   void publish(const ros::Time& stamp);
+  /// Markers and mesh for a new subscriber (they are built only while someone looks).
+  void publishMarkersNow();
+  void publishMeshNow();
+  void publishEmpty();
   void reportDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& status);
   void onPoseMissing(const sensor_msgs::ImageConstPtr& silhouette,
                      tf2_ros::filter_failure_reasons::FilterFailureReason reason);
   void onArrival(const sensor_msgs::ImageConstPtr& silhouette);
+  void onPoseTooLate(const sensor_msgs::ImageConstPtr& silhouette);
   void reportPoseTimeouts();
+  void subscribe();
   bool reset(std_srvs::Empty::Request& request, std_srvs::Empty::Response& response);
   bool save(sift_hull::Save::Request& request, sift_hull::Save::Response& response);
 
   // Destroyed bottom up: subscriptions and services first, then the worker, then what it uses.
   ros::NodeHandle nh_, private_nh_;
   HullNodeConfig config_;
-  std::mutex hull_mutex_;  ///< guards stream_ and octree_ (the worker, ~reset, ~save)
+  /// Guards stream_, octree_, header_ and generation_ (the worker, ~reset, ~save, new
+  /// subscribers).
+  std::mutex hull_mutex_;
   HullStream stream_;
-  std::unique_ptr<octomap::OcTree> octree_;
+  std::unique_ptr<octomap::OcTree> octree_;  ///< the hull as last published
+  std_msgs::Header header_;                  ///< of the last publication
+  std::atomic<uint64_t> generation_{0};
   ThrottledLog log_;
   ros::Publisher octomap_pub_, cloud_pub_, markers_pub_, mesh_pub_;
-  std::atomic<double> last_carve_ms_{0.0}, last_publish_ms_{0.0};
+  std::atomic<double> last_carve_ms_{0.0}, last_publish_ms_{0.0}, last_view_stamp_{0.0};
   std::atomic<size_t> redundant_views_{0};
   WorkQueue<View> work_;
-  diagnostic_updater::Updater diagnostics_;
-  ros::WallTimer diagnostics_timer_;
+  NodeDiagnostics diagnostics_;
   PoseWaits pose_waits_;
   ros::WallTimer pose_timer_;
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
+  // Subscribed last, once every callback is in place.
   message_filters::Subscriber<sensor_msgs::Image> silhouette_sub_;
   message_filters::Subscriber<sensor_msgs::CameraInfo> info_sub_;
   tf2_ros::MessageFilter<sensor_msgs::Image> pose_filter_;
+  PoseGate pose_gate_;
   Sync sync_;
   ros::ServiceServer reset_srv_, save_srv_;
 };

@@ -4,6 +4,7 @@
 #include <image_transport/exception.h>
 
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
 namespace sift_hull {
@@ -27,8 +28,10 @@ ImageInput::ImageInput(image_transport::ImageTransport& transport, ros::NodeHand
 }
 
 void ImageInput::onCompressed(const sensor_msgs::CompressedImageConstPtr& compressed) {
-  const cv::Mat image =
+  const cv::Mat decoded =
       compressed->data.empty() ? cv::Mat() : cv::imdecode(compressed->data, cv::IMREAD_UNCHANGED);
+  cv::Mat image = decoded;
+  if (decoded.channels() == 4) cv::cvtColor(decoded, image, cv::COLOR_BGRA2BGR);
   if (image.empty() || image.depth() != CV_8U || (image.channels() != 1 && image.channels() != 3)) {
     log_.error("image ignored: ", "cannot decode an 8-bit image from the compressed '" +
                                       compressed->format + "' message on " +

@@ -25,9 +25,6 @@ class ImageInput : public message_filters::SimpleFilter<sensor_msgs::Image> {
              const ros::NodeHandle& private_nh, const std::string& topic, uint32_t queue_size,
              const std::string& transport_name);
 
-  /// Whether compressed images are decoded here rather than by an image_transport plugin.
-  bool decodesCompressed() const { return static_cast<bool>(compressed_sub_); }
-
  private:
   void onImage(const sensor_msgs::ImageConstPtr& image) { signalMessage(image); }
   void onCompressed(const sensor_msgs::CompressedImageConstPtr& compressed);

@@ -77,12 +77,11 @@ MatcherNode::MatcherNode(ros::NodeHandle nh, ros::NodeHandle private_nh, Matcher
       tf_listener_(tf_buffer_),
       work_(settings_.node.max_waiting_pairs, settings_.node.workers,
             [this](Pair& pair) { matchPair(pair); }),
-      diagnostics_(nh_, private_nh_, private_nh_.getNamespace()) {
+      diagnostics_(nh_, private_nh_, "matcher",
+                   [this](diagnostic_updater::DiagnosticStatusWrapper& status) {
+                     reportDiagnostics(status);
+                   }) {
   if (settings_.node.calibrated) points_pub_ = nh_.advertise<sensor_msgs::PointCloud2>("points", 1);
-  diagnostics_.setHardwareID("none");
-  diagnostics_.add("matcher", this, &MatcherNode::reportDiagnostics);
-  diagnostics_timer_ = nh_.createWallTimer(
-      ros::WallDuration(0.1), [this](const ros::WallTimerEvent&) { diagnostics_.update(); });
   serveReconfigure();
   subscribe();
 }
@@ -185,8 +184,9 @@ bool MatcherNode::stereoCameras(const Image& left, const Image& right, const Inf
                                 const Info& right_info, StereoCameras* cameras) {
   Eigen::Isometry3d T_L_R;
   try {
-    T_L_R = tf2::transformToEigen(tf_buffer_.lookupTransform(
-        left.header.frame_id, right.header.frame_id, left.header.stamp, ros::Duration(0.5)));
+    waitForTransform(left.header.frame_id, right.header.frame_id, left.header.stamp);
+    T_L_R = tf2::transformToEigen(
+        tf_buffer_.lookupTransform(left.header.frame_id, right.header.frame_id, left.header.stamp));
   } catch (const tf2::TransformException& e) {
     log_.error("matcher: pair ignored: ", e.what());
     return false;
@@ -219,12 +219,16 @@ void MatcherNode::onPair(const sensor_msgs::ImageConstPtr& left,
 }
 
 void MatcherNode::enqueue(Pair pair) {
-  if (!work_.push(std::move(pair))) {
-    ROS_WARN_THROTTLE(5.0,
-                      "matcher: %llu pair(s) dropped so far: pairs come faster than %d "
-                      "worker(s) match them (~max_waiting_pairs: %d)",
-                      static_cast<unsigned long long>(work_.counts().dropped),
-                      settings_.node.workers, settings_.node.max_waiting_pairs);
+  pushCounted(&work_, std::move(pair), "matcher: pairs waiting for a worker (~max_waiting_pairs)");
+}
+
+/// Up to 0.5 s of wall time for tf to catch up: tf2's own timeout sleeps in ROS time, which never
+/// passes once a bag's clock has stopped.
+void MatcherNode::waitForTransform(const std::string& target, const std::string& source,
+                                   const ros::Time& stamp) const {
+  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(0.5);
+  while (!tf_buffer_.canTransform(target, source, stamp) && ros::WallTime::now() < deadline) {
+    ros::WallDuration(0.01).sleep();
   }
 }
 

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "image_input.h"
+#include "node_diagnostics.h"
 #include "sift_hull/Correspondences.h"
 #include "sift_hull/MatcherConfig.h"
 #include "sift_hull/camera.h"
@@ -115,6 +116,8 @@ class MatcherNode {
                         const sensor_msgs::CameraInfoConstPtr& left_info,
                         const sensor_msgs::CameraInfoConstPtr& right_info);
   void enqueue(Pair pair);
+  void waitForTransform(const std::string& target, const std::string& source,
+                        const ros::Time& stamp) const;
   void matchPair(Pair& pair);
   void process(const Pipeline& pipeline, const sensor_msgs::ImageConstPtr& left,
                const sensor_msgs::ImageConstPtr& right, const StereoCameras* cameras);
@@ -143,8 +146,7 @@ class MatcherNode {
   tf2_ros::TransformListener tf_listener_;
   std::atomic<double> last_pair_ms_{0.0};
   WorkQueue<Pair> work_;
-  diagnostic_updater::Updater diagnostics_;
-  ros::WallTimer diagnostics_timer_;
+  NodeDiagnostics diagnostics_;
   boost::recursive_mutex reconfigure_mutex_;  // the server's, so updateConfig cannot race it
   std::unique_ptr<dynamic_reconfigure::Server<sift_hull::MatcherConfig>> reconfigure_;
   std::unique_ptr<ImageInput> left_sub_, right_sub_, frame_sub_;

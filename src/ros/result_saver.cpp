@@ -38,34 +38,67 @@ BagEnd readBagEnd(const std::string& bag_path) {
 
 ResultSaver::ResultSaver(ros::NodeHandle nh, ResultSaverConfig config, BagEnd bag_end)
     : nh_(nh), config_(std::move(config)), bag_end_(bag_end) {
-  octomap_sub_ = nh_.subscribe("octomap_binary", 1, &ResultSaver::onOctomap, this);
-  cloud_sub_ = nh_.subscribe("occupied_cells", 1, &ResultSaver::onCloud, this);
-  correspondences_sub_ = nh_.subscribe("correspondences", 1, &ResultSaver::onCorrespondences, this);
-  matches_image_sub_ = nh_.subscribe("matches_image", 1, &ResultSaver::onMatchesImage, this);
+  // Queues long enough that no output is lost while this node waits for its next spin.
+  octomap_sub_ = nh_.subscribe("octomap_binary", 100, &ResultSaver::onOctomap, this);
+  cloud_sub_ = nh_.subscribe("occupied_cells", 100, &ResultSaver::onCloud, this);
+  correspondences_sub_ =
+      nh_.subscribe("correspondences", 100, &ResultSaver::onCorrespondences, this);
+  matches_image_sub_ = nh_.subscribe("matches_image", 100, &ResultSaver::onMatchesImage, this);
+  diagnostics_sub_ = nh_.subscribe("/diagnostics", 100, &ResultSaver::onDiagnostics, this);
 }
+
+namespace {
+
+/// Keeps the message with the newest stamp: with several matcher workers, outputs can come out of
+/// stamp order.
+template <typename Ptr>
+void keepNewest(const Ptr& message, Ptr* kept) {
+  if (!*kept || message->header.stamp >= (*kept)->header.stamp) *kept = message;
+}
+
+}  // namespace
 
 void ResultSaver::onOctomap(const sift_hull::OctomapConstPtr& message) {
   ++hull_updates_;
-  octomap_ = message;
+  keepNewest(message, &octomap_);
 }
 
-void ResultSaver::onCloud(const sensor_msgs::PointCloud2ConstPtr& message) { cloud_ = message; }
+void ResultSaver::onCloud(const sensor_msgs::PointCloud2ConstPtr& message) {
+  keepNewest(message, &cloud_);
+}
 
 void ResultSaver::onCorrespondences(const sift_hull::CorrespondencesConstPtr& message) {
   ++pairs_matched_;
-  correspondences_ = message;
+  keepNewest(message, &correspondences_);
 }
 
 void ResultSaver::onMatchesImage(const sensor_msgs::ImageConstPtr& message) {
-  matches_image_ = message;
+  keepNewest(message, &matches_image_);
+}
+
+void ResultSaver::onDiagnostics(const diagnostic_msgs::DiagnosticArrayConstPtr& array) {
+  const std::string task = ": hull";
+  for (const diagnostic_msgs::DiagnosticStatus& status : array->status) {
+    const std::string& name = status.name;
+    if (name.size() < task.size() || name.compare(name.size() - task.size(), task.size(), task)) {
+      continue;
+    }
+    for (const diagnostic_msgs::KeyValue& pair : status.values) {
+      if (pair.key == "last view stamp") hull_last_view_s_ = std::stod(pair.value);
+    }
+  }
 }
 
 bool ResultSaver::complete() const {
   const auto reached = [](const auto& message, const ros::Time& stamp) {
     return message && message->header.stamp >= stamp;
   };
-  const bool hull_done = bag_end_.views == 0 || (reached(octomap_, bag_end_.last_view) &&
-                                                 reached(cloud_, bag_end_.last_view));
+  // A last view that changes nothing (redundant, say) brings no new octomap: the hull node's
+  // diagnostics then tell that it was processed.
+  const bool hull_processed_last_view =
+      (reached(octomap_, bag_end_.last_view) && reached(cloud_, bag_end_.last_view)) ||
+      (octomap_ && cloud_ && hull_last_view_s_ >= bag_end_.last_view.toSec() - 1e-6);
+  const bool hull_done = bag_end_.views == 0 || hull_processed_last_view;
   const bool matches_done = bag_end_.pairs == 0 || (reached(correspondences_, bag_end_.last_pair) &&
                                                     reached(matches_image_, bag_end_.last_pair));
   return hull_done && matches_done;

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <diagnostic_msgs/DiagnosticArray.h>
 #include <ros/ros.h>
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/PointCloud2.h>
@@ -46,6 +47,7 @@ class ResultSaver {
   void onCloud(const sensor_msgs::PointCloud2ConstPtr& message);
   void onCorrespondences(const sift_hull::CorrespondencesConstPtr& message);
   void onMatchesImage(const sensor_msgs::ImageConstPtr& message);
+  void onDiagnostics(const diagnostic_msgs::DiagnosticArrayConstPtr& array);
   std::string saveHull() const;
   std::string saveCloud() const;
   std::string saveMatchesImage() const;
@@ -59,7 +61,9 @@ class ResultSaver {
   sensor_msgs::PointCloud2ConstPtr cloud_;
   sift_hull::CorrespondencesConstPtr correspondences_;
   sensor_msgs::ImageConstPtr matches_image_;
-  ros::Subscriber octomap_sub_, cloud_sub_, correspondences_sub_, matches_image_sub_;
+  double hull_last_view_s_ = -1.0;  ///< the stamp of the last view the hull node processed
+  ros::Subscriber octomap_sub_, cloud_sub_, correspondences_sub_, matches_image_sub_,
+      diagnostics_sub_;
 };
 
 }  // namespace sift_hull

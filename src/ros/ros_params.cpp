@@ -1,5 +1,6 @@
 #include "ros_params.h"
 
+#include <cmath>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -142,6 +143,9 @@ MatcherSettings readMatcherSettings(const ros::NodeHandle& private_nh) {
   read(private_nh, "calibrated", &node.calibrated);
   read(private_nh, "frame_to_frame", &node.frame_to_frame);
   read(private_nh, "image_transport", &node.image_transport);
+  if (node.queue_size < 1 || node.max_waiting_pairs < 1 || node.workers < 1) {
+    throw std::invalid_argument("~queue_size, ~max_waiting_pairs and ~workers must be at least 1");
+  }
   settings.sift = readSiftConfig(private_nh);
   settings.matching = readMatchConfig(private_nh);
   settings.filters = readFilterConfigs(private_nh);
@@ -155,6 +159,10 @@ HullNodeConfig readHullNodeConfig(const ros::NodeHandle& private_nh) {
   read(private_nh, "pose_timeout_s", &config.pose_timeout_s);
   read(private_nh, "from_image", &config.from_image);
   config.recipe = readSilhouetteConfig(private_nh);
+  if (config.queue_size < 1) throw std::invalid_argument("~queue_size must be at least 1");
+  if (!std::isfinite(config.pose_timeout_s)) {
+    throw std::invalid_argument("~pose_timeout_s must be a number");
+  }
   return config;
 }
 

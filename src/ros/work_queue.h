@@ -16,6 +16,7 @@ struct WorkCounts {
   uint64_t pushed = 0;   ///< items queued
   uint64_t dropped = 0;  ///< items dropped from a full queue, unprocessed
   uint64_t done = 0;     ///< items processed
+  uint64_t failed = 0;   ///< of those, items whose processing threw
   size_t waiting = 0;    ///< items in the queue now
 };
 
@@ -25,7 +26,8 @@ struct WorkCounts {
 template <typename Item>
 class WorkQueue {
  public:
-  /// `process` runs on one of `workers` threads; it must not throw.
+  /// `process` runs on one of `workers` threads; it should not throw (what it throws is counted
+  /// as failed and otherwise ignored, so that the worker lives on).
   WorkQueue(size_t capacity, int workers, std::function<void(Item&)> process)
       : capacity_(std::max<size_t>(capacity, 1)), process_(std::move(process)) {
     for (int i = 0; i < std::max(workers, 1); ++i) workers_.emplace_back([this] { work(); });
@@ -35,10 +37,12 @@ class WorkQueue {
   ~WorkQueue() { stop(); }
 
   /// Queues `item`; returns false when the oldest waiting item was dropped to make room for it.
+  /// After stop(), items are ignored.
   bool push(Item item) {
     bool made_room = false;
     {
       std::lock_guard<std::mutex> lock(mutex_);
+      if (stopping_) return true;
       if (queue_.size() >= capacity_) {
         queue_.pop_front();
         ++counts_.dropped;
@@ -63,6 +67,7 @@ class WorkQueue {
     std::lock_guard<std::mutex> lock(mutex_);
     const size_t waiting = queue_.size();
     queue_.clear();
+    idle_.notify_all();
     return waiting;
   }
 
@@ -80,6 +85,7 @@ class WorkQueue {
       queue_.clear();
     }
     ready_.notify_all();
+    idle_.notify_all();
     for (std::thread& worker : workers_) {
       if (worker.joinable()) worker.join();
     }
@@ -95,11 +101,21 @@ class WorkQueue {
       queue_.pop_front();
       ++busy_;
       lock.unlock();
-      process_(item);
+      const bool failed = !processes(item);
       lock.lock();
       --busy_;
       ++counts_.done;
+      counts_.failed += failed;
       idle_.notify_all();
+    }
+  }
+
+  bool processes(Item& item) {
+    try {
+      process_(item);
+      return true;
+    } catch (...) {
+      return false;
     }
   }
 
