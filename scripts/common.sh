@@ -14,7 +14,12 @@ prepare_demo() {
   local out="$1"
   bash "$repo_root/scripts/setup.sh"
   echo "building (log: $workspace/build.log) ..."
-  sift_hull="$(bash "$repo_root/scripts/build.sh" 2>"$workspace/build.log" | tail -n 1)"
+  if ! sift_hull="$(bash "$repo_root/scripts/build.sh" 2>"$workspace/build.log" | tail -n 1)" ||
+    [[ ! -x "$sift_hull" ]]; then
+    tail -n 30 "$workspace/build.log" >&2
+    echo "the build failed; log: $workspace/build.log" >&2
+    return 1
+  fi
   mkdir -p "$out"
   echo "rendering the synthetic scene ..."
   "$sift_hull" scene --out "$out/scene" --views 16 --size 640x480

@@ -17,14 +17,14 @@ run_demo_launch "$out" >"$out/launch.log" 2>&1 && test -s "$out/nodes/summary.js
 /usr/bin/python3 - "$out/nodes/summary.json" <<'PY'
 import json, sys
 s = json.load(open(sys.argv[1]))
+if not s["complete"]:
+    sys.exit("the nodes did not process the bag's last view or pair in time: " + sys.argv[1])
 h, m = s["hull"], s["matcher"]
 print(f"  hull: {h['views_in_bag']} views, {h['occupied_cells']} occupied cells of "
       f"{h['resolution_m'] * 100:.1f} cm")
-kept = ", ".join(f"{k} kept {v}" for k, v in m["last_pair"]["kept"].items())
+kept = ", ".join(f"{k} kept {v}" for k, v in m.get("last_pair", {}).get("kept", {}).items())
 print(f"  matcher: {m['pairs_matched']} of {m['pairs_in_bag']} pairs; last pair "
-      f"{m['last_pair']['matches']} matches, {kept}")
-if not s["complete"]:
-    sys.exit("the nodes did not process the bag's last view or pair in time")
+      f"{m.get('last_pair', {}).get('matches', 0)} matches, {kept}")
 PY
 
 echo "offline: matching views 0 and 1 (SIFT, then every filter) ..."

@@ -7,12 +7,19 @@ set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 source "$here/common.sh"
 out="$(realpath -m "${1:-$repo_root/demo_output}")"
-display=":${SIFT_HULL_DISPLAY:-87}"
 
 prepare_demo "$out"
 
-Xvfb "$display" -screen 0 1280x800x24 -nolisten tcp >"$out/xvfb.log" 2>&1 &
+# Xvfb picks a free display and writes its number once it accepts clients.
+rm -f "$out/xvfb.display"
+Xvfb -displayfd 3 -screen 0 1280x800x24 -nolisten tcp 3>"$out/xvfb.display" >"$out/xvfb.log" 2>&1 &
 xvfb=$!
+for _ in $(seq 100); do
+  [[ -s "$out/xvfb.display" ]] && break
+  sleep 0.1
+done
+[[ -s "$out/xvfb.display" ]] || { cat "$out/xvfb.log" >&2; echo "Xvfb did not start" >&2; exit 1; }
+display=":$(head -n 1 "$out/xvfb.display")"
 launch=""
 cleanup() {
   # The launch runs under timeout in a subshell; timeout passes the interrupt on to roslaunch.

@@ -11,6 +11,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "sift_hull/mesh.h"
+#include "../src/ros/free_port.h"
 #include "test_data.h"
 
 namespace sift_hull {
@@ -43,7 +44,7 @@ class DemoLaunch : public ::testing::TestWithParam<bool> {
 
   /// Runs demo.launch with a master of its own on a port no other test uses; returns its exit code.
   static int runDemoLaunch(const std::string& out_dir, bool nodelets, std::string* log) {
-    const int port = 20000 + static_cast<int>(getpid() % 20000);
+    const int port = freeTcpPort();
     const std::string uri = "http://localhost:" + std::to_string(port);
     const std::string command = "ROS_MASTER_URI=" + uri + " timeout 150 roslaunch -p " +
                                 std::to_string(port) + " sift_hull demo.launch bag:=" + dir_ +

@@ -5,6 +5,10 @@
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 
+#include <functional>
+#include <string>
+#include <utility>
+
 #include "../src/ros/ros_params.h"
 
 namespace sift_hull {
@@ -76,6 +80,43 @@ TEST(ParameterReaders, TheParameterFilesRestateTheStructDefaults) {
   ASSERT_TRUE(ros::param::has("/matcher_yaml/filters"));
   expectDefaultHull(ros::NodeHandle("/hull_yaml"));
   expectDefaultMatcher(ros::NodeHandle("/matcher_yaml"));
+}
+
+/// Whether `read` looks at the parameter `key` of the file loaded into `ns`: a copy of the file
+/// with that key set to a dictionary, a type no reader takes, must be refused.
+bool isRead(const std::string& ns, const std::string& key,
+            const std::function<void(const ros::NodeHandle&)>& read) {
+  XmlRpc::XmlRpcValue file;
+  if (!ros::param::get(ns, file)) return false;
+  XmlRpc::XmlRpcValue dictionary;
+  dictionary["not"] = "a parameter value";
+  file[key] = dictionary;
+  const std::string probe = "/probe" + ns + "_" + key;
+  ros::param::set(probe, file);
+  try {
+    read(ros::NodeHandle(probe));
+  } catch (const std::invalid_argument&) {
+    return true;
+  }
+  return false;
+}
+
+TEST(ParameterReaders, EveryKeyOfTheParameterFilesIsRead) {
+  const auto hull = [](const ros::NodeHandle& nh) {
+    readHullNodeConfig(nh);
+    readHullStreamConfig(nh);
+  };
+  const auto matcher = [](const ros::NodeHandle& nh) { readMatcherSettings(nh); };
+  for (const auto& [ns, read] :
+       {std::pair<std::string, std::function<void(const ros::NodeHandle&)>>("/hull_yaml", hull),
+        {"/matcher_yaml", matcher}}) {
+    XmlRpc::XmlRpcValue file;
+    ASSERT_TRUE(ros::param::get(ns, file));
+    ASSERT_EQ(file.getType(), XmlRpc::XmlRpcValue::TypeStruct);
+    for (const auto& [key, value] : file) {
+      EXPECT_TRUE(isRead(ns, key, read)) << ns << "/" << key << " is not read by any reader";
+    }
+  }
 }
 
 TEST(ParameterReaders, UnsetParametersGiveTheStructDefaults) {

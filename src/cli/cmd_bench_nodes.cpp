@@ -172,6 +172,42 @@ class MatcherFeed {
   ros::Publisher left_, right_;
 };
 
+using SendTimes = std::map<ros::Time, ros::WallTime>;
+
+/// Sends pairs at `run->input_hz` for `seconds`, sampling the node's memory; when each was sent.
+SendTimes streamPairs(MatcherFeed& feed, pid_t pid, double seconds, MatcherRun* run) {
+  SendTimes sent;
+  const ros::WallTime start = ros::WallTime::now();
+  for (int k = 0; (ros::WallTime::now() - start).toSec() < seconds; ++k) {
+    const ros::WallTime due = start + ros::WallDuration(k / run->input_hz);
+    if (ros::WallTime::now() < due) (due - ros::WallTime::now()).sleep();
+    sent[feed.publish(k)] = ros::WallTime::now();
+    const double rss = residentMiB(pid);
+    if (run->rss_first_mib == 0.0 && (ros::WallTime::now() - start).toSec() > 1.0) {
+      run->rss_first_mib = rss;
+    }
+    run->rss_max_mib = std::max(run->rss_max_mib, rss);
+  }
+  return sent;
+}
+
+/// Answered rate (from the first pair sent to the last answer) and median latency.
+void summariseAnswers(const SendTimes& sent, const ArrivalLog<sift_hull::Correspondences>& answers,
+                      MatcherRun* run) {
+  std::vector<double> latencies;
+  const ros::WallTime start = sent.begin()->second;
+  ros::WallTime last_answer = start;
+  for (const auto& [stamp, when] : sent) {
+    const std::optional<ros::WallTime> arrival = answers.arrival(stamp);
+    if (!arrival) continue;
+    latencies.push_back((*arrival - when).toSec() * 1e3);
+    last_answer = std::max(last_answer, *arrival);
+  }
+  run->answered = static_cast<int>(latencies.size());
+  run->answered_per_s = run->answered / std::max((last_answer - start).toSec(), 1e-9);
+  run->latency_ms = median(latencies);
+}
+
 MatcherRun runMatcher(RosHarness& harness, const StereoStream& stream, int workers, double input_hz,
                       double seconds) {
   const pid_t pid = harness.startNode(
@@ -187,40 +223,19 @@ MatcherRun runMatcher(RosHarness& harness, const StereoStream& stream, int worke
     const ros::Time stamp = feed.publish(k);
     waitUntil([&] { return answers.arrival(stamp).has_value(); });
   }
-  const size_t warm = answers.count();
   MatcherRun run{workers, input_hz};
-  std::map<ros::Time, ros::WallTime> sent;
-  const ros::WallTime start = ros::WallTime::now();
-  for (int k = 0; (ros::WallTime::now() - start).toSec() < seconds; ++k) {
-    const ros::WallTime due = start + ros::WallDuration(k / input_hz);
-    if (ros::WallTime::now() < due) (due - ros::WallTime::now()).sleep();
-    sent[feed.publish(k)] = ros::WallTime::now();
-    const double rss = residentMiB(pid);
-    if (run.rss_first_mib == 0.0 && (ros::WallTime::now() - start).toSec() > 1.0) {
-      run.rss_first_mib = rss;
-    }
-    run.rss_max_mib = std::max(run.rss_max_mib, rss);
-  }
+  const SendTimes sent = streamPairs(feed, pid, seconds, &run);
   run.published = static_cast<int>(sent.size());
   waitUntil(
       [&] {
-        return diagnostics.value("pairs processed") + diagnostics.value("pairs dropped") >=
-               run.published + 2;
+        const double settled =
+            diagnostics.value("pairs processed") + diagnostics.value("pairs dropped");
+        return settled >= run.published + 2;  // and the two of the warm-up
       },
       10.0);
   run.rss_last_mib = residentMiB(pid);
   run.dropped = diagnostics.value("pairs dropped");
-  run.answered = static_cast<int>(answers.count() - warm);
-  std::vector<double> latencies;
-  ros::WallTime last_answer = start;
-  for (const auto& [stamp, when] : sent) {
-    const std::optional<ros::WallTime> arrival = answers.arrival(stamp);
-    if (!arrival) continue;
-    latencies.push_back((*arrival - when).toSec() * 1e3);
-    last_answer = std::max(last_answer, *arrival);
-  }
-  run.answered_per_s = run.answered / std::max((last_answer - start).toSec(), 1e-9);
-  run.latency_ms = median(latencies);
+  summariseAnswers(sent, answers, &run);
   harness.stopNode(pid);
   return run;
 }
@@ -284,6 +299,8 @@ void measureViews(HullFeed& feed, const ArrivalLog<sift_hull::Octomap>& octomaps
     if (!waitUntil([&] { return diagnostics.value("views processed") >= i + 1; })) {
       throw std::runtime_error("bench-nodes: hull_node did not process view " + std::to_string(i));
     }
+    // A view that changed the hull is followed by its octomap; give it a moment to arrive.
+    waitUntil([&] { return octomaps.arrival(stamp).has_value(); }, 0.5);
     const std::optional<ros::WallTime> arrival = octomaps.arrival(stamp);
     if (had_hull && arrival) {  // refined an existing hull: the incremental case
       carve.push_back(diagnostics.value("last view carve ms"));

@@ -17,6 +17,8 @@
 #include <stdexcept>
 #include <thread>
 
+#include "../ros/free_port.h"
+
 extern char** environ;
 
 namespace sift_hull {
@@ -68,10 +70,12 @@ bool accepts(int port) {
   return open;
 }
 
-bool waitForPort(int port, std::chrono::seconds limit) {
+/// Until `port` accepts connections, while `server` lives.
+bool waitForPort(int port, pid_t server, std::chrono::seconds limit) {
   const auto deadline = std::chrono::steady_clock::now() + limit;
   while (std::chrono::steady_clock::now() < deadline) {
     if (accepts(port)) return true;
+    if (waitpid(server, nullptr, WNOHANG) == server) return false;
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
   }
   return false;
@@ -84,14 +88,14 @@ std::string executableDirectory() {
 }  // namespace
 
 RosHarness::RosHarness() {
-  const int port = 21000 + static_cast<int>(getpid() % 20000);
+  const int port = freeTcpPort();
   const std::string uri = "http://localhost:" + std::to_string(port) + "/";
   setenv("ROS_MASTER_URI", uri.c_str(), 1);
   log_path_ = (std::filesystem::temp_directory_path() /
                ("sift_hull_ros_harness_" + std::to_string(getpid()) + ".log"))
                   .string();
   master_ = spawn({"rosmaster", "--core", "-p", std::to_string(port)}, log_path_);
-  if (!waitForPort(port, std::chrono::seconds(20))) {
+  if (!waitForPort(port, master_, std::chrono::seconds(20))) {
     interrupt(master_);
     throw std::runtime_error("no ROS master at " + uri + " after 20 s");
   }
