@@ -105,15 +105,27 @@ TEST(WorkQueue, CountsAThrowingItemAsFailedAndGoesOn) {
   EXPECT_EQ(queue.counts().done, 3u);
 }
 
-TEST(WorkQueue, StopsWithItemsWaiting) {
+TEST(WorkQueue, StopsAfterTheItemInHandAndDiscardsTheWaitingOnes) {
+  std::promise<void> release;
+  std::shared_future<void> released = release.get_future().share();
+  std::promise<void> first_taken;
   std::atomic<int> done{0};
-  auto queue = std::make_unique<WorkQueue<int>>(10, 1, [&](int&) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  WorkQueue<int> queue(10, 1, [&](int& item) {
+    if (item == 0) {
+      first_taken.set_value();
+      released.wait();
+    }
     ++done;
   });
-  for (int i = 0; i < 10; ++i) queue->push(i);
-  queue.reset();  // joins after the item in hand, the rest discarded
-  EXPECT_LT(done.load(), 10);
+  for (int i = 0; i < 10; ++i) queue.push(i);
+  first_taken.get_future().wait();
+  std::thread stopper([&] { queue.stop(); });
+  while (queue.counts().waiting > 0) std::this_thread::yield();  // stop() has discarded them
+  release.set_value();
+  stopper.join();
+  EXPECT_EQ(done.load(), 1);
+  queue.push(11);  // ignored once stopped
+  EXPECT_EQ(queue.counts().waiting, 0u);
 }
 
 }  // namespace
