@@ -4,6 +4,8 @@
 
 #include <functional>
 
+#include "../src/ros/wall_wait.h"
+
 namespace sift_hull {
 namespace test {
 
@@ -12,13 +14,7 @@ constexpr double kDeadline_s = 30.0;
 
 /// Spins until `done` holds or the deadline passes; returns `done()`.
 inline bool waitFor(const std::function<bool()>& done, double seconds = kDeadline_s) {
-  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(seconds);
-  while (ros::ok() && ros::WallTime::now() < deadline) {
-    ros::spinOnce();
-    if (done()) return true;
-    ros::WallDuration(0.01).sleep();
-  }
-  return done();
+  return waitOnWallClock(done, seconds, 0.01, [] { ros::spinOnce(); });
 }
 
 }  // namespace test

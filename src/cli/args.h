@@ -54,5 +54,15 @@ class ArgParser {
   std::map<std::string, std::vector<std::string>> repeated_values_;
 };
 
+/// validate(config), a bad value reported as a bad command line (UsageError).
+template <typename Config>
+void validateOptions(const Config& config) {
+  try {
+    validate(config);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+}
+
 }  // namespace cli
 }  // namespace sift_hull

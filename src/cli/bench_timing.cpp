@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <iomanip>
+#include <sstream>
 #include <vector>
 
 namespace sift_hull {
@@ -20,8 +22,28 @@ double medianMs(const std::function<void()>& run, double budget_ms, int min_repe
     times.push_back(std::chrono::duration<double, std::milli>(stop - start).count());
     total += times.back();
   }
-  std::nth_element(times.begin(), times.begin() + times.size() / 2, times.end());
-  return times[times.size() / 2];
+  return median(times);
+}
+
+double median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  return values[values.size() / 2];
+}
+
+std::string fixed(double value, int digits) {
+  std::ostringstream out;
+  out << std::fixed << std::setprecision(digits) << value;
+  return out.str();
+}
+
+std::string targetsMarkdown(const nlohmann::json& targets) {
+  std::ostringstream out;
+  out << "### Targets\n\n";
+  for (const auto& [name, value] : targets.items()) {
+    out << "- `" << name << "`: " << value.dump() << '\n';
+  }
+  return out.str();
 }
 
 double peakMemoryMiB() {

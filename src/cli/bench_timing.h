@@ -1,9 +1,21 @@
 #pragma once
 
 #include <functional>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
 
 namespace sift_hull {
 namespace cli {
+
+/// The middle value (the upper one of an even count); 0 for none.
+double median(std::vector<double> values);
+
+/// `value` with `digits` decimals, for the Markdown tables of the benchmarks.
+std::string fixed(double value, int digits);
+
+/// "### Targets" and one line per target: `name`: its JSON (measured, met).
+std::string targetsMarkdown(const nlohmann::json& targets);
 
 /// Median wall time in ms of `run` over repeats: at least `min_repeats`, more while the total is
 /// under `budget_ms`, at most 101.

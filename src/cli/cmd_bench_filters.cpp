@@ -198,10 +198,8 @@ std::string markdown(const nlohmann::json& result) {
        << tableOneMarkdown(result["table1"]);
   }
   md << "\n### Sweep: " << result["sweep_base"].get<std::string>() << "\n\n"
-     << sweepMarkdown(result["sweep"]) << "\n### Targets\n\n";
-  for (const auto& [name, target] : result["targets"].items()) {
-    md << "- `" << name << "`: " << target.dump() << "\n";
-  }
+     << sweepMarkdown(result["sweep"]) << '\n'
+     << targetsMarkdown(result["targets"]);
   return md.str();
 }
 

@@ -32,11 +32,6 @@ struct DepthRun {
   double dense_ms = 0.0, volume_iou = 0.0;
 };
 
-double median(std::vector<double> values) {
-  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
-  return values[values.size() / 2];
-}
-
 HullTimings medianTimings(const std::vector<HullTimings>& runs) {
   const auto field = [&](double HullTimings::*member) {
     std::vector<double> values;
@@ -133,12 +128,6 @@ nlohmann::json depthJson(const DepthRun& run) {
           {"volume_iou_vs_dense", run.volume_iou}};
 }
 
-std::string fixed(double value, int digits) {
-  std::ostringstream out;
-  out << std::fixed << std::setprecision(digits) << value;
-  return out.str();
-}
-
 std::string markdownTable(const std::vector<DatasetRuns>& all) {
   std::ostringstream out;
   out << "| data (views) | depth | distance | bbox | octree | mesh | total | dense carving | "
@@ -191,10 +180,7 @@ std::string markdownReport(const std::vector<DatasetRuns>& all, const nlohmann::
     out << ' ' << runs.name << ' ' << fixed(runs.peak_mib_depth9, 0) << " / "
         << fixed(runs.command_peak_mib_depth9, 0) << " MiB;";
   }
-  out << "\n\n### Targets\n\n";
-  for (const auto& [name, value] : targets.items()) {
-    out << "- `" << name << "`: " << value.dump() << '\n';
-  }
+  out << "\n\n" << targetsMarkdown(targets);
   return out.str();
 }
 

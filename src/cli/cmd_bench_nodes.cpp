@@ -20,7 +20,9 @@
 
 #include "../ros/conversions.h"
 #include "../ros/matcher_node.h"
+#include "../ros/wall_wait.h"
 #include "args.h"
+#include "bench_timing.h"
 #include "commands.h"
 #include "hull_options.h"
 #include "pair_data.h"
@@ -36,26 +38,9 @@ namespace {
 
 constexpr double kDeadline_s = 30.0;
 
-double median(std::vector<double> values) {
-  if (values.empty()) return 0.0;
-  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
-  return values[values.size() / 2];
-}
-
-std::string fixed(double value, int digits) {
-  std::ostringstream out;
-  out << std::fixed << std::setprecision(digits) << value;
-  return out.str();
-}
-
-/// Waits (spinning in the background) until `done` holds or the deadline passes.
+/// Waits (the AsyncSpinner spins) until `done` holds or the deadline passes.
 bool waitUntil(const std::function<bool()>& done, double seconds = kDeadline_s) {
-  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(seconds);
-  while (ros::ok() && ros::WallTime::now() < deadline) {
-    if (done()) return true;
-    ros::WallDuration(0.005).sleep();
-  }
-  return done();
+  return waitOnWallClock(done, seconds, 0.005);
 }
 
 /// The latest values of one node's diagnostics task, e.g. "pairs dropped".
@@ -444,10 +429,7 @@ std::string markdownReport(const std::vector<MatcherRun>& matcher,
         << fixed(r.overload_dropped, 0) << " | " << fixed(r.rss_first_mib, 0) << " / "
         << fixed(r.rss_last_mib, 0) << " |\n";
   }
-  out << "\n### Targets\n\n";
-  for (const auto& [name, value] : targets.items()) {
-    out << "- `" << name << "`: " << value.dump() << '\n';
-  }
+  out << '\n' << targetsMarkdown(targets);
   return out.str();
 }
 

@@ -46,11 +46,7 @@ SceneConfig configFromArgs(const ArgParser& parser) {
   config.layout = parser.get("layout");
   config.seed = static_cast<unsigned>(parser.getInt("seed"));
   config.camera_distance_m = parser.getDouble("distance");
-  try {
-    validate(config);
-  } catch (const std::invalid_argument& e) {
-    throw UsageError(e.what());
-  }
+  validateOptions(config);
   return config;
 }
 

@@ -66,11 +66,7 @@ HullConfig hullConfigFromArgs(const ArgParser& parser) {
   config.carve_outside_image = parser.flag("carve-outside-image");
   config.distance_slack_px = parser.getDouble("slack");
   config.threads = parser.getInt("threads");
-  try {
-    validate(config);
-  } catch (const std::invalid_argument& e) {
-    throw UsageError(e.what());
-  }
+  validateOptions(config);
   return config;
 }
 

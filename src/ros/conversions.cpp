@@ -180,15 +180,11 @@ sensor_msgs::PointCloud2 pointCloudMessage(const std::vector<Eigen::Vector3d>& p
 
 sensor_msgs::PointCloud2 occupiedCellsCloud(const octomap::OcTree& tree,
                                             const std_msgs::Header& header) {
-  pcl::PointCloud<pcl::PointXYZ> cloud;
+  std::vector<Eigen::Vector3d> centres;
   for (auto leaf = tree.begin_leafs(); leaf != tree.end_leafs(); ++leaf) {
-    if (!tree.isNodeOccupied(*leaf)) continue;
-    cloud.push_back(pcl::PointXYZ(leaf.getX(), leaf.getY(), leaf.getZ()));
+    if (tree.isNodeOccupied(*leaf)) centres.emplace_back(leaf.getX(), leaf.getY(), leaf.getZ());
   }
-  sensor_msgs::PointCloud2 message;
-  pcl::toROSMsg(cloud, message);
-  message.header = header;
-  return message;
+  return pointCloudMessage(centres, header);
 }
 
 namespace {

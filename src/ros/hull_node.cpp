@@ -8,6 +8,7 @@
 #include "node_diagnostics.h"
 #include "ros_params.h"
 #include "sift_hull/hull_octomap.h"
+#include "sift_hull/mesh.h"
 
 namespace sift_hull {
 namespace {
@@ -195,14 +196,20 @@ void HullNode::publish(const ros::Time& stamp) {
   header_.stamp = stamp;
   header_.frame_id = config_.world_frame;
   octree_ = toOctomap(stream_.hull());
+  mesh_.reset();
   octomap_pub_.publish(ros_conversions::octomapMessage(*octree_, header_));
   cloud_pub_.publish(ros_conversions::occupiedCellsCloud(*octree_, header_));
   if (markers_pub_.getNumSubscribers() > 0) {
     markers_pub_.publish(ros_conversions::occupiedCellsMarkers(*octree_, header_));
   }
   if (mesh_pub_.getNumSubscribers() > 0) {
-    mesh_pub_.publish(ros_conversions::meshMarker(stream_.hull().mesh(), header_));
+    mesh_pub_.publish(ros_conversions::meshMarker(publishedMesh(), header_));
   }
+}
+
+const TriangleMesh& HullNode::publishedMesh() {
+  if (!mesh_) mesh_ = std::make_unique<TriangleMesh>(stream_.hull().mesh());
+  return *mesh_;
 }
 
 void HullNode::publishMarkersNow() {
@@ -212,7 +219,7 @@ void HullNode::publishMarkersNow() {
 
 void HullNode::publishMeshNow() {
   std::lock_guard<std::mutex> lock(hull_mutex_);
-  if (octree_) mesh_pub_.publish(ros_conversions::meshMarker(stream_.hull().mesh(), header_));
+  if (octree_) mesh_pub_.publish(ros_conversions::meshMarker(publishedMesh(), header_));
 }
 
 /// An empty map at the last resolution, and markers deleted.
@@ -238,6 +245,7 @@ bool HullNode::reset(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
   stream_.reset();
   publishEmpty();
   octree_.reset();
+  mesh_.reset();
   ROS_INFO("hull: reset (%zu view(s) waiting to be carved discarded)", discarded);
   return true;
 }
@@ -251,7 +259,7 @@ bool HullNode::save(sift_hull::Save::Request& request, sift_hull::Save::Response
   }
   try {
     writeOctomap(*octree_, request.path + ".bt");
-    writePly(request.path + ".ply", stream_.hull().mesh());
+    writePly(request.path + ".ply", publishedMesh());
     response.success = true;
     response.message = "wrote " + request.path + ".bt and " + request.path + ".ply";
   } catch (const std::exception& e) {

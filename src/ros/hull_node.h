@@ -78,6 +78,9 @@ class HullNode {
   void publishMarkersNow();
   void publishMeshNow();
   void publishEmpty();
+  /// The published hull's mesh (marching cubes once per hull, shared by `mesh`, new subscribers
+  /// and ~save). Requires octree_.
+  const TriangleMesh& publishedMesh();
   void reportDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& status);
   void onPoseMissing(const sensor_msgs::ImageConstPtr& silhouette,
                      tf2_ros::filter_failure_reasons::FilterFailureReason reason);
@@ -91,11 +94,12 @@ class HullNode {
   // Destroyed bottom up: subscriptions and services first, then the worker, then what it uses.
   ros::NodeHandle nh_, private_nh_;
   HullNodeConfig config_;
-  /// Guards stream_, octree_, header_ and generation_ (the worker, ~reset, ~save, new
+  /// Guards stream_, octree_, mesh_, header_ and generation_ (the worker, ~reset, ~save, new
   /// subscribers).
   std::mutex hull_mutex_;
   HullStream stream_;
   std::unique_ptr<octomap::OcTree> octree_;  ///< the hull as last published
+  std::unique_ptr<TriangleMesh> mesh_;       ///< its mesh, made when first asked for
   std_msgs::Header header_;                  ///< of the last publication
   std::atomic<uint64_t> generation_{0};
   ThrottledLog log_;

@@ -5,13 +5,13 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <nlohmann/json.hpp>
 
 #include "conversions.h"
 #include "node_diagnostics.h"
 #include "ros_params.h"
 #include "sift_hull/match_drawing.h"
+#include "wall_wait.h"
 
 namespace sift_hull {
 namespace {
@@ -99,8 +99,8 @@ void MatcherNode::reportDiagnostics(diagnostic_updater::DiagnosticStatusWrapper&
 void MatcherNode::serveReconfigure() {
   sift_hull::MatcherConfig config;
   config.ratio = settings_.matching.ratio;
-  const double max_distance = settings_.matching.max_descriptor_distance;
-  config.max_descriptor_distance = std::isfinite(max_distance) ? max_distance : 0.0;
+  config.max_descriptor_distance =
+      ros_params::descriptorDistanceParam(settings_.matching.max_descriptor_distance);
   config.cross_check = settings_.matching.cross_check;
   config.gsc_max_histogram_distance = settings_.filters.gsc.max_histogram_distance;
   config.ransac_max_epipolar_px = settings_.filters.ransac.max_epipolar_px;
@@ -117,9 +117,8 @@ void MatcherNode::serveReconfigure() {
 void MatcherNode::onReconfigure(sift_hull::MatcherConfig& config, uint32_t) {
   MatcherSettings changed = pipeline()->settings;
   changed.matching.ratio = config.ratio;
-  changed.matching.max_descriptor_distance = config.max_descriptor_distance > 0.0
-                                                 ? config.max_descriptor_distance
-                                                 : std::numeric_limits<double>::infinity();
+  changed.matching.max_descriptor_distance =
+      ros_params::descriptorDistanceFromParam(config.max_descriptor_distance);
   changed.matching.cross_check = config.cross_check;
   changed.filters.gsc.max_histogram_distance = config.gsc_max_histogram_distance;
   changed.filters.ransac.max_epipolar_px = config.ransac_max_epipolar_px;
@@ -226,10 +225,7 @@ void MatcherNode::enqueue(Pair pair) {
 /// passes once a bag's clock has stopped.
 void MatcherNode::waitForTransform(const std::string& target, const std::string& source,
                                    const ros::Time& stamp) const {
-  const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(0.5);
-  while (!tf_buffer_.canTransform(target, source, stamp) && ros::WallTime::now() < deadline) {
-    ros::WallDuration(0.01).sleep();
-  }
+  waitOnWallClock([&] { return tf_buffer_.canTransform(target, source, stamp); }, 0.5, 0.01);
 }
 
 void MatcherNode::matchPair(Pair& pair) {

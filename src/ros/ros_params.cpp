@@ -1,6 +1,7 @@
 #include "ros_params.h"
 
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -36,6 +37,12 @@ void read(const ros::NodeHandle& private_nh, const std::string& name, int* value
 }
 
 }  // namespace
+
+double descriptorDistanceFromParam(double param) {
+  return param > 0.0 ? param : std::numeric_limits<double>::infinity();
+}
+
+double descriptorDistanceParam(double distance) { return std::isfinite(distance) ? distance : 0.0; }
 
 SilhouetteConfig readSilhouetteConfig(const ros::NodeHandle& private_nh) {
   SilhouetteConfig config;
@@ -95,9 +102,9 @@ SiftConfig readSiftConfig(const ros::NodeHandle& private_nh) {
 MatchConfig readMatchConfig(const ros::NodeHandle& private_nh) {
   MatchConfig config;
   read(private_nh, "ratio", &config.ratio);
-  double max_distance = 0.0;
+  double max_distance = descriptorDistanceParam(config.max_descriptor_distance);
   read(private_nh, "max_descriptor_distance", &max_distance);
-  if (max_distance > 0.0) config.max_descriptor_distance = max_distance;
+  config.max_descriptor_distance = descriptorDistanceFromParam(max_distance);
   read(private_nh, "cross_check", &config.cross_check);
   read(private_nh, "matcher", &config.backend);
   validate(config);

@@ -15,6 +15,11 @@
 namespace sift_hull {
 namespace ros_params {
 
+/// ~max_descriptor_distance, and its dynamic_reconfigure setting, write "no limit" as 0;
+/// MatchConfig writes it as infinity.
+double descriptorDistanceFromParam(double param);
+double descriptorDistanceParam(double distance);
+
 /// ~threshold (grey level in [0, 1]), ~dilate_px, ~erode_px: the Middlebury silhouette recipe.
 SilhouetteConfig readSilhouetteConfig(const ros::NodeHandle& private_nh);
 

@@ -5,6 +5,7 @@
 
 #include "result_saver.h"
 #include "ros_params.h"
+#include "wall_wait.h"
 
 int main(int argc, char** argv) {
   ros::init(argc, argv, "save_results");
@@ -13,12 +14,8 @@ int main(int argc, char** argv) {
     const sift_hull::ResultSaverConfig config =
         sift_hull::ros_params::readResultSaverConfig(private_nh);
     sift_hull::ResultSaver saver(nh, config, sift_hull::readBagEnd(config.bag));
-    const ros::WallTime deadline = ros::WallTime::now() + ros::WallDuration(config.timeout_s);
-    ros::WallRate rate(20.0);
-    while (ros::ok() && !saver.complete() && ros::WallTime::now() < deadline) {
-      ros::spinOnce();
-      rate.sleep();
-    }
+    sift_hull::waitOnWallClock([&] { return saver.complete(); }, config.timeout_s, 0.05,
+                               [] { ros::spinOnce(); });
     if (!ros::ok()) return 1;
     if (!saver.complete()) {
       ROS_ERROR(
