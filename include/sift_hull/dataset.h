@@ -67,6 +67,10 @@ struct SilhouetteConfig {
   int erode_px = 7;
 };
 
+/// Throws std::invalid_argument for a threshold outside [0, 1] or a radius outside
+/// [0, limits::kMaxMorphologyRadiusPx].
+void validate(const SilhouetteConfig& config);
+
 /// Mask (CV_8UC1, 255 inside, 0 outside) of the object in an 8-bit grey or BGR image.
 cv::Mat silhouetteFromImage(const cv::Mat& image, const SilhouetteConfig& config);
 

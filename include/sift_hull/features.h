@@ -1,6 +1,8 @@
 #pragma once
 
 #include <opencv2/core.hpp>
+
+#include "sift_hull/limits.h"
 #include <vector>
 
 namespace sift_hull {
@@ -12,6 +14,9 @@ struct SiftConfig {
   double contrast_threshold = 0.04;  ///< on DoG response (image values in [0, 1]), / octave_layers
   double edge_threshold = 10.0;      ///< largest principal-curvature ratio kept
   double sigma_px = 1.6;             ///< blur of the first octave's base image
+  /// Larger images are refused (detectSift throws): SIFT needs about 75 bytes per pixel of a
+  /// pair, so 25 megapixels (a 6000x4000 photo) keep a pair within 4 GiB.
+  size_t max_image_pixels = limits::kDefaultMaxImagePixels;
 };
 
 /// Throws std::invalid_argument naming the first bad field.
@@ -24,7 +29,11 @@ struct Features {
   cv::Mat descriptors;  ///< CV_32FC1, one 128-D row per keypoint
 };
 
-/// Detects and describes SIFT features in a colour (BGR) or grey 8-bit image.
+/// Throws std::invalid_argument when the image has more than config.max_image_pixels pixels.
+void checkImageSize(const cv::Mat& image, const SiftConfig& config);
+
+/// Detects and describes SIFT features in a colour (BGR) or grey 8-bit image. Throws
+/// std::invalid_argument for a bad config, an empty image or one over max_image_pixels.
 Features detectSift(const cv::Mat& image, const SiftConfig& config = SiftConfig());
 
 }  // namespace sift_hull

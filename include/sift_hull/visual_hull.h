@@ -82,7 +82,8 @@ void validate(const HullConfig& config);
 /// Where a view puts a cell or point.
 enum class Verdict : uint8_t { kOut, kIn, kUndecided };
 
-/// Points in structure-of-arrays form (world coordinates as floats), for batched look-ups.
+/// Points in structure-of-arrays form, for batched look-ups: coordinates as floats in the view's
+/// local frame (HullView::useFrame), X_local = (X_W - origin_W) / scale.
 struct PointBatch {
   const float* x;
   const float* y;
@@ -110,15 +111,26 @@ class HullView {
   /// The brute-force test of dense carving: whether the view keeps a point, by the mask pixel
   /// nearest to its projection, or by the bounds outside the image.
   bool keeps(const Eigen::Vector3d& X_W) const;
-  /// values[i] = max(values[i], D_i(P_i X_i)) for a batch of points: f_iso built view by view.
+  /// values[i] = max(values[i], D_i(P_i X_i)) for a batch of points in the local frame: f_iso
+  /// built view by view.
   void maxInto(const PointBatch& points, float* values) const;
-  /// For balls of one radius around up to 32 centres, from the distance at each centre and the
+  /// For balls of one radius (local units) around up to 32 centres (local frame), from the distance at each centre and the
   /// ball's projected radius (plus the slack): maxInto for the centres; bit i of `out_bits` set
   /// when the view sees all of ball i outside the silhouette, of `in_bits` when all inside.
   void classifyBalls(const PointBatch& centres, float radius_m, float* values, uint32_t* out_bits,
                      uint32_t* in_bits) const;
 
   static constexpr float kFarOutside_px = 1e6f;
+
+  /// The frame of the batched look-ups: X_local = (X_W - origin_W) / scale. Single-precision
+  /// arithmetic keeps its relative precision in a frame around the hull whatever the world
+  /// coordinates are (a map frame far from its origin, millimetres or kilometres). Projection is
+  /// invariant to the scale, so only the camera's translation changes: (R origin_W + t) / scale.
+  /// Throws std::invalid_argument when the camera lies more than kMaxCameraDistance local units
+  /// from the origin (it would see the frame's unit cube as less than a millionth of its focal
+  /// length) or the frame is not finite and positive. The default frame is the world's.
+  void useFrame(const Eigen::Vector3d& origin_W, double scale);
+  static constexpr double kMaxCameraDistance = 1e6;
 
  private:
   /// Pixel of a point in the camera frame (K's last row is 0 0 1).
@@ -132,6 +144,8 @@ class HullView {
   SilhouetteBounds bounds_;
   SignedDistanceMap distance_;
   bool carves_behind_ = true;
+  Eigen::Vector3d frame_origin_W_ = Eigen::Vector3d::Zero();
+  double frame_scale_ = 1.0;
   detail::DistanceKernel kernel_;
 };
 
@@ -188,7 +202,9 @@ class VisualHull {
   VisualHull(VisualHull&&) noexcept;
   VisualHull& operator=(VisualHull&&) noexcept;
 
-  /// Carves with more views. Before any view the whole cube is one in cell.
+  /// Carves with more views. Before any view the whole cube is one in cell. Throws
+  /// std::invalid_argument, before carving with any of them, when a view's camera is too far
+  /// from the cube for single precision (HullView::useFrame).
   void addViews(std::vector<HullView> views);
   void addView(HullView view);
   /// Back to one in cell and no views.
@@ -215,6 +231,9 @@ class VisualHull {
  private:
   HullCube cube_;
   HullConfig config_;
+  /// The views' local frame (HullView::useFrame): the cube's centre, half its edge.
+  Eigen::Vector3d frame_origin_W_;
+  double frame_scale_;
   std::vector<HullView> views_;
   std::unique_ptr<detail::HullNode> root_;
 };

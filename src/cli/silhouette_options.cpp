@@ -25,12 +25,7 @@ SilhouetteConfig silhouetteConfigFromArgs(const ArgParser& parser) {
   config.threshold = parser.getDouble("threshold");
   config.dilate_px = parser.getInt("dilate");
   config.erode_px = parser.getInt("erode");
-  if (config.threshold < 0.0 || config.threshold > 1.0) {
-    throw UsageError("--threshold must lie in [0, 1]");
-  }
-  if (config.dilate_px < 0 || config.erode_px < 0) {
-    throw UsageError("--dilate and --erode must not be negative");
-  }
+  validateOptions(config);
   return config;
 }
 

@@ -1,4 +1,5 @@
 #include "sift_hull/dataset.h"
+#include "sift_hull/limits.h"
 
 #include <Eigen/Dense>
 #include <algorithm>
@@ -30,6 +31,9 @@ std::vector<Line> readFields(const std::string& path) {
   std::vector<Line> lines;
   std::string text;
   for (int number = 1; std::getline(in, text); ++number) {
+    if (text.find('\0') != std::string::npos) {
+      throw ParseError(path, number, "the line holds a NUL byte: not a text file");
+    }
     std::istringstream words(text);
     Line line{number, {}};
     for (std::string word; words >> word;) line.fields.push_back(word);
@@ -42,7 +46,7 @@ std::vector<Line> readFields(const std::string& path) {
 bool readDouble(const std::string& word, double* value) {
   char* end = nullptr;
   *value = std::strtod(word.c_str(), &end);
-  return end != word.c_str() && *end == '\0';
+  return !word.empty() && end == word.c_str() + word.size();
 }
 
 bool isNumber(const std::string& word) {
@@ -224,7 +228,19 @@ cv::Mat loadViewImage(const std::string& directory, const CalibratedView& view) 
   return image;
 }
 
+void validate(const SilhouetteConfig& config) {
+  if (!(config.threshold >= 0.0 && config.threshold <= 1.0)) {
+    throw std::invalid_argument("SilhouetteConfig::threshold must be in [0, 1], got " +
+                                std::to_string(config.threshold));
+  }
+  limits::requireInRange("SilhouetteConfig::dilate_px", config.dilate_px, 0,
+                         limits::kMaxMorphologyRadiusPx);
+  limits::requireInRange("SilhouetteConfig::erode_px", config.erode_px, 0,
+                         limits::kMaxMorphologyRadiusPx);
+}
+
 cv::Mat silhouetteFromImage(const cv::Mat& image, const SilhouetteConfig& config) {
+  validate(config);
   if (image.empty() || image.depth() != CV_8U) {
     throw std::invalid_argument("silhouetteFromImage needs a non-empty 8-bit image");
   }

@@ -1,5 +1,7 @@
 #include "sift_hull/depth_io.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <fstream>
@@ -43,6 +45,27 @@ void writePfm(const std::string& path, const cv::Mat& image) {
   if (!out) throw std::runtime_error(path + ": write failed");
 }
 
+namespace {
+
+/// Throws ParseError, before anything is allocated, when the rest of the file is shorter than
+/// `floats` 4-byte values (a header cannot ask for more memory than the file holds).
+void checkPfmLength(const std::string& path, std::ifstream& in, size_t floats) {
+  const std::streampos data_start = in.tellg();
+  in.seekg(0, std::ios::end);
+  const std::streampos file_end = in.tellg();
+  in.seekg(data_start);
+  if (data_start < 0 || file_end < data_start ||
+      static_cast<size_t>(file_end - data_start) < floats * sizeof(float)) {
+    throw ParseError(path, 0,
+                     "the header announces " + std::to_string(floats) + " floats (" +
+                         std::to_string(floats * sizeof(float)) + " bytes) but the file holds " +
+                         std::to_string(std::max<std::streamoff>(0, file_end - data_start)) +
+                         " bytes after it");
+  }
+}
+
+}  // namespace
+
 cv::Mat readPfm(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw ParseError(path, 0, "cannot open file");
@@ -52,10 +75,12 @@ cv::Mat readPfm(const std::string& path) {
   in >> magic >> width >> height >> scale;
   if (!in || magic != "Pf") throw ParseError(path, 1, "not a one-channel PFM (expected 'Pf')");
   constexpr int kMaxSide = 1 << 15;
-  if (width <= 0 || height <= 0 || width > kMaxSide || height > kMaxSide || scale == 0.0) {
+  if (width <= 0 || height <= 0 || width > kMaxSide || height > kMaxSide || scale == 0.0 ||
+      !std::isfinite(scale)) {
     throw ParseError(path, 2, "bad PFM size or scale");
   }
   in.get();  // the single white-space character ending the header
+  checkPfmLength(path, in, static_cast<size_t>(width) * static_cast<size_t>(height));
   cv::Mat image(height, width, CV_32FC1);
   for (int row = height - 1; row >= 0; --row) {
     in.read(reinterpret_cast<char*>(image.ptr<float>(row)), width * sizeof(float));

@@ -70,6 +70,7 @@ __attribute__((target("avx2"))) __m256 affine(const float* row, float t, __m256 
                        _mm256_set1_ps(t));
 }
 
+/// clampToMap on eight values: _mm256_max_ps returns its second operand (0) for NaN.
 __attribute__((target("avx2"))) __m256 clampTo(__m256 value, float high) {
   return _mm256_min_ps(_mm256_max_ps(value, _mm256_setzero_ps()), _mm256_set1_ps(high));
 }

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cstddef>
 #include <cstdint>
 
 #include "sift_hull/visual_hull.h"
@@ -12,14 +13,21 @@ namespace detail {
 /// one exists.
 inline float lookUpLimit(int size) { return size - 1 - 1.0f / 512; }
 
+/// `value` clamped to [0, high]; NaN becomes 0, so a look-up never leaves the map. The AVX2 path
+/// (_mm256_max_ps(value, 0), which returns its second operand for NaN) agrees.
+inline float clampToMap(float value, float high) {
+  return value > 0.0f ? std::min(value, high) : 0.0f;
+}
+
 /// Bilinear look-up of a row-major float map at map coordinates (u, v), clamped to
-/// [0, u_high] x [0, v_high]. The AVX2 path (distance_kernel.cpp) does the same operations.
+/// [0, u_high] x [0, v_high] (clampToMap). The AVX2 path (distance_kernel.cpp) does the same
+/// operations.
 inline float lookUp(const float* map, int stride, float u_high, float v_high, float u, float v) {
-  u = std::min(std::max(u, 0.0f), u_high);
-  v = std::min(std::max(v, 0.0f), v_high);
+  u = clampToMap(u, u_high);
+  v = clampToMap(v, v_high);
   const int u0 = static_cast<int>(u), v0 = static_cast<int>(v);
   const float fu = u - u0, fv = v - v0;
-  const float* top = map + v0 * stride + u0;
+  const float* top = map + static_cast<ptrdiff_t>(v0) * stride + u0;
   const float* bottom = top + stride;
   const float upper = top[0] + fu * (top[1] - top[0]);
   const float lower = bottom[0] + fu * (bottom[1] - bottom[0]);

@@ -51,9 +51,10 @@ Eigen::Matrix3d readHomography(const std::string& path) {
     for (std::string word; words >> word;) {
       char* end = nullptr;
       const double value = std::strtod(word.c_str(), &end);
-      if (*end != '\0' || !std::isfinite(value)) {
+      if (end != word.c_str() + word.size() || !std::isfinite(value)) {
         throw ParseError(path, line_number, "not a number: " + word);
       }
+      if (values.size() == 9) throw ParseError(path, line_number, "more than 9 numbers");
       values.push_back(value);
     }
   }

@@ -1,5 +1,6 @@
 #include "sift_hull/features.h"
 
+#include <cmath>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
@@ -31,14 +32,30 @@ cv::Mat greyImage(const cv::Mat& image) {
 
 void validate(const SiftConfig& config) {
   require(config.max_features >= 0, "max_features must be >= 0");
-  require(config.octave_layers >= 1, "octave_layers must be >= 1");
-  require(config.contrast_threshold >= 0.0, "contrast_threshold must be >= 0");
-  require(config.edge_threshold > 0.0, "edge_threshold must be > 0");
-  require(config.sigma_px > 0.0, "sigma_px must be > 0");
+  require(config.octave_layers >= 1 && config.octave_layers <= limits::kMaxOctaveLayers,
+          "octave_layers must be in [1, " + std::to_string(limits::kMaxOctaveLayers) + "]");
+  require(config.contrast_threshold >= 0.0 && std::isfinite(config.contrast_threshold),
+          "contrast_threshold must be finite and >= 0");
+  require(config.edge_threshold > 0.0 && std::isfinite(config.edge_threshold),
+          "edge_threshold must be finite and > 0");
+  require(config.sigma_px > 0.0 && std::isfinite(config.sigma_px),
+          "sigma_px must be finite and > 0");
+  require(config.max_image_pixels >= 1, "max_image_pixels must be >= 1");
+}
+
+void checkImageSize(const cv::Mat& image, const SiftConfig& config) {
+  const size_t pixels = static_cast<size_t>(image.cols) * static_cast<size_t>(image.rows);
+  if (pixels > config.max_image_pixels) {
+    throw std::invalid_argument("the image is " + std::to_string(image.cols) + "x" +
+                                std::to_string(image.rows) + " = " + std::to_string(pixels) +
+                                " pixels, more than max_image_pixels (" +
+                                std::to_string(config.max_image_pixels) + ")");
+  }
 }
 
 Features detectSift(const cv::Mat& image, const SiftConfig& config) {
   validate(config);
+  checkImageSize(image, config);
   const cv::Ptr<cv::SIFT> sift =
       cv::SIFT::create(config.max_features, config.octave_layers, config.contrast_threshold,
                        config.edge_threshold, config.sigma_px);

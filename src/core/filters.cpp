@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "sift_hull/camera.h"
+#include "sift_hull/limits.h"
 
 namespace sift_hull {
 namespace {
@@ -150,11 +151,14 @@ size_t FilterResult::keptCount() const {
 void validate(const FilterConfigs& configs) {
   require(configs.epipolar.max_epipolar_px > 0.0, "epipolar.max_epipolar_px must be > 0");
   require(configs.gsc.max_histogram_distance >= 0.0, "gsc.max_histogram_distance must be >= 0");
-  require(configs.gsc.threads >= 0, "gsc.threads must be >= 0 (0: all)");
+  require(configs.gsc.threads >= 0 && configs.gsc.threads <= limits::kMaxThreads,
+          "gsc.threads must be in [0, " + std::to_string(limits::kMaxThreads) + "] (0: all)");
   validate(configs.ransac, "ransac");
   validate(configs.magsac, "magsac");
-  require(configs.gms.grid_cells >= 3, "gms.grid_cells must be >= 3");
-  require(configs.gms.threshold_factor > 0.0, "gms.threshold_factor must be > 0");
+  require(configs.gms.grid_cells >= 3 && configs.gms.grid_cells <= limits::kMaxGmsGridCells,
+          "gms.grid_cells must be in [3, " + std::to_string(limits::kMaxGmsGridCells) + "]");
+  require(configs.gms.threshold_factor > 0.0 && std::isfinite(configs.gms.threshold_factor),
+          "gms.threshold_factor must be finite and > 0");
 }
 
 const std::vector<std::string>& filterNames() {

@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "sift_hull/filters.h"
+#include "sift_hull/limits.h"
 
 namespace sift_hull {
 namespace {
@@ -263,11 +264,8 @@ std::vector<double> bestScores(const std::vector<NormalisedMatch>& matches,
 }
 
 void validateGmsConfig(const GmsConfig& config) {
-  if (config.grid_cells < 3) {
-    throw std::invalid_argument(
-        "GmsConfig::grid_cells must be at least 3 (a 3x3 neighbourhood), got " +
-        std::to_string(config.grid_cells));
-  }
+  limits::requireInRange("GmsConfig::grid_cells (a 3x3 neighbourhood at least)",
+                         config.grid_cells, 3, limits::kMaxGmsGridCells);
   if (!std::isfinite(config.threshold_factor) || config.threshold_factor <= 0.0) {
     throw std::invalid_argument("GmsConfig::threshold_factor must be finite and positive, got " +
                                 std::to_string(config.threshold_factor));

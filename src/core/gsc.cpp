@@ -17,6 +17,7 @@
 #include <cstdint>
 #include <thread>
 
+#include "parallel.h"
 #include "sift_hull/filters.h"
 
 namespace sift_hull {
@@ -189,19 +190,13 @@ int threadCount(int requested, size_t matches) {
   return static_cast<int>(std::min<size_t>(wanted, useful));
 }
 
-/// Histogram distance of every valid match, split over threads by interleaved indices.
+/// Histogram distance of every valid match, on `threads` threads.
 std::vector<double> histogramDistances(const PolarPoints& left, const PolarPoints& right,
                                        int threads) {
   std::vector<double> distances(left.count);
-  const auto work = [&](int first) {
-    for (size_t i = first; i < left.count; i += threads) {
-      distances[i] = histogramDistance(histogramAround(left, i), histogramAround(right, i));
-    }
-  };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t) pool.emplace_back(work, t);
-  work(0);
-  for (std::thread& thread : pool) thread.join();
+  detail::parallelFor(left.count, threads, [&](size_t i) {
+    distances[i] = histogramDistance(histogramAround(left, i), histogramAround(right, i));
+  });
   return distances;
 }
 

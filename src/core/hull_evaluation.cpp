@@ -6,6 +6,7 @@
 #include <opencv2/core.hpp>
 #include <stdexcept>
 #include <thread>
+#include "parallel.h"
 
 namespace sift_hull {
 namespace {
@@ -73,14 +74,8 @@ DenseGrid denseCarving(const std::vector<HullView>& views, const Box3d& cube, in
   grid.voxel_m = cube.size().maxCoeff() / cells;
   grid.cells = cells;
   grid.occupied.assign(static_cast<size_t>(cells) * cells * cells, 0);
-  std::atomic<int> next{0};
-  const auto work = [&] {
-    for (int k = next++; k < cells; k = next++) carveSlice(views, k, &grid);
-  };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t) pool.emplace_back(work);
-  work();
-  for (std::thread& thread : pool) thread.join();
+  detail::parallelFor(static_cast<size_t>(cells), threads,
+                      [&](size_t k) { carveSlice(views, static_cast<int>(k), &grid); });
   return grid;
 }
 

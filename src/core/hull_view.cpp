@@ -6,8 +6,10 @@
 #include <stdexcept>
 #include <thread>
 
+#include "parallel.h"
 #include "distance_kernel.h"
 #include "sift_hull/visual_hull.h"
+#include "sift_hull/limits.h"
 
 namespace sift_hull {
 namespace {
@@ -105,14 +107,12 @@ float SignedDistanceMap::at(double u_px, double v_px) const {
 }
 
 void validate(const HullConfig& config) {
-  if (config.max_depth < 2 || config.max_depth > 12) {
-    throw std::invalid_argument("HullConfig::max_depth must be in 2..12");
+  limits::requireInRange("HullConfig::max_depth", config.max_depth, 2, limits::kMaxHullDepth);
+  if (!(config.distance_slack_px >= 0.0) || !std::isfinite(config.distance_slack_px)) {
+    throw std::invalid_argument("HullConfig::distance_slack_px must be finite and >= 0");
   }
-  if (!(config.distance_slack_px >= 0.0)) {
-    throw std::invalid_argument("HullConfig::distance_slack_px must be >= 0");
-  }
-  if (config.padding_px < 1) throw std::invalid_argument("HullConfig::padding_px must be >= 1");
-  if (config.threads < 1) throw std::invalid_argument("HullConfig::threads must be >= 1");
+  limits::requireInRange("HullConfig::padding_px", config.padding_px, 1, limits::kMaxPaddingPx);
+  limits::requireInRange("HullConfig::threads", config.threads, 1, limits::kMaxThreads);
 }
 
 HullView::HullView(std::string name, const PinholeCamera& camera, const cv::Mat& mask,
@@ -145,9 +145,28 @@ detail::DistanceKernel HullView::makeKernel(const HullConfig& config) const {
   return kernel;
 }
 
+void HullView::useFrame(const Eigen::Vector3d& origin_W, double scale) {
+  if (!origin_W.allFinite() || !(scale > 0.0) || !std::isfinite(scale)) {
+    throw std::invalid_argument("view '" + name_ + "': the hull's frame is not finite and positive");
+  }
+  const double distance = (camera_.centre() - origin_W).norm() / scale;
+  if (!(distance <= kMaxCameraDistance)) {
+    throw std::invalid_argument(
+        "view '" + name_ + "': its camera lies " + std::to_string(distance) +
+        " half cube edges from the hull's centre, more than " +
+        std::to_string(kMaxCameraDistance) +
+        ": it would see the hull as a point; check the calibration and the box");
+  }
+  const Eigen::Vector3d t_local = (camera_.R() * origin_W + camera_.t()) / scale;
+  for (int i = 0; i < 3; ++i) kernel_.t[i] = static_cast<float>(t_local(i));
+  frame_origin_W_ = origin_W;
+  frame_scale_ = scale;
+}
+
 float HullView::valueAt(const Eigen::Vector3d& X_W) const {
-  const float x = static_cast<float>(X_W.x()), y = static_cast<float>(X_W.y()),
-              z = static_cast<float>(X_W.z());
+  const Eigen::Vector3d X_local = (X_W - frame_origin_W_) / frame_scale_;
+  const float x = static_cast<float>(X_local.x()), y = static_cast<float>(X_local.y()),
+              z = static_cast<float>(X_local.z());
   float value = -std::numeric_limits<float>::infinity();
   maxInto({&x, &y, &z, 1}, &value);
   return value;
@@ -188,16 +207,9 @@ std::vector<HullView> makeHullViews(const std::vector<std::string>& names,
     throw std::invalid_argument("makeHullViews: names, cameras and masks differ in count");
   }
   std::vector<std::unique_ptr<HullView>> made(cameras.size());
-  std::atomic<size_t> next{0};
-  const auto work = [&] {
-    for (size_t i = next++; i < made.size(); i = next++) {
-      made[i] = std::make_unique<HullView>(names[i], cameras[i], masks[i], config);
-    }
-  };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < config.threads; ++t) pool.emplace_back(work);
-  work();
-  for (std::thread& thread : pool) thread.join();
+  detail::parallelFor(made.size(), config.threads, [&](size_t i) {
+    made[i] = std::make_unique<HullView>(names[i], cameras[i], masks[i], config);
+  });
   std::vector<HullView> views;
   for (auto& view : made) views.push_back(std::move(*view));
   return views;

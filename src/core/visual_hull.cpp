@@ -6,6 +6,7 @@
 #include <numeric>
 #include <stdexcept>
 #include <thread>
+#include "parallel.h"
 
 namespace sift_hull {
 namespace detail {
@@ -32,25 +33,18 @@ CellIndex childOf(const CellIndex& cell, int child) {
   return {2 * cell.index + offset, cell.depth + 1};
 }
 
-double cellEdge(const HullCube& cube, int depth) { return cube.edge_m() / (1 << depth); }
-
-Eigen::Vector3d cellCentre(const HullCube& cube, const CellIndex& cell) {
-  const double edge = cellEdge(cube, cell.depth);
-  return cube.origin_W() + (cell.index.cast<double>() + Eigen::Vector3d::Constant(0.5)) * edge;
+/// A cell's centre in the views' local frame (HullView::useFrame): the cube is [-1, 1]^3.
+Eigen::Vector3d localCentre(const CellIndex& cell) {
+  const double cells = static_cast<double>(1 << cell.depth);
+  return (cell.index.cast<double>() + Eigen::Vector3d::Constant(0.5)) * (2.0 / cells) -
+         Eigen::Vector3d::Ones();
 }
 
-/// Runs fn(i) for i in [0, count) on `threads` threads, handing out indices one at a time.
-template <typename Fn>
-void parallelFor(size_t count, int threads, const Fn& fn) {
-  std::atomic<size_t> next{0};
-  const auto work = [&] {
-    for (size_t i = next++; i < count; i = next++) fn(i);
-  };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < threads && static_cast<size_t>(t) < count; ++t) pool.emplace_back(work);
-  work();
-  for (std::thread& thread : pool) thread.join();
+/// The local frame of a cube: its centre and half its edge.
+Eigen::Vector3d frameOrigin(const HullCube& cube) {
+  return cube.origin_W() + Eigen::Vector3d::Constant(0.5 * cube.edge_m());
 }
+double frameScale(const HullCube& cube) { return 0.5 * cube.edge_m(); }
 
 using ViewList = std::vector<uint32_t>;
 
@@ -101,7 +95,7 @@ class Refiner {
     if (root.state == CellState::kOut || first_view == views_.size()) return;
     ViewList views(views_.size() - first_view);
     std::iota(views.begin(), views.end(), static_cast<uint32_t>(first_view));
-    const Eigen::Vector3f centre = cellCentre(cube_, CellIndex{}).cast<float>();
+    const Eigen::Vector3f centre = localCentre(CellIndex{}).cast<float>();
     Scratch& scratch = Scratch::forThread(cube_.depth + 2);
     Verdicts& verdicts = scratch.verdicts[0];
     classify({&centre.x(), &centre.y(), &centre.z(), 1}, 0, views, &verdicts);
@@ -117,7 +111,7 @@ class Refiner {
     }
     float x[8], y[8], z[8];
     for (int c = 0; c < 8; ++c) {
-      const Eigen::Vector3d centre = cellCentre(cube_, childOf(cell, c));
+      const Eigen::Vector3d centre = localCentre(childOf(cell, c));
       x[c] = static_cast<float>(centre.x());
       y[c] = static_cast<float>(centre.y());
       z[c] = static_cast<float>(centre.z());
@@ -172,7 +166,8 @@ class Refiner {
   /// Applies the views in order, stopping once every cell is out.
   void classify(const PointBatch& centres, int depth, const ViewList& views,
                 Verdicts* verdicts) const {
-    const float radius = static_cast<float>(0.5 * std::sqrt(3.0) * cellEdge(cube_, depth));
+    // Half the cell's diagonal in local units (the cube's edge is 2).
+    const float radius = static_cast<float>(std::sqrt(3.0) / (1 << depth));
     const uint32_t all = (uint32_t{1} << centres.count) - 1;
     std::fill(verdicts->values, verdicts->values + 8, -HullView::kFarOutside_px);
     verdicts->out_bits = 0;
@@ -225,6 +220,8 @@ void collectSurfaceLeaves(const HullNode& node, const CellIndex& cell,
 VisualHull::VisualHull(const Box3d& box, const HullConfig& config)
     : cube_(HullCube::around(box, config.max_depth)),
       config_(config),
+      frame_origin_W_(frameOrigin(cube_)),
+      frame_scale_(frameScale(cube_)),
       root_(std::make_unique<HullNode>()) {
   validate(config);
 }
@@ -234,12 +231,13 @@ VisualHull::VisualHull(VisualHull&&) noexcept = default;
 VisualHull& VisualHull::operator=(VisualHull&&) noexcept = default;
 
 void VisualHull::addViews(std::vector<HullView> views) {
+  for (HullView& view : views) view.useFrame(frame_origin_W_, frame_scale_);
   const size_t first_new = views_.size();
   for (HullView& view : views) views_.push_back(std::move(view));
   std::vector<DeferredUpdate> deferred;
   Refiner(cube_, views_, &deferred, kParallelDepth).updateRoot(*root_, first_new);
   const Refiner refiner(cube_, views_, nullptr, 0);
-  parallelFor(deferred.size(), config_.threads, [&](size_t i) {
+  detail::parallelFor(deferred.size(), config_.threads, [&](size_t i) {
     refiner.updateChildren(*deferred[i].node, deferred[i].cell, deferred[i].views);
   });
 }
@@ -308,13 +306,14 @@ void VisualHull::sampleField(const std::vector<Eigen::Vector3d>& points_W,
   constexpr size_t kChunk = 4096;
   const size_t chunks = (points_W.size() + kChunk - 1) / kChunk;
   // View by view within a chunk, as single-precision coordinates for the batched look-ups.
-  parallelFor(chunks, config_.threads, [&](size_t chunk) {
+  detail::parallelFor(chunks, config_.threads, [&](size_t chunk) {
     const size_t begin = chunk * kChunk, end = std::min(points_W.size(), begin + kChunk);
     std::vector<float> x, y, z;
     for (size_t i = begin; i < end; ++i) {
-      x.push_back(static_cast<float>(points_W[i].x()));
-      y.push_back(static_cast<float>(points_W[i].y()));
-      z.push_back(static_cast<float>(points_W[i].z()));
+      const Eigen::Vector3d X_local = (points_W[i] - frame_origin_W_) / frame_scale_;
+      x.push_back(static_cast<float>(X_local.x()));
+      y.push_back(static_cast<float>(X_local.y()));
+      z.push_back(static_cast<float>(X_local.z()));
     }
     float* values_out = values->data() + begin;
     std::fill(values_out, values_out + (end - begin), -HullView::kFarOutside_px);
