@@ -80,8 +80,8 @@ cv::Mat loadMask(const std::string& path);
 
 /// Silhouettes of all views, in view order: the mask file of each view's name in `mask_directory`
 /// when that is not empty, else extracted from the view's image in `image_directory` by `recipe`.
-/// Throws std::runtime_error naming a missing or unreadable file, or a mask whose size differs from
-/// its image's.
+/// Throws std::runtime_error naming a missing or unreadable file, a mask whose size differs from
+/// its image's, or an image whose size differs from the first view's.
 std::vector<cv::Mat> loadSilhouettes(const std::vector<CalibratedView>& views,
                                      const std::string& image_directory,
                                      const std::string& mask_directory,

@@ -21,15 +21,31 @@ struct HullStreamConfig {
   /// still on a 30 Hz stream would grow it by a view per frame. 0 and 0 take every view.
   double min_view_distance_m = 0.01;
   double min_view_angle_deg = 1.0;
+  /// Views waiting for a box at most; when one more comes, the oldest waiting view is refused,
+  /// so that views that never bound a box (parallel rays, a bad calibration) cannot pile up.
+  int max_waiting_views = 16;
+  /// Views the hull takes at most (each keeps its distance map, about 8 bytes per pixel of its
+  /// silhouette's box); later views are refused.
+  int max_views = 1000;
 };
 
-/// Throws std::invalid_argument for a negative or non-finite distance, or an angle outside
-/// [0, 180] degrees.
+/// Throws std::invalid_argument for a negative or non-finite distance, an angle outside
+/// [0, 180] degrees, or view counts below 2 (waiting) or 1.
 void validate(const HullStreamConfig& config);
 
 /// A visual hull that views refine as they arrive (the hull node's worker). Until a box exists,
 /// views wait; the first time the LP over the waiting views gives a box, the hull is carved with
 /// all of them; every later view refines it (VisualHull::addView).
+///
+/// Bad views are refused with a reason (kRefused, whyRefused()) and leave the stream as if they
+/// never came:
+/// - a silhouette that covers no pixel or every pixel of its image;
+/// - once the hull exists, a view that would carve it to nothing, or that cannot join it (its
+///   camera too far from the box for single precision, or inside a voxel);
+/// - while waiting: a view whose cone misses the others' (the LP is empty with it and feasible
+///   without it, and that holds for it alone), and the oldest waiting view once more than
+///   max_waiting_views wait;
+/// - views beyond max_views.
 class HullStream {
  public:
   explicit HullStream(HullStreamConfig config);
@@ -39,6 +55,7 @@ class HullStream {
     kWaiting,    ///< no box yet: the view waits for more
     kSkipped,    ///< named in skip_views
     kRedundant,  ///< seen from where a view already taken was (min_view_distance_m)
+    kRefused,    ///< a bad view, left out (whyRefused())
   };
   /// Throws std::invalid_argument for a bad mask (see HullView).
   Outcome add(const std::string& name, const PinholeCamera& camera, const cv::Mat& mask);
@@ -47,6 +64,11 @@ class HullStream {
   void reset();
   /// Views left out as redundant since the start or the last reset.
   size_t redundantViews() const { return redundant_views_; }
+  /// Views refused since the start or the last reset, and why the last one was; a waiting view
+  /// refused while a later view was added counts too (see takeRefusals).
+  size_t refusedViews() const { return refused_views_; }
+  /// The refusals since the last call, each "view 'NAME': reason", oldest first.
+  std::vector<std::string> takeRefusals();
 
   bool hasHull() const { return hull_ != nullptr; }
   /// Requires hasHull().
@@ -57,15 +79,17 @@ class HullStream {
 
  private:
   void tryToStart();
+  void startHull(const Box3d& box);
+  bool dropViewMissingTheOthers();
+  Outcome refuse(const std::string& name, const std::string& reason);
+  Outcome addToHull(HullView view);
   bool isRedundant(const PinholeCamera& camera) const;
 
-  struct Viewpoint {
-    Eigen::Vector3d centre, axis;
-  };
-
   HullStreamConfig config_;
-  std::vector<Viewpoint> taken_;  ///< of the waiting and the carved views
   size_t redundant_views_ = 0;
+  size_t refused_views_ = 0;
+  std::vector<std::string> refusals_;
+  bool newest_refused_ = false;  ///< whether the view being added was refused while waiting
   std::vector<HullView> waiting_;
   std::unique_ptr<VisualHull> hull_;
   std::string why_no_box_ = "no view yet";

@@ -201,12 +201,22 @@ class VisualHull {
   ~VisualHull();
   VisualHull(VisualHull&&) noexcept;
   VisualHull& operator=(VisualHull&&) noexcept;
+  VisualHull(const VisualHull&) = delete;
+  VisualHull& operator=(const VisualHull&) = delete;
 
   /// Carves with more views. Before any view the whole cube is one in cell. Throws
   /// std::invalid_argument, before carving with any of them, when a view's camera is too far
   /// from the cube for single precision (HullView::useFrame).
   void addViews(std::vector<HullView> views);
   void addView(HullView view);
+  /// Throws std::invalid_argument when the view cannot join this hull: its camera too far from
+  /// the cube for single precision (HullView::useFrame), or within a voxel of the cube's centre
+  /// (a box far too large for the cameras).
+  void checkView(const HullView& view) const;
+  /// Removes the view added last and carves again with the others: the tree the others give.
+  void dropLastView();
+  /// Whether nothing is occupied: no in cell and no surface cell whose centre is inside.
+  bool isEmpty() const;
   /// Back to one in cell and no views.
   void reset();
 

@@ -12,18 +12,6 @@ namespace {
 
 nlohmann::json vectorJson(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 
-/// Size shared by all the views' silhouettes (each the size of its image); throws when they differ.
-cv::Size commonImageSize(const std::string& directory, const std::vector<CalibratedView>& views,
-                         const std::vector<cv::Mat>& silhouettes) {
-  for (size_t i = 1; i < views.size(); ++i) {
-    if (silhouettes[i].size() != silhouettes[0].size()) {
-      throw std::runtime_error(directory + "/" + views[i].name + ": image size differs from " +
-                               views[0].name + "'s");
-    }
-  }
-  return silhouettes.front().size();
-}
-
 bool projectsInside(const std::vector<CalibratedView>& views, const Eigen::Vector3d& X_W,
                     cv::Size size) {
   for (const CalibratedView& view : views) {
@@ -86,7 +74,7 @@ int runDatasetInfo(const std::vector<std::string>& args) {
   const std::vector<cv::Mat> silhouettes =
       loadSilhouettes(views, images, parser.has("silhouettes") ? parser.get("silhouettes") : "",
                       silhouetteConfigFromArgs(parser));
-  const cv::Size size = commonImageSize(images, views, silhouettes);
+  const cv::Size size = silhouettes.front().size();  // loadSilhouettes: one size for all
   nlohmann::json cameras = nlohmann::json::array();
   for (size_t i = 0; i < views.size(); ++i) {
     const double fraction = cv::countNonZero(silhouettes[i]) / static_cast<double>(size.area());

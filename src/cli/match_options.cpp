@@ -22,6 +22,8 @@ void addSiftOptions(ArgParser* parser) {
                     text(sift.contrast_threshold));
   parser->addOption("edge-threshold", "T", "SIFT edge threshold", text(sift.edge_threshold));
   parser->addOption("sigma", "PX", "SIFT base blur in pixels", text(sift.sigma_px));
+  parser->addOption("max-image-pixels", "N", "larger images are refused",
+                    std::to_string(sift.max_image_pixels));
 }
 
 void addMatchingOptions(ArgParser* parser) {
@@ -74,6 +76,9 @@ MatchOptions matchOptionsFromArgs(const ArgParser& parser) {
   options.sift.contrast_threshold = parser.getDouble("contrast-threshold");
   options.sift.edge_threshold = parser.getDouble("edge-threshold");
   options.sift.sigma_px = parser.getDouble("sigma");
+  const int max_image_pixels = parser.getInt("max-image-pixels");
+  if (max_image_pixels < 1) throw UsageError("--max-image-pixels must be >= 1");
+  options.sift.max_image_pixels = static_cast<size_t>(max_image_pixels);
   options.matching.ratio = parser.getDouble("ratio");
   options.matching.max_descriptor_distance = parser.get("max-distance") == "inf"
                                                  ? std::numeric_limits<double>::infinity()

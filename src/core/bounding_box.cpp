@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <csetjmp>
 #include <opencv2/imgproc.hpp>
 #include <string>
 #include <vector>
@@ -79,9 +80,14 @@ void checkViews(const std::vector<PinholeCamera>& cameras,
       throw HullBoxError(HullBoxError::Reason::kEmpty,
                          "the silhouette of " + viewName(names, i) + " is empty");
     }
-    if (!boundsAreFinite(bounds[i])) {
+    if (!boundsAreFinite(bounds[i]) || !(bounds[i].u_min_px <= bounds[i].u_max_px) ||
+        !(bounds[i].v_min_px <= bounds[i].v_max_px)) {
       throw std::invalid_argument("the silhouette bounds of " + viewName(names, i) +
-                                  " are not finite");
+                                  " are not finite or not ordered (min <= max)");
+    }
+    if (!cameras[i].projectionMatrix().allFinite() || !cameras[i].centre().allFinite()) {
+      throw std::invalid_argument("the camera of " + viewName(names, i) +
+                                  " has a projection beyond double precision");
     }
     if (bounds[i].boundedSides() > 0) ++bounding_views;
   }
@@ -92,87 +98,142 @@ void checkViews(const std::vector<PinholeCamera>& cameras,
   }
 }
 
-/// Owns a glp_prob.
-class GlpkProblem {
- public:
-  GlpkProblem() : problem_(glp_create_prob()) {}
-  ~GlpkProblem() { glp_delete_prob(problem_); }
-  GlpkProblem(const GlpkProblem&) = delete;
-  GlpkProblem& operator=(const GlpkProblem&) = delete;
-  glp_prob* get() const { return problem_; }
-
- private:
-  glp_prob* problem_;
+/// The half-spaces in a frame around the cameras, X = origin + scale X': the simplex's
+/// tolerances are absolute, so coordinates far from the world origin (a map frame) or of another
+/// unit (millimetres) would otherwise blunt them.
+struct LpFrame {
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+  double scale = 1.0;
 };
 
-/// Turns GLPK's terminal output off for its lifetime and then restores the previous state.
-class GlpkTerminalSilencer {
- public:
-  GlpkTerminalSilencer() : previous_state_(glp_term_out(GLP_OFF)) {}
-  ~GlpkTerminalSilencer() { glp_term_out(previous_state_); }
-  GlpkTerminalSilencer(const GlpkTerminalSilencer&) = delete;
-  GlpkTerminalSilencer& operator=(const GlpkTerminalSilencer&) = delete;
+LpFrame frameOfCameras(const std::vector<PinholeCamera>& cameras) {
+  LpFrame frame;
+  for (const PinholeCamera& camera : cameras) frame.origin += camera.centre() / cameras.size();
+  double sum_squares = 0.0;
+  for (const PinholeCamera& camera : cameras) {
+    sum_squares += (camera.centre() - frame.origin).squaredNorm() / cameras.size();
+  }
+  const double rms = std::sqrt(sum_squares);
+  if (rms > 0.0 && std::isfinite(rms)) frame.scale = rms;
+  return frame;
+}
 
- private:
-  int previous_state_;
+HalfSpace toFrame(const HalfSpace& half_space, const LpFrame& frame) {
+  // a.X >= b with X = o + s X' and |a| = 1: a.X' >= (b - a.o) / s.
+  return {half_space.coefficients,
+          (half_space.lower_bound - half_space.coefficients.dot(frame.origin)) / frame.scale};
+}
+
+/// What one GLPK session found: per axis and direction (x min, x max, y min, ...) the GLPK
+/// return code, status and optimum.
+struct LpSolution {
+  bool aborted = false;  ///< GLPK called its error hook (a failed internal assertion)
+  int return_codes[6] = {0, 0, 0, 0, 0, 0};
+  int statuses[6] = {0, 0, 0, 0, 0, 0};
+  double optima[6] = {0, 0, 0, 0, 0, 0};
 };
 
-/// Columns 1..3 are the free variables x, y, z; one row per half-space.
-void fillProblem(const std::vector<HalfSpace>& half_spaces, glp_prob* problem) {
+/// Simplex iterations and milliseconds one solve may take: three unknowns need a few dozen
+/// iterations, so reaching either means GLPK is cycling on degenerate input.
+constexpr int kIterationLimit = 10000;
+constexpr int kTimeLimit_ms = 5000;
+
+/// GLPK's error hook: GLPK's memory of this thread is freed and control returns to the setjmp
+/// in solveBoxLp, instead of GLPK calling abort().
+extern "C" void glpkErrorHook(void* jump) {
+  glp_free_env();
+  std::longjmp(*static_cast<std::jmp_buf*>(jump), 1);
+}
+
+/// Fills the problem: columns 1..3 are the free variables x, y, z; one row per half-space.
+void fillProblem(const HalfSpace* half_spaces, int rows, glp_prob* problem) {
   glp_add_cols(problem, 3);
   for (int column = 1; column <= 3; ++column) glp_set_col_bnds(problem, column, GLP_FR, 0.0, 0.0);
-  glp_add_rows(problem, static_cast<int>(half_spaces.size()));
-  const std::array<int, 4> columns = {0, 1, 2, 3};  // GLPK arrays start at index 1
-  for (size_t i = 0; i < half_spaces.size(); ++i) {
-    const int row = static_cast<int>(i) + 1;
+  glp_add_rows(problem, rows);
+  const int columns[4] = {0, 1, 2, 3};  // GLPK arrays start at index 1
+  for (int i = 0; i < rows; ++i) {
     const Eigen::Vector3d& a = half_spaces[i].coefficients;
-    const std::array<double, 4> values = {0.0, a.x(), a.y(), a.z()};
-    glp_set_mat_row(problem, row, 3, columns.data(), values.data());
-    glp_set_row_bnds(problem, row, GLP_LO, half_spaces[i].lower_bound, 0.0);
+    const double values[4] = {0.0, a.x(), a.y(), a.z()};
+    glp_set_mat_row(problem, i + 1, 3, columns, values);
+    glp_set_row_bnds(problem, i + 1, GLP_LO, half_spaces[i].lower_bound, 0.0);
   }
 }
 
-double farCoordinateLimit(const std::vector<PinholeCamera>& cameras) {
+/// The six extremes of x, y, z over the half-spaces, in one GLPK session that leaves no GLPK
+/// memory behind (glp_free_env: GLPK keeps an environment per thread otherwise). Holds only
+/// trivially destructible locals, so that the error hook's longjmp skips no destructor.
+void solveBoxLp(const HalfSpace* half_spaces, int rows, LpSolution* solution) {
+  std::jmp_buf jump;
+  if (setjmp(jump) != 0) {  // GLPK failed an assertion; glpkErrorHook freed its memory
+    glp_error_hook(nullptr, nullptr);
+    solution->aborted = true;
+    return;
+  }
+  glp_error_hook(glpkErrorHook, &jump);
+  glp_term_out(GLP_OFF);
+  glp_prob* problem = glp_create_prob();
+  fillProblem(half_spaces, rows, problem);
+  glp_smcp parameters;
+  glp_init_smcp(&parameters);
+  parameters.msg_lev = GLP_MSG_OFF;
+  parameters.presolve = GLP_OFF;
+  parameters.it_lim = kIterationLimit;
+  parameters.tm_lim = kTimeLimit_ms;
+  for (int k = 0; k < 6; ++k) {
+    const int column = k / 2 + 1;
+    for (int j = 1; j <= 3; ++j) glp_set_obj_coef(problem, j, j == column ? 1.0 : 0.0);
+    glp_set_obj_dir(problem, k % 2 == 0 ? GLP_MIN : GLP_MAX);
+    solution->return_codes[k] = glp_simplex(problem, &parameters);
+    solution->statuses[k] = glp_get_status(problem);
+    solution->optima[k] = glp_get_col_prim(problem, column);
+  }
+  glp_delete_prob(problem);
+  glp_error_hook(nullptr, nullptr);
+  glp_free_env();
+}
+
+double farCoordinateLimit(const std::vector<PinholeCamera>& cameras, const LpFrame& frame) {
   double farthest_centre = 1.0;
   for (const PinholeCamera& camera : cameras) {
-    farthest_centre = std::max(farthest_centre, camera.centre().cwiseAbs().maxCoeff());
+    farthest_centre =
+        std::max(farthest_centre, (camera.centre() - frame.origin).norm() / frame.scale);
   }
   return kFarCoordinateFactor * farthest_centre;
 }
 
-[[noreturn]] void throwUnbounded(const char* axis_name, int direction, const std::string& detail) {
-  const std::string side = direction == GLP_MIN ? "minimum" : "maximum";
+[[noreturn]] void throwUnbounded(const char* axis_name, bool minimum, const std::string& detail) {
+  const std::string side = minimum ? "minimum" : "maximum";
   throw HullBoxError(HullBoxError::Reason::kUnbounded, "the bounding box has no finite " + side +
                                                            " " + axis_name + " (" + detail +
                                                            "): " + kUnboundedHint);
 }
 
-/// The minimum or maximum (direction GLP_MIN or GLP_MAX) of one coordinate (column 1..3).
-double solveExtreme(glp_prob* problem, int column, int direction, double far_limit) {
+/// Extreme k (x min, x max, y min, ...) of the solution, in the LP frame, or an error.
+double extremeOf(const LpSolution& solution, int k, double far_limit) {
   static constexpr const char* kAxisNames[] = {"x", "y", "z"};
-  const char* axis_name = kAxisNames[column - 1];
-  for (int j = 1; j <= 3; ++j) glp_set_obj_coef(problem, j, j == column ? 1.0 : 0.0);
-  glp_set_obj_dir(problem, direction);
-  glp_smcp parameters;
-  glp_init_smcp(&parameters);
-  parameters.msg_lev = GLP_MSG_OFF;
-  parameters.presolve = GLP_OFF;
-  const int return_code = glp_simplex(problem, &parameters);
+  const char* axis_name = kAxisNames[k / 2];
+  const bool minimum = k % 2 == 0;
+  const int return_code = solution.return_codes[k], status = solution.statuses[k];
+  if (return_code == GLP_EITLIM || return_code == GLP_ETMLIM) {
+    throw HullBoxError(HullBoxError::Reason::kUnbounded,
+                       std::string("the bounding-box LP did not converge within ") +
+                           std::to_string(kIterationLimit) + " simplex iterations or " +
+                           std::to_string(kTimeLimit_ms) +
+                           " ms (degenerate silhouette bounds?): " + kUnboundedHint);
+  }
   if (return_code != 0) {
-    throwUnbounded(axis_name, direction,
+    throwUnbounded(axis_name, minimum,
                    "the simplex method failed with GLPK code " + std::to_string(return_code));
   }
-  const int status = glp_get_status(problem);
   if (status == GLP_NOFEAS) throw HullBoxError(HullBoxError::Reason::kEmpty, kEmptyHint);
-  if (status == GLP_UNBND) throwUnbounded(axis_name, direction, "the linear program is unbounded");
+  if (status == GLP_UNBND) throwUnbounded(axis_name, minimum, "the linear program is unbounded");
   if (status != GLP_OPT) {
-    throwUnbounded(axis_name, direction, "no optimum, GLPK status " + std::to_string(status));
+    throwUnbounded(axis_name, minimum, "no optimum, GLPK status " + std::to_string(status));
   }
-  const double value = glp_get_col_prim(problem, column);
+  const double value = solution.optima[k];
   if (!(std::abs(value) <= far_limit)) {
-    throwUnbounded(axis_name, direction,
-                   "its optimum " + std::to_string(value) +
-                       " lies a million times farther out than the cameras");
+    throwUnbounded(axis_name, minimum,
+                   "its optimum lies a million times farther out than the cameras");
   }
   return value;
 }
@@ -210,14 +271,28 @@ Box3d hullBoundingBox(const std::vector<PinholeCamera>& cameras,
   for (size_t i = 0; i < cameras.size(); ++i) {
     if (bounds[i].boundedSides() > 0) appendViewHalfSpaces(cameras[i], bounds[i], &half_spaces);
   }
-  const GlpkTerminalSilencer silencer;
-  const GlpkProblem problem;
-  fillProblem(half_spaces, problem.get());
-  const double far_limit = farCoordinateLimit(cameras);
+  const LpFrame frame = frameOfCameras(cameras);
+  for (HalfSpace& half_space : half_spaces) half_space = toFrame(half_space, frame);
+  for (const HalfSpace& half_space : half_spaces) {
+    if (!half_space.coefficients.allFinite() || !std::isfinite(half_space.lower_bound)) {
+      throw HullBoxError(HullBoxError::Reason::kUnbounded,
+                         "a view's cone gives a degenerate LP row (a camera with a zero or "
+                         "non-finite projection row?): check the calibration");
+    }
+  }
+  LpSolution solution;
+  solveBoxLp(half_spaces.data(), static_cast<int>(half_spaces.size()), &solution);
+  if (solution.aborted) {
+    throw HullBoxError(HullBoxError::Reason::kUnbounded,
+                       "GLPK failed on the bounding-box LP (numerically degenerate cones): " +
+                           std::string(kUnboundedHint));
+  }
+  const double far_limit = farCoordinateLimit(cameras, frame);
   Box3d box;
   for (int axis = 0; axis < 3; ++axis) {
-    box.min_W(axis) = solveExtreme(problem.get(), axis + 1, GLP_MIN, far_limit);
-    box.max_W(axis) = solveExtreme(problem.get(), axis + 1, GLP_MAX, far_limit);
+    box.min_W(axis) = frame.origin(axis) + frame.scale * extremeOf(solution, 2 * axis, far_limit);
+    box.max_W(axis) =
+        frame.origin(axis) + frame.scale * extremeOf(solution, 2 * axis + 1, far_limit);
   }
   return box;
 }

@@ -271,6 +271,14 @@ std::vector<cv::Mat> loadSilhouettes(const std::vector<CalibratedView>& views,
   std::vector<cv::Mat> silhouettes;
   for (const CalibratedView& view : views) {
     const cv::Mat image = loadViewImage(image_directory, view);
+    if (!silhouettes.empty() && image.size() != silhouettes.front().size()) {
+      throw std::runtime_error(image_directory + "/" + view.name + ": image size differs from " +
+                               views.front().name + "'s (" + std::to_string(image.cols) + "x" +
+                               std::to_string(image.rows) + ", not " +
+                               std::to_string(silhouettes.front().cols) + "x" +
+                               std::to_string(silhouettes.front().rows) +
+                               "): one calibration set is for one image size");
+    }
     if (mask_directory.empty()) {
       silhouettes.push_back(silhouetteFromImage(image, recipe));
       continue;

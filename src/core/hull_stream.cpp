@@ -7,6 +7,20 @@
 #include "sift_hull/hull_pipeline.h"
 
 namespace sift_hull {
+namespace {
+
+/// Why a silhouette carves nothing useful: empty when it covers some but not all of its image.
+std::string coverageProblem(const cv::Mat& mask) {
+  if (mask.empty() || mask.type() != CV_8UC1) return "";  // HullView says what is wrong
+  const int inside = cv::countNonZero(mask);
+  if (inside == 0) return "its silhouette covers no pixel";
+  if (static_cast<size_t>(inside) == mask.total()) {
+    return "its silhouette covers the whole image (a threshold or mask problem?)";
+  }
+  return "";
+}
+
+}  // namespace
 
 void validate(const HullStreamConfig& config) {
   validate(config.hull);
@@ -16,6 +30,8 @@ void validate(const HullStreamConfig& config) {
   if (!(config.min_view_angle_deg >= 0.0 && config.min_view_angle_deg <= 180.0)) {
     throw std::invalid_argument("min_view_angle_deg must lie in [0, 180]");
   }
+  if (config.max_waiting_views < 2) throw std::invalid_argument("max_waiting_views must be >= 2");
+  if (config.max_views < 1) throw std::invalid_argument("max_views must be >= 1");
 }
 
 HullStream::HullStream(HullStreamConfig config) : config_(std::move(config)) { validate(config_); }
@@ -26,53 +42,128 @@ bool HullStream::isRedundant(const PinholeCamera& camera) const {
   const double min_cos = std::cos(config_.min_view_angle_deg * M_PI / 180.0) - 1e-12;
   const Eigen::Vector3d centre = camera.centre();
   const Eigen::Vector3d axis = camera.opticalAxis();
-  return std::any_of(taken_.begin(), taken_.end(), [&](const Viewpoint& taken) {
-    return (taken.centre - centre).norm() <= config_.min_view_distance_m &&
-           taken.axis.dot(axis) >= min_cos;
-  });
+  const auto near = [&](const HullView& taken) {
+    return (taken.camera().centre() - centre).norm() <= config_.min_view_distance_m &&
+           taken.camera().opticalAxis().dot(axis) >= min_cos;
+  };
+  return std::any_of(waiting_.begin(), waiting_.end(), near) ||
+         (hull_ && std::any_of(hull_->views().begin(), hull_->views().end(), near));
+}
+
+HullStream::Outcome HullStream::refuse(const std::string& name, const std::string& reason) {
+  ++refused_views_;
+  refusals_.push_back("view '" + name + "': " + reason);
+  return Outcome::kRefused;
+}
+
+std::vector<std::string> HullStream::takeRefusals() {
+  std::vector<std::string> taken;
+  taken.swap(refusals_);
+  return taken;
 }
 
 HullStream::Outcome HullStream::add(const std::string& name, const PinholeCamera& camera,
                                     const cv::Mat& mask) {
   const auto& skip = config_.skip_views;
   if (std::find(skip.begin(), skip.end(), name) != skip.end()) return Outcome::kSkipped;
+  const std::string coverage = coverageProblem(mask);
+  if (!coverage.empty()) return refuse(name, coverage);
+  const size_t views = waiting_.size() + (hull_ ? hull_->views().size() : 0);
+  if (views >= static_cast<size_t>(config_.max_views)) {
+    return refuse(name, "the hull holds max_views (" + std::to_string(config_.max_views) +
+                            ") views already");
+  }
   if (isRedundant(camera)) {
     ++redundant_views_;
     return Outcome::kRedundant;
   }
   HullView view(name, camera, mask, config_.hull);
-  const Viewpoint viewpoint{camera.centre(), camera.opticalAxis()};
-  if (hull_) {
-    hull_->addView(std::move(view));
-    taken_.push_back(viewpoint);
-    return Outcome::kCarved;
+  if (hull_) return addToHull(std::move(view));
+  if (waiting_.size() >= static_cast<size_t>(config_.max_waiting_views)) {
+    refuse(waiting_.front().name(), "no box after max_waiting_views (" +
+                                        std::to_string(config_.max_waiting_views) +
+                                        ") views: " + why_no_box_);
+    waiting_.erase(waiting_.begin());
   }
   waiting_.push_back(std::move(view));
-  taken_.push_back(viewpoint);
+  newest_refused_ = false;
   tryToStart();
+  if (newest_refused_) return Outcome::kRefused;
   return hull_ ? Outcome::kCarved : Outcome::kWaiting;
 }
 
-void HullStream::tryToStart() {
-  std::optional<Box3d> box = config_.box;
-  if (!box) {
+HullStream::Outcome HullStream::addToHull(HullView view) {
+  const std::string name = view.name();
+  try {
+    hull_->checkView(view);
+  } catch (const std::invalid_argument& e) {
+    return refuse(name, e.what());
+  }
+  hull_->addView(std::move(view));
+  if (hull_->isEmpty()) {
+    hull_->dropLastView();  // rare: a full re-carve beats copying the tree for every view
+    return refuse(name, "it would carve the hull to nothing");
+  }
+  return Outcome::kCarved;
+}
+
+/// When the LP over the waiting views is empty, the view whose cone misses the others is the one
+/// without which the rest are feasible, and it must be the only such view: with two views either
+/// could be the bad one, so both wait for a third.
+bool HullStream::dropViewMissingTheOthers() {
+  std::vector<size_t> culprits;
+  for (size_t i = 0; i < waiting_.size(); ++i) {
+    std::vector<HullView> others = waiting_;
+    others.erase(others.begin() + static_cast<std::ptrdiff_t>(i));
     try {
-      box = boundingBoxOf(waiting_);
+      boundingBoxOf(others);
+      culprits.push_back(i);
+    } catch (const HullBoxError& e) {
+      if (e.reason() != HullBoxError::Reason::kEmpty) culprits.push_back(i);
+    }
+  }
+  if (culprits.size() != 1) return false;
+  const size_t bad = culprits.front();
+  refuse(waiting_[bad].name(), "its viewing cone misses the other views' cones");
+  newest_refused_ = bad + 1 == waiting_.size();
+  waiting_.erase(waiting_.begin() + static_cast<std::ptrdiff_t>(bad));
+  return true;
+}
+
+void HullStream::tryToStart() {
+  for (;;) {
+    if (config_.box) return startHull(*config_.box);
+    try {
+      return startHull(boundingBoxOf(waiting_));
     } catch (const HullBoxError& e) {
       // Fewer than two views, or cones still parallel: later views may bound the box.
       why_no_box_ = e.what();
-      return;
+      if (e.reason() != HullBoxError::Reason::kEmpty || !dropViewMissingTheOthers()) return;
     }
   }
-  hull_ = std::make_unique<VisualHull>(*box, config_.hull);
-  hull_->addViews(std::move(waiting_));
+}
+
+/// Starts the hull in `box` and adds the waiting views to it one by one, refusing those that
+/// cannot join it or would carve it to nothing (addToHull).
+void HullStream::startHull(const Box3d& box) {
+  hull_ = std::make_unique<VisualHull>(box, config_.hull);
+  std::vector<HullView> waiting = std::move(waiting_);
   waiting_.clear();
+  for (size_t i = 0; i < waiting.size(); ++i) {
+    newest_refused_ = addToHull(std::move(waiting[i])) == Outcome::kRefused;
+  }
+  if (hull_->views().empty()) {  // every view refused: the next views bound a box afresh
+    hull_.reset();
+    why_no_box_ = "no waiting view could join the hull";
+    return;
+  }
   why_no_box_.clear();
 }
 
 void HullStream::reset() {
-  taken_.clear();
   redundant_views_ = 0;
+  refused_views_ = 0;
+  refusals_.clear();
   waiting_.clear();
   hull_.reset();
   why_no_box_ = "no view yet";

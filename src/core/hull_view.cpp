@@ -1,7 +1,9 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <iomanip>
 #include <limits>
+#include <sstream>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 #include <thread>
@@ -29,6 +31,12 @@ cv::Mat distanceWithin(const cv::Mat& region) {
 
 double spectralNorm2x2(const Eigen::Matrix3d& K) {
   return Eigen::JacobiSVD<Eigen::Matrix2d>(K.topLeftCorner<2, 2>()).singularValues()(0);
+}
+
+std::string shortNumber(double value) {
+  std::ostringstream out;
+  out << std::setprecision(3) << value;
+  return out.str();
 }
 
 /// Whether a pixel (u, v) satisfies the bounds, open sides unbounded.
@@ -151,11 +159,11 @@ void HullView::useFrame(const Eigen::Vector3d& origin_W, double scale) {
   }
   const double distance = (camera_.centre() - origin_W).norm() / scale;
   if (!(distance <= kMaxCameraDistance)) {
-    throw std::invalid_argument(
-        "view '" + name_ + "': its camera lies " + std::to_string(distance) +
-        " half cube edges from the hull's centre, more than " +
-        std::to_string(kMaxCameraDistance) +
-        ": it would see the hull as a point; check the calibration and the box");
+    throw std::invalid_argument("view '" + name_ + "': its camera lies " + shortNumber(distance) +
+                                " half cube edges from the hull's centre, more than " +
+                                shortNumber(kMaxCameraDistance) +
+                                ": it would see the hull as a point; check the calibration and "
+                                "the box");
   }
   const Eigen::Vector3d t_local = (camera_.R() * origin_W + camera_.t()) / scale;
   for (int i = 0; i < 3; ++i) kernel_.t[i] = static_cast<float>(t_local(i));

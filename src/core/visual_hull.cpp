@@ -4,6 +4,7 @@
 #include <atomic>
 #include <cmath>
 #include <numeric>
+#include <sstream>
 #include <stdexcept>
 #include <thread>
 #include "parallel.h"
@@ -187,6 +188,20 @@ class Refiner {
   int defer_depth_;
 };
 
+/// A box so large that its finest voxel is wider than a camera's distance to it cannot hold a
+/// hull the cameras resolve: throws std::invalid_argument.
+void requireCameraOutsideVoxel(const HullView& view, const Eigen::Vector3d& centre_W,
+                               double voxel_m) {
+  const double distance_m = (view.camera().centre() - centre_W).norm();
+  if (!(distance_m > voxel_m)) {
+    std::ostringstream message;
+    message << "view '" << view.name() << "': the box is too large for its camera: a voxel ("
+            << voxel_m << " m) is wider than the camera's distance to the box centre ("
+            << distance_m << " m); give a box around the object";
+    throw std::invalid_argument(message.str());
+  }
+}
+
 /// Depth of the cells the threads share out: 64 groups of eight balance two threads well.
 constexpr int kParallelDepth = 3;
 
@@ -197,6 +212,18 @@ void visitLeaves(const HullNode& node, const CellIndex& cell,
     return;
   }
   for (int c = 0; c < 8; ++c) visitLeaves(node.children[c], childOf(cell, c), visit);
+}
+
+/// Whether a leaf below is in, or on the surface with its centre inside (HullStats' volume).
+bool holdsOccupied(const HullNode& node) {
+  if (!node.children) {
+    return node.state == CellState::kIn ||
+           (node.state == CellState::kSurface && node.centre_value <= 0.0f);
+  }
+  for (int c = 0; c < 8; ++c) {
+    if (holdsOccupied(node.children[c])) return true;
+  }
+  return false;
 }
 
 size_t countSurfaceLeaves(const HullNode& node) {
@@ -230,8 +257,17 @@ VisualHull::~VisualHull() = default;
 VisualHull::VisualHull(VisualHull&&) noexcept = default;
 VisualHull& VisualHull::operator=(VisualHull&&) noexcept = default;
 
+void VisualHull::checkView(const HullView& view) const {
+  HullView in_frame = view;
+  in_frame.useFrame(frame_origin_W_, frame_scale_);
+  requireCameraOutsideVoxel(view, frame_origin_W_, cube_.resolution_m);
+}
+
 void VisualHull::addViews(std::vector<HullView> views) {
-  for (HullView& view : views) view.useFrame(frame_origin_W_, frame_scale_);
+  for (HullView& view : views) {
+    view.useFrame(frame_origin_W_, frame_scale_);
+    requireCameraOutsideVoxel(view, frame_origin_W_, cube_.resolution_m);
+  }
   const size_t first_new = views_.size();
   for (HullView& view : views) views_.push_back(std::move(view));
   std::vector<DeferredUpdate> deferred;
@@ -247,6 +283,16 @@ void VisualHull::addView(HullView view) {
   one.push_back(std::move(view));
   addViews(std::move(one));
 }
+
+void VisualHull::dropLastView() {
+  if (views_.empty()) return;
+  std::vector<HullView> others = std::move(views_);
+  others.pop_back();
+  reset();
+  addViews(std::move(others));
+}
+
+bool VisualHull::isEmpty() const { return !holdsOccupied(*root_); }
 
 void VisualHull::reset() {
   views_.clear();

@@ -12,24 +12,50 @@
 #include <map>
 #include <sstream>
 
+#include "sift_hull/limits.h"
+
 namespace sift_hull {
 namespace ros_conversions {
+
+bool holdsPixels(const sensor_msgs::Image& image, size_t bytes_per_pixel, std::string* why_not) {
+  const std::string size = std::to_string(image.width) + "x" + std::to_string(image.height);
+  if (image.width == 0 || image.height == 0) {
+    *why_not = "the image is empty (" + size + ")";
+    return false;
+  }
+  if (image.width > limits::kMaxImageSidePx || image.height > limits::kMaxImageSidePx) {
+    *why_not = "the image is " + size + ", wider or higher than " +
+               std::to_string(limits::kMaxImageSidePx) + " pixels";
+    return false;
+  }
+  // Every factor is below 2^32, so no product of two wraps in size_t.
+  const size_t row_bytes = static_cast<size_t>(image.width) * bytes_per_pixel;
+  const size_t needed = static_cast<size_t>(image.step) * static_cast<size_t>(image.height);
+  if (image.step < row_bytes || image.data.size() < needed) {
+    *why_not = "the image data (" + std::to_string(image.data.size()) + " bytes, step " +
+               std::to_string(image.step) + ") does not hold " + size + " pixels of " +
+               std::to_string(bytes_per_pixel) + " bytes";
+    return false;
+  }
+  return true;
+}
+
+bool withinPixelLimit(const sensor_msgs::Image& image, size_t max_pixels, std::string* why_not) {
+  const size_t pixels = static_cast<size_t>(image.width) * static_cast<size_t>(image.height);
+  if (pixels <= max_pixels) return true;
+  *why_not = "the image is " + std::to_string(image.width) + "x" + std::to_string(image.height) +
+             " = " + std::to_string(pixels) + " pixels, more than max_image_pixels (" +
+             std::to_string(max_pixels) + ")";
+  return false;
+}
 
 cv::Mat maskFromImage(const sensor_msgs::Image& image, std::string* why_not) {
   if (image.encoding != "mono8") {
     *why_not = "silhouette encoding is '" + image.encoding + "', expected mono8";
     return {};
   }
-  if (image.width == 0 || image.height == 0) {
-    *why_not = "silhouette is empty (" + std::to_string(image.width) + "x" +
-               std::to_string(image.height) + ")";
-    return {};
-  }
-  if (image.step < image.width ||
-      image.data.size() < static_cast<size_t>(image.step) * image.height) {
-    *why_not = "silhouette data (" + std::to_string(image.data.size()) + " bytes, step " +
-               std::to_string(image.step) + ") does not hold " + std::to_string(image.width) + "x" +
-               std::to_string(image.height) + " pixels";
+  if (!holdsPixels(image, 1, why_not)) {
+    *why_not = "silhouette: " + *why_not;
     return {};
   }
   const cv::Mat view(image.height, image.width, CV_8UC1, const_cast<uint8_t*>(image.data.data()),
@@ -39,16 +65,15 @@ cv::Mat maskFromImage(const sensor_msgs::Image& image, std::string* why_not) {
 
 cv::Mat eightBitImage(const sensor_msgs::ImageConstPtr& image, std::string* why_not) {
   namespace enc = sensor_msgs::image_encodings;
-  if (image->width == 0 || image->height == 0) {
-    *why_not = "the image is empty";
-    return {};
-  }
   if (!enc::isColor(image->encoding) && !enc::isMono(image->encoding)) {
     *why_not = "encoding '" + image->encoding + "' is neither colour nor mono";
     return {};
   }
   if (enc::bitDepth(image->encoding) != 8) {
     *why_not = "encoding '" + image->encoding + "' is not 8 bits per channel";
+    return {};
+  }
+  if (!holdsPixels(*image, static_cast<size_t>(enc::numChannels(image->encoding)), why_not)) {
     return {};
   }
   try {
@@ -64,8 +89,13 @@ namespace {
 bool intrinsicsFromInfo(const sensor_msgs::CameraInfo& info, Eigen::Matrix3d* K,
                         std::string* why_not) {
   for (int i = 0; i < 9; ++i) (*K)(i / 3, i % 3) = info.K[i];
-  if (!K->allFinite() || (*K)(2, 2) == 0.0) {
-    *why_not = "camera_info K is not finite or has K[8] = 0";
+  if (!K->allFinite()) {
+    *why_not = "camera_info K holds a value that is not finite";
+    return false;
+  }
+  if ((*K)(2, 2) == 0.0) {
+    *why_not = K->isZero() ? "camera_info K is all zero (an uncalibrated camera?)"
+                           : "camera_info K[8] is 0";
     return false;
   }
   *K /= (*K)(2, 2);

@@ -24,14 +24,24 @@ class OcTree;
 namespace sift_hull {
 namespace ros_conversions {
 
+/// Whether the message's data holds its width x height pixels of `bytes_per_pixel` bytes, all
+/// sizes in size_t before any pointer arithmetic: false, with `why_not`, for an empty image, a
+/// side over limits::kMaxImageSidePx, a step shorter than a row, or data shorter than
+/// step x height (a height x step that would wrap in 32 bits is caught).
+bool holdsPixels(const sensor_msgs::Image& image, size_t bytes_per_pixel, std::string* why_not);
+
+/// Whether the image has at most `max_pixels` pixels (SiftConfig::max_image_pixels); false, with
+/// `why_not`, otherwise. Reads only the header fields.
+bool withinPixelLimit(const sensor_msgs::Image& image, size_t max_pixels, std::string* why_not);
+
 /// A silhouette message as a CV_8UC1 mask sharing nothing with the message. Accepts mono8 only
-/// (non-zero inside); returns an empty Mat and sets `why_not` for another encoding, an empty image
-/// or a step that does not match the width.
+/// (non-zero inside); returns an empty Mat and sets `why_not` for another encoding or pixels the
+/// data does not hold (holdsPixels).
 cv::Mat maskFromImage(const sensor_msgs::Image& image, std::string* why_not);
 
 /// An 8-bit colour or mono image as BGR or grey, sharing the message's pixels (keep the message
-/// while the Mat is in use). Returns an empty Mat and sets `why_not` for an empty image or
-/// another encoding.
+/// while the Mat is in use). Returns an empty Mat and sets `why_not` for another encoding or
+/// pixels the data does not hold (holdsPixels).
 cv::Mat eightBitImage(const sensor_msgs::ImageConstPtr& image, std::string* why_not);
 
 /// The camera of a view: K from `info` (pixels) and the pose T_W_C (the camera frame in the world

@@ -159,6 +159,7 @@ void HullNode::integrate(View& view) {
 void HullNode::reportDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& status) {
   reportQueue(work_.counts(), "views", &status);
   status.add("views redundant", redundant_views_.load());
+  status.add("views refused", refused_views_.load());
   status.add("last view carve ms", last_carve_ms_.load());
   status.add("last view publish ms", last_publish_ms_.load());
   status.add("last view stamp", last_view_stamp_.load());
@@ -174,6 +175,10 @@ bool HullNode::carve(const View& view) {
   const std::string& name = view.name;
   try {
     const HullStream::Outcome outcome = stream_.add(name, view.camera, view.mask);
+    for (const std::string& refusal : stream_.takeRefusals()) {
+      log_.error("hull: view refused: ", refusal);
+    }
+    refused_views_ = stream_.refusedViews();
     if (outcome == HullStream::Outcome::kWaiting) {
       ROS_INFO_THROTTLE(kThrottle_s, "hull: %zu view(s) waiting for a bounding box: %s",
                         stream_.waitingViews(), stream_.whyNoBox().c_str());
@@ -243,6 +248,7 @@ bool HullNode::reset(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
   ++generation_;
   const size_t discarded = work_.clear();  // views from before the reset
   stream_.reset();
+  refused_views_ = 0;
   publishEmpty();
   octree_.reset();
   mesh_.reset();

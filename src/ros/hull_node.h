@@ -106,6 +106,7 @@ class HullNode {
   ros::Publisher octomap_pub_, cloud_pub_, markers_pub_, mesh_pub_;
   std::atomic<double> last_carve_ms_{0.0}, last_publish_ms_{0.0}, last_view_stamp_{0.0};
   std::atomic<size_t> redundant_views_{0};
+  std::atomic<size_t> refused_views_{0};
   WorkQueue<View> work_;
   NodeDiagnostics diagnostics_;
   PoseWaits pose_waits_;

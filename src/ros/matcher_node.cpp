@@ -218,6 +218,14 @@ void MatcherNode::onPair(const sensor_msgs::ImageConstPtr& left,
 }
 
 void MatcherNode::enqueue(Pair pair) {
+  // Checked on arrival, from the headers alone, so that oversized images never reach a worker.
+  const size_t max_pixels = pipeline()->settings.sift.max_image_pixels;
+  std::string why_not;
+  if (!ros_conversions::withinPixelLimit(*pair.left, max_pixels, &why_not) ||
+      !ros_conversions::withinPixelLimit(*pair.right, max_pixels, &why_not)) {
+    log_.error("matcher: pair ignored: ", why_not);
+    return;
+  }
   pushCounted(&work_, std::move(pair), "matcher: pairs waiting for a worker (~max_waiting_pairs)");
 }
 

@@ -49,10 +49,7 @@ SilhouetteConfig readSilhouetteConfig(const ros::NodeHandle& private_nh) {
   read(private_nh, "threshold", &config.threshold);
   read(private_nh, "dilate_px", &config.dilate_px);
   read(private_nh, "erode_px", &config.erode_px);
-  if (!(config.threshold >= 0.0 && config.threshold <= 1.0) || config.dilate_px < 0 ||
-      config.erode_px < 0) {
-    throw std::invalid_argument("~threshold must lie in [0, 1], ~dilate_px and ~erode_px >= 0");
-  }
+  validate(config);
   return config;
 }
 
@@ -84,6 +81,8 @@ HullStreamConfig readHullStreamConfig(const ros::NodeHandle& private_nh) {
   read(private_nh, "skip_views", &config.skip_views);
   read(private_nh, "min_view_distance_m", &config.min_view_distance_m);
   read(private_nh, "min_view_angle_deg", &config.min_view_angle_deg);
+  read(private_nh, "max_waiting_views", &config.max_waiting_views);
+  read(private_nh, "max_views", &config.max_views);
   validate(config);
   return config;
 }
@@ -95,6 +94,10 @@ SiftConfig readSiftConfig(const ros::NodeHandle& private_nh) {
   read(private_nh, "contrast_threshold", &config.contrast_threshold);
   read(private_nh, "edge_threshold", &config.edge_threshold);
   read(private_nh, "sigma_px", &config.sigma_px);
+  int max_image_pixels = static_cast<int>(config.max_image_pixels);
+  read(private_nh, "max_image_pixels", &max_image_pixels);
+  if (max_image_pixels < 1) throw std::invalid_argument("~max_image_pixels must be >= 1");
+  config.max_image_pixels = static_cast<size_t>(max_image_pixels);
   validate(config);
   return config;
 }
