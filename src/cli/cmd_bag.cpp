@@ -72,7 +72,11 @@ int runBag(const std::vector<std::string>& args) {
   parser.addFlag("json", "print the result as one JSON object");
   if (!parser.parse(args)) return 0;
   const double rate = parser.getDouble("rate");
-  if (!(rate > 0.0)) throw UsageError("--rate must be positive");
+  // Stamps 1 us apart at the most stay distinct; 1000 s apart at the least keep a million views
+  // within ros::Time's range.
+  if (!(rate >= 1e-3 && rate <= 1e6)) {
+    throw UsageError("--rate must lie in [0.001, 1000000] views per second");
+  }
 
   const std::vector<BagView> views = loadViews(parser);
   rosbag::Bag bag(parser.get("out"), rosbag::bagmode::Write);

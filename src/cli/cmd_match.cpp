@@ -69,7 +69,9 @@ std::optional<PairTruth> pairTruth(const ArgParser& parser, const std::string& l
   if (given > 1)
     throw UsageError("give at most one of --gt-disparity, --gt-homography, --gt-scene");
   if (parser.has("gt-disparity")) {
-    return disparityTruth(parser.get("gt-disparity"), parser.getDouble("disparity-scale"));
+    const double scale = parser.getDouble("disparity-scale");
+    if (!(scale > 0.0)) throw UsageError("--disparity-scale must be positive");
+    return disparityTruth(parser.get("gt-disparity"), scale);
   }
   if (parser.has("gt-homography")) return homographyTruth(parser.get("gt-homography"));
   if (!parser.has("gt-scene")) return std::nullopt;
@@ -81,8 +83,20 @@ std::optional<PairTruth> pairTruth(const ArgParser& parser, const std::string& l
 }
 
 /// The filters named with --filter, else every one the input allows.
+/// Throws UsageError for a name makeFilter refuses, and for epipolar without calibration.
 std::vector<std::string> chosenFilters(const ArgParser& parser, bool calibrated) {
   std::vector<std::string> names = parser.getAll("filter");
+  for (const std::string& name : names) {
+    try {
+      makeFilter(name, FilterConfigs());
+    } catch (const std::invalid_argument& e) {
+      throw UsageError(std::string("--filter: ") + e.what());
+    }
+    if (!calibrated && ("+" + name + "+").find("+epipolar+") != std::string::npos) {
+      throw UsageError("--filter " + name +
+                       ": epipolar needs calibration (--calib, --rectified or --gt-scene)");
+    }
+  }
   if (!names.empty()) return names;
   for (const std::string& name : filterNames()) {
     if (name != "epipolar" || calibrated) names.push_back(name);

@@ -1,10 +1,12 @@
 #include "commands.h"
 
+#include <cstdlib>
 #include <cstring>
 #include <exception>
 #include <iostream>
 
 #include "args.h"
+#include "sift_hull/limits.h"
 
 namespace sift_hull {
 namespace cli {
@@ -56,6 +58,9 @@ void printResult(bool as_json, const nlohmann::json& result, const std::string& 
 }
 
 int runMain(int argc, char** argv) {
+  // OpenCV refuses to decode image files of more pixels than this (its own default is 2^30, 3 GiB
+  // of colour), read once on the first decode; a value the user set stays.
+  setenv("OPENCV_IO_MAX_IMAGE_PIXELS", std::to_string(limits::kMaxDecodedImagePixels).c_str(), 0);
   const std::vector<std::string> args(argv + 1, argv + argc);
   if (args.empty() || args[0] == "--help" || args[0] == "-h" || args[0] == "help") {
     printUsage(args.empty() ? std::cerr : std::cout);

@@ -1,6 +1,7 @@
 #include "hull_options.h"
 
 #include <sstream>
+#include <stdexcept>
 
 #include "silhouette_options.h"
 
@@ -15,8 +16,10 @@ std::vector<std::string> splitList(const std::string& text) {
   std::istringstream in(text);
   std::string item;
   while (std::getline(in, item, ',')) {
-    if (!item.empty()) items.push_back(item);
+    if (item.empty()) throw UsageError("--views: an empty name in '" + text + "'");
+    items.push_back(item);
   }
+  if (items.empty()) throw UsageError("--views names no view");
   return items;
 }
 
@@ -25,7 +28,11 @@ std::vector<std::string> viewNamesFromArgs(const ArgParser& parser) {
     throw UsageError("give --views or --views-file, not both");
   }
   if (parser.has("views")) return splitList(parser.get("views"));
-  if (parser.has("views-file")) return readViewList(parser.get("views-file"));
+  if (parser.has("views-file")) {
+    std::vector<std::string> names = readViewList(parser.get("views-file"));
+    if (names.empty()) throw std::runtime_error(parser.get("views-file") + ": names no view");
+    return names;
+  }
   return {};
 }
 
