@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
@@ -42,10 +43,12 @@ void validate(const HullStreamConfig& config);
 /// - a silhouette that covers no pixel or every pixel of its image;
 /// - once the hull exists, a view that would carve it to nothing, or that cannot join it (its
 ///   camera too far from the box for single precision, or inside a voxel);
-/// - while waiting: a view whose cone misses the others' (the LP is empty with it and feasible
+/// - while waiting: a view whose cone misses the others' (the LP is empty with it and not empty
 ///   without it, and that holds for it alone), and the oldest waiting view once more than
 ///   max_waiting_views wait;
 /// - views beyond max_views.
+/// After a waiting view is refused, the views that waited with it are taken again in their order,
+/// so the box forms when it would have formed without the refused view.
 class HullStream {
  public:
   explicit HullStream(HullStreamConfig config);
@@ -78,19 +81,29 @@ class HullStream {
   const std::string& whyNoBox() const { return why_no_box_; }
 
  private:
+  /// A view with the number of its arrival, so that a refusal knows whether it is the newest.
+  struct Arrival {
+    HullView view;
+    uint64_t serial;
+  };
+
+  void take(Arrival arrival);
+  void wait(Arrival arrival);
   void tryToStart();
   void startHull(const Box3d& box);
-  bool dropViewMissingTheOthers();
-  Outcome refuse(const std::string& name, const std::string& reason);
-  Outcome addToHull(HullView view);
+  void dropViewMissingTheOthers();
+  void replay(std::vector<Arrival> arrivals);
+  void addToHull(Arrival arrival);
+  void refuse(const std::string& name, uint64_t serial, const std::string& reason);
   bool isRedundant(const PinholeCamera& camera) const;
 
   HullStreamConfig config_;
   size_t redundant_views_ = 0;
   size_t refused_views_ = 0;
   std::vector<std::string> refusals_;
-  bool newest_refused_ = false;  ///< whether the view being added was refused while waiting
-  std::vector<HullView> waiting_;
+  uint64_t arrivals_ = 0;        ///< serial of the newest view
+  bool newest_refused_ = false;  ///< whether the newest view was refused
+  std::vector<Arrival> waiting_;
   std::unique_ptr<VisualHull> hull_;
   std::string why_no_box_ = "no view yet";
 };

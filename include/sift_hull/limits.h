@@ -28,7 +28,8 @@ constexpr int kMaxOctaveLayers = 32;
 /// The default of SiftConfig::max_image_pixels: 25 megapixels (a 6000x4000 photo). SIFT needs
 /// about 75 bytes per pixel of an image pair.
 constexpr size_t kDefaultMaxImagePixels = 25000000;
-/// Pixels of an image file the command-line program decodes (OPENCV_IO_MAX_IMAGE_PIXELS).
+/// Pixels of an image file the command-line program decodes (OPENCV_IO_MAX_IMAGE_PIXELS) and of
+/// an image message a node accepts (a mask of 1e8 pixels is 100 MB, its distance maps 800 MB).
 constexpr size_t kMaxDecodedImagePixels = 100000000;
 /// Width or height of an image or map read from a file or a message, pixels.
 constexpr size_t kMaxImageSidePx = 1 << 16;

@@ -16,6 +16,8 @@ namespace {
 // A box coordinate this many times farther out than the farthest camera centre is not a bound:
 // near-parallel cones give finite but meaningless optima of that size.
 constexpr double kFarCoordinateFactor = 1e6;
+// A box edge below this fraction of the cameras' spread is no volume (rounding of the LP).
+constexpr double kMinRelativeExtent = 1e-9;
 
 constexpr char kUnboundedHint[] =
     "the views' rays are nearly parallel or silhouettes touch the image border; add views from "
@@ -293,6 +295,12 @@ Box3d hullBoundingBox(const std::vector<PinholeCamera>& cameras,
     box.min_W(axis) = frame.origin(axis) + frame.scale * extremeOf(solution, 2 * axis, far_limit);
     box.max_W(axis) =
         frame.origin(axis) + frame.scale * extremeOf(solution, 2 * axis + 1, far_limit);
+  }
+  // Cones that meet only at a common apex, along a line or in a plane bound no volume.
+  if (!(box.size().minCoeff() > kMinRelativeExtent * frame.scale)) {
+    throw HullBoxError(HullBoxError::Reason::kEmpty,
+                       "the viewing cones meet in a point, a line or a plane, not in a volume: " +
+                           std::string(kEmptyHint));
   }
   return box;
 }

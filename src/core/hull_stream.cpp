@@ -42,18 +42,20 @@ bool HullStream::isRedundant(const PinholeCamera& camera) const {
   const double min_cos = std::cos(config_.min_view_angle_deg * M_PI / 180.0) - 1e-12;
   const Eigen::Vector3d centre = camera.centre();
   const Eigen::Vector3d axis = camera.opticalAxis();
-  const auto near = [&](const HullView& taken) {
-    return (taken.camera().centre() - centre).norm() <= config_.min_view_distance_m &&
-           taken.camera().opticalAxis().dot(axis) >= min_cos;
+  const auto near = [&](const PinholeCamera& taken) {
+    return (taken.centre() - centre).norm() <= config_.min_view_distance_m &&
+           taken.opticalAxis().dot(axis) >= min_cos;
   };
-  return std::any_of(waiting_.begin(), waiting_.end(), near) ||
-         (hull_ && std::any_of(hull_->views().begin(), hull_->views().end(), near));
+  return std::any_of(waiting_.begin(), waiting_.end(),
+                     [&](const Arrival& a) { return near(a.view.camera()); }) ||
+         (hull_ && std::any_of(hull_->views().begin(), hull_->views().end(),
+                               [&](const HullView& v) { return near(v.camera()); }));
 }
 
-HullStream::Outcome HullStream::refuse(const std::string& name, const std::string& reason) {
+void HullStream::refuse(const std::string& name, uint64_t serial, const std::string& reason) {
   ++refused_views_;
   refusals_.push_back("view '" + name + "': " + reason);
-  return Outcome::kRefused;
+  if (serial == arrivals_) newest_refused_ = true;
 }
 
 std::vector<std::string> HullStream::takeRefusals() {
@@ -66,55 +68,87 @@ HullStream::Outcome HullStream::add(const std::string& name, const PinholeCamera
                                     const cv::Mat& mask) {
   const auto& skip = config_.skip_views;
   if (std::find(skip.begin(), skip.end(), name) != skip.end()) return Outcome::kSkipped;
+  const uint64_t serial = ++arrivals_;
+  newest_refused_ = false;
   const std::string coverage = coverageProblem(mask);
-  if (!coverage.empty()) return refuse(name, coverage);
   const size_t views = waiting_.size() + (hull_ ? hull_->views().size() : 0);
-  if (views >= static_cast<size_t>(config_.max_views)) {
-    return refuse(name, "the hull holds max_views (" + std::to_string(config_.max_views) +
-                            ") views already");
-  }
-  if (isRedundant(camera)) {
+  if (!coverage.empty()) {
+    refuse(name, serial, coverage);
+  } else if (views >= static_cast<size_t>(config_.max_views)) {
+    refuse(name, serial,
+           "the hull holds max_views (" + std::to_string(config_.max_views) + ") views already");
+  } else if (isRedundant(camera)) {
     ++redundant_views_;
     return Outcome::kRedundant;
+  } else {
+    take({HullView(name, camera, mask, config_.hull), serial});
   }
-  HullView view(name, camera, mask, config_.hull);
-  if (hull_) return addToHull(std::move(view));
-  if (waiting_.size() >= static_cast<size_t>(config_.max_waiting_views)) {
-    refuse(waiting_.front().name(), "no box after max_waiting_views (" +
-                                        std::to_string(config_.max_waiting_views) +
-                                        ") views: " + why_no_box_);
-    waiting_.erase(waiting_.begin());
-  }
-  waiting_.push_back(std::move(view));
-  newest_refused_ = false;
-  tryToStart();
   if (newest_refused_) return Outcome::kRefused;
   return hull_ ? Outcome::kCarved : Outcome::kWaiting;
 }
 
-HullStream::Outcome HullStream::addToHull(HullView view) {
-  const std::string name = view.name();
-  try {
-    hull_->checkView(view);
-  } catch (const std::invalid_argument& e) {
-    return refuse(name, e.what());
+void HullStream::take(Arrival arrival) {
+  if (hull_) return addToHull(std::move(arrival));
+  wait(std::move(arrival));
+}
+
+void HullStream::wait(Arrival arrival) {
+  if (waiting_.size() < static_cast<size_t>(config_.max_waiting_views)) {
+    waiting_.push_back(std::move(arrival));
+    return tryToStart();
   }
-  hull_->addView(std::move(view));
+  const HullView& oldest = waiting_.front().view;
+  refuse(oldest.name(), waiting_.front().serial,
+         "no box after max_waiting_views (" + std::to_string(config_.max_waiting_views) +
+             ") views: " + why_no_box_);
+  std::vector<Arrival> rest(std::make_move_iterator(waiting_.begin() + 1),
+                            std::make_move_iterator(waiting_.end()));
+  rest.push_back(std::move(arrival));
+  waiting_.clear();
+  replay(std::move(rest));
+}
+
+void HullStream::replay(std::vector<Arrival> arrivals) {
+  for (Arrival& arrival : arrivals) take(std::move(arrival));
+}
+
+void HullStream::addToHull(Arrival arrival) {
+  const std::string name = arrival.view.name();
+  try {
+    hull_->checkView(arrival.view);
+  } catch (const std::invalid_argument& e) {
+    return refuse(name, arrival.serial, e.what());
+  }
+  hull_->addView(std::move(arrival.view));
   if (hull_->isEmpty()) {
     hull_->dropLastView();  // rare: a full re-carve beats copying the tree for every view
-    return refuse(name, "it would carve the hull to nothing");
+    refuse(name, arrival.serial, "it would carve the hull to nothing");
   }
-  return Outcome::kCarved;
+}
+
+void HullStream::tryToStart() {
+  if (config_.box) return startHull(*config_.box);
+  std::vector<HullView> views;
+  for (const Arrival& arrival : waiting_) views.push_back(arrival.view);
+  try {
+    startHull(boundingBoxOf(views));
+  } catch (const HullBoxError& e) {
+    // Fewer than two views, or cones still parallel: later views may bound the box.
+    why_no_box_ = e.what();
+    if (e.reason() == HullBoxError::Reason::kEmpty) dropViewMissingTheOthers();
+  }
 }
 
 /// When the LP over the waiting views is empty, the view whose cone misses the others is the one
-/// without which the rest are feasible, and it must be the only such view: with two views either
+/// without which the rest are not empty, and it must be the only such view: with two views either
 /// could be the bad one, so both wait for a third.
-bool HullStream::dropViewMissingTheOthers() {
+void HullStream::dropViewMissingTheOthers() {
   std::vector<size_t> culprits;
   for (size_t i = 0; i < waiting_.size(); ++i) {
-    std::vector<HullView> others = waiting_;
-    others.erase(others.begin() + static_cast<std::ptrdiff_t>(i));
+    std::vector<HullView> others;
+    for (size_t j = 0; j < waiting_.size(); ++j) {
+      if (j != i) others.push_back(waiting_[j].view);
+    }
     try {
       boundingBoxOf(others);
       culprits.push_back(i);
@@ -122,36 +156,25 @@ bool HullStream::dropViewMissingTheOthers() {
       if (e.reason() != HullBoxError::Reason::kEmpty) culprits.push_back(i);
     }
   }
-  if (culprits.size() != 1) return false;
+  if (culprits.size() != 1) return;
   const size_t bad = culprits.front();
-  refuse(waiting_[bad].name(), "its viewing cone misses the other views' cones");
-  newest_refused_ = bad + 1 == waiting_.size();
-  waiting_.erase(waiting_.begin() + static_cast<std::ptrdiff_t>(bad));
-  return true;
-}
-
-void HullStream::tryToStart() {
-  for (;;) {
-    if (config_.box) return startHull(*config_.box);
-    try {
-      return startHull(boundingBoxOf(waiting_));
-    } catch (const HullBoxError& e) {
-      // Fewer than two views, or cones still parallel: later views may bound the box.
-      why_no_box_ = e.what();
-      if (e.reason() != HullBoxError::Reason::kEmpty || !dropViewMissingTheOthers()) return;
-    }
+  refuse(waiting_[bad].view.name(), waiting_[bad].serial,
+         "its viewing cone misses the other views' cones");
+  std::vector<Arrival> rest;
+  for (size_t j = 0; j < waiting_.size(); ++j) {
+    if (j != bad) rest.push_back(std::move(waiting_[j]));
   }
+  waiting_.clear();
+  replay(std::move(rest));
 }
 
 /// Starts the hull in `box` and adds the waiting views to it one by one, refusing those that
 /// cannot join it or would carve it to nothing (addToHull).
 void HullStream::startHull(const Box3d& box) {
   hull_ = std::make_unique<VisualHull>(box, config_.hull);
-  std::vector<HullView> waiting = std::move(waiting_);
+  std::vector<Arrival> waiting = std::move(waiting_);
   waiting_.clear();
-  for (size_t i = 0; i < waiting.size(); ++i) {
-    newest_refused_ = addToHull(std::move(waiting[i])) == Outcome::kRefused;
-  }
+  for (Arrival& arrival : waiting) addToHull(std::move(arrival));
   if (hull_->views().empty()) {  // every view refused: the next views bound a box afresh
     hull_.reset();
     why_no_box_ = "no waiting view could join the hull";

@@ -29,6 +29,12 @@ bool holdsPixels(const sensor_msgs::Image& image, size_t bytes_per_pixel, std::s
     return false;
   }
   // Every factor is below 2^32, so no product of two wraps in size_t.
+  const size_t pixels = static_cast<size_t>(image.width) * static_cast<size_t>(image.height);
+  if (pixels > limits::kMaxDecodedImagePixels) {
+    *why_not = "the image is " + size + ", more than " +
+               std::to_string(limits::kMaxDecodedImagePixels) + " pixels";
+    return false;
+  }
   const size_t row_bytes = static_cast<size_t>(image.width) * bytes_per_pixel;
   const size_t needed = static_cast<size_t>(image.step) * static_cast<size_t>(image.height);
   if (image.step < row_bytes || image.data.size() < needed) {

@@ -26,7 +26,8 @@ namespace ros_conversions {
 
 /// Whether the message's data holds its width x height pixels of `bytes_per_pixel` bytes, all
 /// sizes in size_t before any pointer arithmetic: false, with `why_not`, for an empty image, a
-/// side over limits::kMaxImageSidePx, a step shorter than a row, or data shorter than
+/// side over limits::kMaxImageSidePx, more than limits::kMaxDecodedImagePixels pixels, a step
+/// shorter than a row, or data shorter than
 /// step x height (a height x step that would wrap in 32 bits is caught).
 bool holdsPixels(const sensor_msgs::Image& image, size_t bytes_per_pixel, std::string* why_not);
 
