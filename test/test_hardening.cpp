@@ -102,8 +102,7 @@ TEST(Limits, SettingsBeyondALimitAreRefusedNamingIt) {
   EXPECT_THROW(validate(recipe), std::invalid_argument);
   SiftConfig sift;
   sift.max_image_pixels = 1000;
-  EXPECT_THROW(detectSift(cv::Mat(100, 100, CV_8UC1, cv::Scalar(0)), sift),
-               std::invalid_argument);
+  EXPECT_THROW(detectSift(cv::Mat(100, 100, CV_8UC1, cv::Scalar(0)), sift), std::invalid_argument);
 }
 
 TEST(Readers, APfmHeaderCannotAskForMoreThanTheFileHolds) {
@@ -125,10 +124,11 @@ TEST(Readers, NumbersWithTrailingBytesAreRefused) {
   EXPECT_THROW(readHomography(dir + "/H"), std::exception);
   writeText(dir + "/H10", "1 0 0 0 1 0 0 0 1 1\n");
   EXPECT_THROW(readHomography(dir + "/H10"), std::exception);
-  const std::vector<CalibratedView> views = {{"a.png", PinholeCamera(Eigen::Matrix3d::Identity(),
-                                                                     Eigen::Matrix3d::Identity(),
-                                                                     Eigen::Vector3d(0, 0, 1)),
-                                              ""}};
+  const std::vector<CalibratedView> views = {
+      {"a.png",
+       PinholeCamera(Eigen::Matrix3d::Identity(), Eigen::Matrix3d::Identity(),
+                     Eigen::Vector3d(0, 0, 1)),
+       ""}};
   writeMiddleburyPar(dir + "/good.txt", views);
   std::ifstream in(dir + "/good.txt");
   std::string text((std::istreambuf_iterator<char>(in)), {});
@@ -230,8 +230,8 @@ TEST(HullStream, RefusesSilhouettesThatCoverNothingOrEverything) {
   }
   ASSERT_TRUE(stream.hasHull());
   const HullSummary before = summary(stream.hull());
-  const PinholeCamera other = PinholeCamera::fromCentre(
-      input.cameras[0].K(), input.cameras[0].R(), input.cameras[0].centre() * 1.1);
+  const PinholeCamera other = PinholeCamera::fromCentre(input.cameras[0].K(), input.cameras[0].R(),
+                                                        input.cameras[0].centre() * 1.1);
   EXPECT_EQ(stream.add("black", other, black), HullStream::Outcome::kRefused);
   EXPECT_EQ(stream.add("white", other, white), HullStream::Outcome::kRefused);
   EXPECT_TRUE(summary(stream.hull()) == before);
@@ -254,8 +254,8 @@ TEST(HullStream, RefusesAViewThatWouldCarveTheHullToNothing) {
   // A blob in the image's corner, where the sphere does not project, seen from a new place.
   cv::Mat corner = cv::Mat::zeros(input.masks[0].size(), CV_8UC1);
   corner(cv::Rect(0, 0, 10, 10)).setTo(255);
-  const PinholeCamera other = PinholeCamera::fromCentre(
-      input.cameras[0].K(), input.cameras[0].R(), input.cameras[0].centre() * 1.1);
+  const PinholeCamera other = PinholeCamera::fromCentre(input.cameras[0].K(), input.cameras[0].R(),
+                                                        input.cameras[0].centre() * 1.1);
   EXPECT_EQ(stream.add("corner", other, corner), HullStream::Outcome::kRefused);
   EXPECT_TRUE(summary(stream.hull()) == before);
   const std::vector<std::string> refusals = stream.takeRefusals();

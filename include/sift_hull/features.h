@@ -1,9 +1,9 @@
 #pragma once
 
 #include <opencv2/core.hpp>
+#include <vector>
 
 #include "sift_hull/limits.h"
-#include <vector>
 
 namespace sift_hull {
 

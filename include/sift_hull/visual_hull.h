@@ -114,9 +114,10 @@ class HullView {
   /// values[i] = max(values[i], D_i(P_i X_i)) for a batch of points in the local frame: f_iso
   /// built view by view.
   void maxInto(const PointBatch& points, float* values) const;
-  /// For balls of one radius (local units) around up to 32 centres (local frame), from the distance at each centre and the
-  /// ball's projected radius (plus the slack): maxInto for the centres; bit i of `out_bits` set
-  /// when the view sees all of ball i outside the silhouette, of `in_bits` when all inside.
+  /// For balls of one radius (local units) around up to 32 centres (local frame), from the distance
+  /// at each centre and the ball's projected radius (plus the slack): maxInto for the centres; bit
+  /// i of `out_bits` set when the view sees all of ball i outside the silhouette, of `in_bits` when
+  /// all inside.
   void classifyBalls(const PointBatch& centres, float radius_m, float* values, uint32_t* out_bits,
                      uint32_t* in_bits) const;
 

@@ -1,5 +1,4 @@
 #include "sift_hull/dataset.h"
-#include "sift_hull/limits.h"
 
 #include <Eigen/Dense>
 #include <algorithm>
@@ -11,6 +10,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
+
+#include "sift_hull/limits.h"
 
 namespace sift_hull {
 namespace {

@@ -1,5 +1,4 @@
 #include "sift_hull/evaluation.h"
-#include "sift_hull/depth_io.h"
 
 #include <cmath>
 #include <fstream>
@@ -8,6 +7,7 @@
 #include <stdexcept>
 
 #include "sift_hull/dataset.h"
+#include "sift_hull/depth_io.h"
 
 namespace sift_hull {
 namespace {
@@ -35,7 +35,8 @@ double ratio(size_t numerator, size_t denominator) {
 cv::Mat readDisparity(const std::string& path, double scale) {
   if (!(scale > 0.0)) throw std::invalid_argument("readDisparity: scale must be > 0");
   const bool pfm = path.size() >= 4 && path.compare(path.size() - 4, 4, ".pfm") == 0;
-  const cv::Mat raw = pfm ? readPfm(path) : cv::imread(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_GRAYSCALE);
+  const cv::Mat raw =
+      pfm ? readPfm(path) : cv::imread(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_GRAYSCALE);
   if (raw.empty()) throw std::runtime_error(path + ": cannot read the disparity image");
   cv::Mat disparity;
   raw.convertTo(disparity, CV_32F, 1.0 / scale);
@@ -72,11 +73,11 @@ std::vector<MatchTruth> judgeByDisparity(const PutativeMatches& input, const cv:
     throw std::invalid_argument("judgeByDisparity: disparity must be CV_32FC1");
   }
   if (input.left_image_size.area() > 0 && disparity_px.size() != input.left_image_size) {
-    throw std::invalid_argument(
-        "the disparity map is " + std::to_string(disparity_px.cols) + "x" +
-        std::to_string(disparity_px.rows) + " but the left image is " +
-        std::to_string(input.left_image_size.width) + "x" +
-        std::to_string(input.left_image_size.height) + ": it is not this image's ground truth");
+    throw std::invalid_argument("the disparity map is " + std::to_string(disparity_px.cols) + "x" +
+                                std::to_string(disparity_px.rows) + " but the left image is " +
+                                std::to_string(input.left_image_size.width) + "x" +
+                                std::to_string(input.left_image_size.height) +
+                                ": it is not this image's ground truth");
   }
   return judgeEach(input, [&](const Eigen::Vector2d& left, const Eigen::Vector2d& right) {
     const long u = std::lround(left.x()), v = std::lround(left.y());

@@ -264,8 +264,8 @@ std::vector<double> bestScores(const std::vector<NormalisedMatch>& matches,
 }
 
 void validateGmsConfig(const GmsConfig& config) {
-  limits::requireInRange("GmsConfig::grid_cells (a 3x3 neighbourhood at least)",
-                         config.grid_cells, 3, limits::kMaxGmsGridCells);
+  limits::requireInRange("GmsConfig::grid_cells (a 3x3 neighbourhood at least)", config.grid_cells,
+                         3, limits::kMaxGmsGridCells);
   if (!std::isfinite(config.threshold_factor) || config.threshold_factor <= 0.0) {
     throw std::invalid_argument("GmsConfig::threshold_factor must be finite and positive, got " +
                                 std::to_string(config.threshold_factor));

@@ -6,6 +6,7 @@
 #include <opencv2/core.hpp>
 #include <stdexcept>
 #include <thread>
+
 #include "parallel.h"
 
 namespace sift_hull {

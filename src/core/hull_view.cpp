@@ -3,15 +3,15 @@
 #include <cmath>
 #include <iomanip>
 #include <limits>
-#include <sstream>
 #include <opencv2/imgproc.hpp>
+#include <sstream>
 #include <stdexcept>
 #include <thread>
 
-#include "parallel.h"
 #include "distance_kernel.h"
-#include "sift_hull/visual_hull.h"
+#include "parallel.h"
 #include "sift_hull/limits.h"
+#include "sift_hull/visual_hull.h"
 
 namespace sift_hull {
 namespace {
@@ -155,7 +155,8 @@ detail::DistanceKernel HullView::makeKernel(const HullConfig& config) const {
 
 void HullView::useFrame(const Eigen::Vector3d& origin_W, double scale) {
   if (!origin_W.allFinite() || !(scale > 0.0) || !std::isfinite(scale)) {
-    throw std::invalid_argument("view '" + name_ + "': the hull's frame is not finite and positive");
+    throw std::invalid_argument("view '" + name_ +
+                                "': the hull's frame is not finite and positive");
   }
   const double distance = (camera_.centre() - origin_W).norm() / scale;
   if (!(distance <= kMaxCameraDistance)) {

@@ -7,6 +7,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <thread>
+
 #include "parallel.h"
 
 namespace sift_hull {

@@ -46,9 +46,8 @@ class ThrottledLog {
       it = now - it->second >= period_ ? last_.erase(it) : std::next(it);
     }
     if (last_.size() < kMaxMessages) return;
-    last_.erase(std::min_element(last_.begin(), last_.end(), [](const auto& a, const auto& b) {
-      return a.second < b.second;
-    }));
+    last_.erase(std::min_element(last_.begin(), last_.end(),
+                                 [](const auto& a, const auto& b) { return a.second < b.second; }));
   }
 
   ros::WallDuration period_;
