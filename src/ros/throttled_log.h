@@ -21,16 +21,18 @@ class ThrottledLog {
 
   static constexpr size_t kMaxMessages = 256;
 
-  /// Logs `prefix + reason` unless the same message was logged less than the period ago.
-  void error(const std::string& prefix, const std::string& reason) {
+  /// Logs `prefix + reason` unless the same message was logged less than the period ago;
+  /// returns whether it logged.
+  bool error(const std::string& prefix, const std::string& reason) {
     const std::string message = prefix + reason;
     const ros::WallTime now = ros::WallTime::now();
     std::lock_guard<std::mutex> lock(mutex_);
     auto found = last_.find(message);
-    if (found != last_.end() && now - found->second < period_) return;
+    if (found != last_.end() && now - found->second < period_) return false;
     if (found == last_.end() && last_.size() >= kMaxMessages) forgetOldest(now);
     last_[message] = now;
     ROS_ERROR("%s", message.c_str());
+    return true;
   }
 
   /// Messages remembered (for tests).
