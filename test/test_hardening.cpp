@@ -199,6 +199,19 @@ TEST(VisualHull, BoxesTheCamerasCannotResolveAreRefused) {
                std::invalid_argument);
 }
 
+TEST(VisualHull, ABoxBeyondIntVoxelIndicesIsRefused) {
+  Box3d earth_centred;  // a 1 m box 6400 km from the origin at depth 10: 6e9 voxels out
+  earth_centred.min_W = Eigen::Vector3d(6.4e6, 0, 0);
+  earth_centred.max_W = Eigen::Vector3d(6.4e6 + 1, 1, 1);
+  HullConfig config;
+  config.max_depth = 10;
+  EXPECT_THROW(VisualHull(earth_centred, config), std::invalid_argument);
+  HullStreamConfig stream;
+  stream.box = earth_centred;
+  stream.hull = config;
+  EXPECT_THROW(validate(stream), std::invalid_argument);
+}
+
 TEST(VisualHull, AWorldFrameFarFromItsOriginGivesTheSameHull) {
   // A map frame 100 km from its origin: the local frame keeps single precision's accuracy.
   const HullInput input = ring(8);
@@ -330,11 +343,12 @@ TEST(HullStream, ACameraFarBeyondTheBoxIsRefusedAndTheOthersCarve) {
   for (size_t i = 0; i < input.masks.size(); ++i) {
     PinholeCamera camera = input.cameras[i];
     if (i == 5) camera = PinholeCamera(camera.K(), camera.R(), Eigen::Vector3d(0, 0, 1e39));
+    if (i == 6) camera = PinholeCamera(camera.K(), camera.R(), Eigen::Vector3d(0, 0, 1e307));
     stream.add(input.names[i], camera, input.masks[i]);
   }
   ASSERT_TRUE(stream.hasHull());
-  EXPECT_EQ(stream.hull().views().size(), 7u);
-  EXPECT_EQ(stream.refusedViews(), 1u);
+  EXPECT_EQ(stream.hull().views().size(), 6u);
+  EXPECT_EQ(stream.refusedViews(), 2u);
 }
 
 // ---- the command-line program --------------------------------------------------------------

@@ -31,7 +31,7 @@ struct HullStreamConfig {
 };
 
 /// Throws std::invalid_argument for a negative or non-finite distance, an angle outside
-/// [0, 180] degrees, or view counts below 2 (waiting) or 1.
+/// [0, 180] degrees, view counts below 2 (waiting) or 1, or a box the octree cannot hold.
 void validate(const HullStreamConfig& config);
 
 /// A visual hull that views refine as they arrive (the hull node's worker). Until a box exists,

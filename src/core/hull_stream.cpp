@@ -20,6 +20,12 @@ std::string coverageProblem(const cv::Mat& mask) {
   return "";
 }
 
+/// Why a camera cannot take part in the box LP: empty when its projection is finite.
+std::string cameraProblem(const PinholeCamera& camera) {
+  if (camera.projectionMatrix().allFinite() && camera.centre().allFinite()) return "";
+  return "its camera's projection is beyond double precision (a translation near 1e308?)";
+}
+
 }  // namespace
 
 void validate(const HullStreamConfig& config) {
@@ -32,6 +38,7 @@ void validate(const HullStreamConfig& config) {
   }
   if (config.max_waiting_views < 2) throw std::invalid_argument("max_waiting_views must be >= 2");
   if (config.max_views < 1) throw std::invalid_argument("max_views must be >= 1");
+  if (config.box) HullCube::around(*config.box, config.hull.max_depth);  // throws for a bad box
 }
 
 HullStream::HullStream(HullStreamConfig config) : config_(std::move(config)) { validate(config_); }
@@ -70,7 +77,8 @@ HullStream::Outcome HullStream::add(const std::string& name, const PinholeCamera
   if (std::find(skip.begin(), skip.end(), name) != skip.end()) return Outcome::kSkipped;
   const uint64_t serial = ++arrivals_;
   newest_refused_ = false;
-  const std::string coverage = coverageProblem(mask);
+  std::string coverage = coverageProblem(mask);
+  if (coverage.empty()) coverage = cameraProblem(camera);
   const size_t views = waiting_.size() + (hull_ ? hull_->views().size() : 0);
   if (!coverage.empty()) {
     refuse(name, serial, coverage);
@@ -136,6 +144,11 @@ void HullStream::tryToStart() {
     // Fewer than two views, or cones still parallel: later views may bound the box.
     why_no_box_ = e.what();
     if (e.reason() == HullBoxError::Reason::kEmpty) dropViewMissingTheOthers();
+  } catch (const std::invalid_argument& e) {
+    // A box the octree cannot hold (HullCube::around): the views go on waiting, within
+    // max_waiting_views.
+    hull_.reset();
+    why_no_box_ = e.what();
   }
 }
 

@@ -235,6 +235,13 @@ HullCube HullCube::around(const Box3d& box, int depth) {
   // least one voxel of margin remains on every side.
   cube.resolution_m = longest_m / ((1 << depth) - 3);
   const Eigen::Vector3d corner = box.min_W / cube.resolution_m - Eigen::Vector3d::Ones();
+  // Voxel indices of the cube's cells must fit an int (and its far corner too).
+  constexpr double kMaxVoxelIndex = 1 << 30;
+  if (!(corner.cwiseAbs().maxCoeff() < kMaxVoxelIndex) || !box.min_W.allFinite()) {
+    throw std::invalid_argument(
+        "the hull box lies more than 2^30 voxels from the world origin at this resolution: "
+        "express the poses in a frame nearer the object, or lower the depth");
+  }
   cube.origin_voxels = corner.array().floor().cast<int>();
   return cube;
 }
