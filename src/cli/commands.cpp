@@ -3,6 +3,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <exception>
+#include <new>
 #include <iostream>
 
 #include "args.h"
@@ -78,6 +79,10 @@ int runMain(int argc, char** argv) {
     std::cerr << "sift_hull " << command->name << ": " << e.what() << "\n(see 'sift_hull "
               << command->name << " --help')\n";
     return 2;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "sift_hull " << command->name
+              << ": error: out of memory; lower --depth or use smaller images\n";
+    return 1;
   } catch (const std::exception& e) {
     std::cerr << "sift_hull " << command->name << ": error: " << e.what() << '\n';
     return 1;
