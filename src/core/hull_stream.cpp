@@ -61,7 +61,9 @@ bool HullStream::isRedundant(const PinholeCamera& camera) const {
 
 void HullStream::refuse(const std::string& name, uint64_t serial, const std::string& reason) {
   ++refused_views_;
-  refusals_.push_back("view '" + name + "': " + reason);
+  // Reasons from VisualHull::checkView name the view already.
+  const std::string prefix = "view '" + name + "': ";
+  refusals_.push_back(reason.rfind(prefix, 0) == 0 ? reason : prefix + reason);
   if (serial == arrivals_) newest_refused_ = true;
 }
 
