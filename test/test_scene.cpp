@@ -281,7 +281,10 @@ TEST_F(WrittenScene, DepthCorrespondencesAgreeWithProjectedPoints) {
     const DepthView b{scene.views[ib].camera, scene.depths[ib]};
     for (int trial = 0; trial < 10000; ++trial) {
       const bool integer_pixel = trial % 2 == 0;
-      Eigen::Vector2d pixel(u(rng), v(rng));
+      // Two statements: the order of two draws in one argument list is unspecified.
+      const double v_px = v(rng);
+      const double u_px = u(rng);
+      Eigen::Vector2d pixel(u_px, v_px);
       if (integer_pixel) pixel = pixel.array().round();
       checkCorrespondence(shape, a, b, pixel, integer_pixel, &tally);
     }
