@@ -296,6 +296,12 @@ Box3d hullBoundingBox(const std::vector<PinholeCamera>& cameras,
     box.max_W(axis) =
         frame.origin(axis) + frame.scale * extremeOf(solution, 2 * axis + 1, far_limit);
   }
+  // The LP frame's optimum, scaled back, can overflow where the cameras lie near 1e300.
+  if (!box.min_W.allFinite() || !box.max_W.allFinite()) {
+    throw HullBoxError(HullBoxError::Reason::kUnbounded,
+                       "the bounding box lies beyond double precision (cameras near 1e300?): "
+                       "check the calibration");
+  }
   // Cones that meet only at a common apex, along a line or in a plane bound no volume.
   if (!(box.size().minCoeff() > kMinRelativeExtent * frame.scale)) {
     throw HullBoxError(HullBoxError::Reason::kEmpty,
