@@ -1,0 +1,62 @@
+// Every input of the fuzz corpus (test/fuzz/corpus/HARNESS/: the seeds and the regress_* inputs
+// of fixed findings) replayed through its libFuzzer harness in the ordinary build, so that
+// scripts/test.sh checks on every run that no input that once crashed a reader or the
+// bounding-box solver crashes, aborts or hangs it again. The harnesses themselves (test/fuzz/)
+// are compiled here with their entry point renamed (CMakeLists.txt).
+
+#include <dirent.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <fstream>
+#include <string>
+#include <vector>
+
+extern "C" int fuzzMiddleburyPar(const uint8_t* data, size_t size);
+extern "C" int fuzzProjectionList(const uint8_t* data, size_t size);
+extern "C" int fuzzHomography(const uint8_t* data, size_t size);
+extern "C" int fuzzPfm(const uint8_t* data, size_t size);
+extern "C" int fuzzPly(const uint8_t* data, size_t size);
+extern "C" int fuzzBoundingBox(const uint8_t* data, size_t size);
+
+namespace sift_hull {
+namespace {
+
+using Harness = int (*)(const uint8_t*, size_t);
+
+std::vector<std::string> corpusFiles(const std::string& harness) {
+  const std::string directory = std::string(SIFT_HULL_SOURCE_DIR) + "/test/fuzz/corpus/" + harness;
+  std::vector<std::string> files;
+  if (DIR* dir = opendir(directory.c_str())) {
+    while (const dirent* entry = readdir(dir)) {
+      if (entry->d_name[0] != '.') files.push_back(directory + "/" + entry->d_name);
+    }
+    closedir(dir);
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+/// Runs every corpus file of `harness` once; a crash, abort or sanitizer report ends the test.
+void replay(const std::string& harness, Harness run) {
+  const std::vector<std::string> files = corpusFiles(harness);
+  ASSERT_FALSE(files.empty()) << "no corpus for " << harness;
+  for (const std::string& path : files) {
+    std::ifstream in(path, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), {});
+    SCOPED_TRACE(path);
+    EXPECT_EQ(run(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size()), 0);
+  }
+}
+
+TEST(FuzzCorpus, MiddleburyPar) { replay("fuzz_middlebury_par", fuzzMiddleburyPar); }
+TEST(FuzzCorpus, ProjectionList) { replay("fuzz_projection_list", fuzzProjectionList); }
+TEST(FuzzCorpus, Homography) { replay("fuzz_homography", fuzzHomography); }
+TEST(FuzzCorpus, Pfm) { replay("fuzz_pfm", fuzzPfm); }
+TEST(FuzzCorpus, Ply) { replay("fuzz_ply", fuzzPly); }
+TEST(FuzzCorpus, BoundingBox) { replay("fuzz_bounding_box", fuzzBoundingBox); }
+
+}  // namespace
+}  // namespace sift_hull
