@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "../src/ros/conversions.h"
+#include "octomap_volume.h"
 #include "ros_wait.h"
 #include "sift_hull/Correspondences.h"
 #include "sift_hull/Octomap.h"
@@ -39,6 +40,7 @@ namespace sift_hull {
 namespace {
 
 using test::kDeadline_s;
+using test::occupiedVolume;
 using test::waitFor;
 
 constexpr long kMaxRssGrowthKiB = 200 * 1024;  // 200 MiB
@@ -516,18 +518,6 @@ HullData& hullData() {
     return d;
   }();
   return data;
-}
-
-double occupiedVolume(const sift_hull::Octomap& message) {
-  if (message.data.empty()) return 0.0;  // an empty tree
-  octomap::OcTree tree(message.resolution);
-  std::stringstream data(std::string(message.data.begin(), message.data.end()));
-  tree.readBinaryData(data);
-  double volume = 0.0;
-  for (auto leaf = tree.begin_leafs(); leaf != tree.end_leafs(); ++leaf) {
-    if (tree.isNodeOccupied(*leaf)) volume += std::pow(leaf.getSize(), 3);
-  }
-  return volume;
 }
 
 using Change = std::function<void(sensor_msgs::Image*, sensor_msgs::CameraInfo*)>;

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "sift_hull/hull_pipeline.h"
+#include "sift_hull/hull_stream.h"
 #include "sift_hull/scene.h"
 
 namespace sift_hull {
@@ -34,6 +35,16 @@ inline HullInput sceneHullInput(const std::string& shape, int views,
   config.width_px = 320;
   config.height_px = 240;
   return hullInputOf(renderScene(config));
+}
+
+/// A sphere seen by `views` cameras on a ring, 320x240 (the hull stream tests' input).
+inline HullInput ring(int views) { return sceneHullInput("sphere", views, "ring"); }
+
+/// Hull stream settings with the octree depth set, the rest the struct's defaults.
+inline HullStreamConfig streamConfig(int depth) {
+  HullStreamConfig config;
+  config.hull.max_depth = depth;
+  return config;
 }
 
 /// Root of the real data sets: $SIFT_HULL_DATA, else ../shared/data beside the repository when it

@@ -32,13 +32,8 @@
 namespace sift_hull {
 namespace {
 
-HullInput ring(int views) { return test::sceneHullInput("sphere", views, "ring"); }
-
-HullStreamConfig streamConfig(int depth) {
-  HullStreamConfig config;
-  config.hull.max_depth = depth;
-  return config;
-}
+using test::ring;
+using test::streamConfig;
 
 void writeText(const std::string& path, const std::string& text) {
   std::ofstream out(path, std::ios::binary);

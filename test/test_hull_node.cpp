@@ -21,6 +21,7 @@
 #include <sstream>
 
 #include "../src/ros/conversions.h"
+#include "octomap_volume.h"
 #include "ros_wait.h"
 #include "sift_hull/Octomap.h"
 #include "sift_hull/hull_octomap.h"
@@ -31,6 +32,7 @@ namespace sift_hull {
 namespace {
 
 using test::kDeadline_s;
+using test::occupiedVolume;
 using test::waitFor;
 
 constexpr int kViews = 8;
@@ -46,18 +48,6 @@ std::vector<RenderedView> sphereViews() {
 }
 
 std::string frameOf(int view) { return "camera_" + std::to_string(view); }
-
-double occupiedVolume(const sift_hull::Octomap& message) {
-  if (message.data.empty()) return 0.0;  // an empty tree
-  octomap::OcTree tree(message.resolution);
-  std::stringstream data(std::string(message.data.begin(), message.data.end()));
-  tree.readBinaryData(data);
-  double volume = 0.0;
-  for (auto leaf = tree.begin_leafs(); leaf != tree.end_leafs(); ++leaf) {
-    if (tree.isNodeOccupied(*leaf)) volume += std::pow(leaf.getSize(), 3);
-  }
-  return volume;
-}
 
 class HullNodeTest : public ::testing::Test {
  protected:

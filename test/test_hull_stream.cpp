@@ -13,13 +13,8 @@
 namespace sift_hull {
 namespace {
 
-HullInput ring(int views) { return test::sceneHullInput("sphere", views, "ring"); }
-
-HullStreamConfig streamConfig(int depth) {
-  HullStreamConfig config;
-  config.hull.max_depth = depth;
-  return config;
-}
+using test::ring;
+using test::streamConfig;
 
 /// The camera moved by `offset_m` along world x and turned by `angle_deg` about its own y axis.
 PinholeCamera moved(const PinholeCamera& camera, double offset_m, double angle_deg) {
