@@ -27,7 +27,7 @@ namespace {
 // are a permutation of the sectors.
 constexpr int kSectorOfLabel[kGscSectors] = {1, 2, 6, 5, 0, 3, 7, 4};
 // Label of a point coincident with the keypoint (a = b = 0).
-constexpr int kCoincidentLabel = 5;
+[[maybe_unused]] constexpr int kCoincidentLabel = 5;
 // Label of the NaN padding (every comparison false).
 constexpr int kPaddingLabel = 0;
 // Points per vector lane group the arrays are padded to, and per block of byte-wide counters
