@@ -293,6 +293,25 @@ TEST(HullStream, RefusesAViewThatWouldCarveTheHullToNothing) {
   EXPECT_EQ(stream.add("more", more.cameras[4], more.masks[4]), HullStream::Outcome::kCarved);
 }
 
+TEST(HullStream, WithAGivenBoxAFirstViewThatCarvesItToNothingIsRefused) {
+  const HullInput input = ring(8);
+  HullStreamConfig config = streamConfig(6);
+  config.box = buildHull(input, config.hull).box;
+  HullStream without(config), with(config);
+  cv::Mat corner = cv::Mat::zeros(input.masks[0].size(), CV_8UC1);
+  corner(cv::Rect(0, 0, 10, 10)).setTo(255);
+  const PinholeCamera other = PinholeCamera::fromCentre(input.cameras[0].K(), input.cameras[0].R(),
+                                                        input.cameras[0].centre() * 1.1);
+  EXPECT_EQ(with.add("corner", other, corner), HullStream::Outcome::kRefused);
+  EXPECT_FALSE(with.hasHull());
+  for (size_t i = 0; i < input.masks.size(); ++i) {
+    without.add(input.names[i], input.cameras[i], input.masks[i]);
+    with.add(input.names[i], input.cameras[i], input.masks[i]);
+  }
+  ASSERT_TRUE(with.hasHull());
+  EXPECT_TRUE(summary(with.hull()) == summary(without.hull()));
+}
+
 /// View 0's camera moved sideways by 3 m along its own x axis: its cone runs beside the others'.
 PinholeCamera besideTheOthers(const PinholeCamera& camera) {
   return PinholeCamera::fromCentre(camera.K(), camera.R(),

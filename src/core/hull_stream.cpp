@@ -183,13 +183,28 @@ void HullStream::dropViewMissingTheOthers() {
   replay(std::move(rest));
 }
 
-/// Starts the hull in `box` and adds the waiting views to it one by one, refusing those that
-/// cannot join it or would carve it to nothing (addToHull).
+/// Starts the hull in `box` with the waiting views that can join it, all at once (carving them
+/// one by one from the whole cube would refine a far larger tree on the way). Should they carve
+/// it to nothing, they are added again one by one (addToHull) to refuse the ones that do.
 void HullStream::startHull(const Box3d& box) {
   hull_ = std::make_unique<VisualHull>(box, config_.hull);
-  std::vector<Arrival> waiting = std::move(waiting_);
+  std::vector<Arrival> joining;
+  for (Arrival& arrival : waiting_) {
+    try {
+      hull_->checkView(arrival.view);
+      joining.push_back(std::move(arrival));
+    } catch (const std::invalid_argument& e) {
+      refuse(arrival.view.name(), arrival.serial, e.what());
+    }
+  }
   waiting_.clear();
-  for (Arrival& arrival : waiting) addToHull(std::move(arrival));
+  std::vector<HullView> views;
+  for (const Arrival& arrival : joining) views.push_back(arrival.view);
+  hull_->addViews(std::move(views));
+  if (hull_->isEmpty()) {
+    hull_->reset();
+    for (Arrival& arrival : joining) addToHull(std::move(arrival));
+  }
   if (hull_->views().empty()) {  // every view refused: the next views bound a box afresh
     hull_.reset();
     why_no_box_ = "no waiting view could join the hull";
