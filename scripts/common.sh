@@ -26,7 +26,7 @@ prepare_demo() {
   local info=(dataset-info --calib "$out/scene/scene_par.txt" --silhouettes "$out/scene/masks")
   "$sift_hull" "${info[@]}" --json >"$out/scene_info.json"
   "$sift_hull" "${info[@]}" | tail -n 1
-  "$sift_hull" bag --calib "$out/scene/scene_par.txt" --images "$out/scene" \
+  "$(dirname "$sift_hull")/sift_hull_ros" bag --calib "$out/scene/scene_par.txt" --images "$out/scene" \
     --silhouettes "$out/scene/masks" --out "$out/scene.bag" --rate 4
 }
 

@@ -8,6 +8,13 @@
 
 namespace sift_hull {
 namespace cli {
+namespace {
+
+const char* program_name = "sift_hull";
+
+}  // namespace
+
+void setProgramName(const char* name) { program_name = name; }
 
 ArgParser::ArgParser(std::string command, std::string summary)
     : command_(std::move(command)), summary_(std::move(summary)) {}
@@ -67,7 +74,7 @@ bool ArgParser::parse(const std::vector<std::string>& args) {
 
 std::string ArgParser::help() const {
   std::ostringstream out;
-  out << "usage: sift_hull " << command_;
+  out << "usage: " << program_name << " " << command_;
   for (const auto& positional : positionals_) out << ' ' << positional.first;
   out << " [options]\n\n" << summary_ << "\n";
   for (const auto& positional : positionals_) {

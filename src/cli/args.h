@@ -15,6 +15,9 @@ class UsageError : public std::runtime_error {
 };
 
 /// Parses "--name value", "--name=value", flags and positional arguments of one subcommand.
+/// The program a usage text names (sift_hull unless runMain says otherwise).
+void setProgramName(const char* name);
+
 class ArgParser {
  public:
   ArgParser(std::string command, std::string summary);

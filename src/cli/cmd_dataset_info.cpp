@@ -3,7 +3,9 @@
 
 #include "args.h"
 #include "commands.h"
-#include "sift_hull/dataset.h"
+#include "sift_hull/io/calibration.h"
+#include "sift_hull/geometry/camera_set.h"
+#include "sift_hull/io/images.h"
 #include "silhouette_options.h"
 
 namespace sift_hull {
@@ -25,7 +27,7 @@ bool projectsInside(const std::vector<CalibratedView>& views, const Eigen::Vecto
 }
 
 nlohmann::json commonPointJson(const std::vector<CalibratedView>& views, cv::Size size) {
-  const CommonPoint common = opticalAxesMeetingPoint(views);
+  const CommonPoint common = opticalAxesMeetingPoint(camerasOf(views));
   if (!common.well_defined) return {{"looks_at_common_point", false}, {"point", nullptr}};
   const bool inside = projectsInside(views, common.point_W, size);
   return {{"point", vectorJson(common.point_W)},

@@ -4,7 +4,7 @@
 
 #include "args.h"
 #include "commands.h"
-#include "sift_hull/scene.h"
+#include "sift_hull/synthetic/scene.h"
 
 namespace sift_hull {
 namespace cli {

@@ -7,7 +7,7 @@
 namespace sift_hull {
 namespace cli {
 
-/// One subcommand of the sift_hull program. `run` gets the arguments after the command's name and
+/// One subcommand of the sift_hull (offline) or sift_hull_ros (ROS tools) program. `run` gets the arguments after the command's name and
 /// returns the exit code; it throws UsageError for a bad command line and std::exception for bad
 /// input, which main reports on stderr.
 struct Command {
@@ -16,7 +16,12 @@ struct Command {
   int (*run)(const std::vector<std::string>& args);
 };
 
-const std::vector<Command>& commands();
+/// A program: its name (for usage and error messages) and its subcommands.
+struct Program {
+  const char* name;
+  std::vector<Command> commands;
+};
+
 
 /// Prints a command's result: the JSON object on stdout with --json, else the human text.
 void printResult(bool as_json, const nlohmann::json& result, const std::string& text);
@@ -28,11 +33,9 @@ int runBenchFilters(const std::vector<std::string>& args);
 int runEvaluateFilters(const std::vector<std::string>& args);
 int runHull(const std::vector<std::string>& args);
 int runBenchHull(const std::vector<std::string>& args);
-int runBag(const std::vector<std::string>& args);
-int runBenchNodes(const std::vector<std::string>& args);
 
-/// Parses the command line and runs the chosen command.
-int runMain(int argc, char** argv);
+/// Parses the command line and runs the chosen command of `program`.
+int runMain(const Program& program, int argc, char** argv);
 
 }  // namespace cli
 }  // namespace sift_hull

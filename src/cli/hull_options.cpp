@@ -5,6 +5,11 @@
 
 #include "silhouette_options.h"
 
+#include "sift_hull/hull/hull_config.h"
+#include "sift_hull/hull/hull_pipeline.h"
+#include "sift_hull/hull/silhouette.h"
+#include "sift_hull/io/view_list.h"
+
 namespace sift_hull {
 namespace cli {
 namespace {

@@ -6,8 +6,9 @@
 #include <vector>
 
 #include "args.h"
-#include "sift_hull/hull_evaluation.h"
-#include "sift_hull/hull_pipeline.h"
+#include "sift_hull/eval/hull_evaluation.h"
+#include "sift_hull/hull/hull_pipeline.h"
+#include "sift_hull/hull/hull_config.h"
 
 namespace sift_hull {
 namespace cli {

@@ -3,6 +3,11 @@
 #include <chrono>
 #include <cmath>
 
+#include "sift_hull/eval/match_evaluation.h"
+#include "sift_hull/features/labelled_matches.h"
+#include "sift_hull/filters/filter_result.h"
+#include "sift_hull/io/ground_truth_files.h"
+
 namespace sift_hull {
 namespace cli {
 

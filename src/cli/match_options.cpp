@@ -4,6 +4,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "sift_hull/filters/filter.h"
+
 namespace sift_hull {
 namespace cli {
 namespace {

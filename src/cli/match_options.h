@@ -1,7 +1,7 @@
 #pragma once
 
 #include "args.h"
-#include "sift_hull/filters.h"
+#include "sift_hull/filters/filter.h"
 
 namespace sift_hull {
 namespace cli {

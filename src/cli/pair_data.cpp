@@ -7,6 +7,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "sift_hull/eval/match_evaluation.h"
+
 namespace sift_hull {
 namespace cli {
 namespace {
@@ -35,15 +37,22 @@ std::optional<EvaluationPair> teddyPair(const std::string& data_root, const Matc
                                         std::string* why_not) {
   const std::string dir = dataSet(data_root, "middlebury_stereo2003_teddy", why_not);
   if (dir.empty()) return std::nullopt;
-  return EvaluationPair{"teddy", matchTeddy(dir, options.sift, options.matching)};
+  // Middlebury 2003 quarter size: im2 left, im6 right, disp2.pgm holds disparity * 4.
+  return EvaluationPair{"teddy", matchRectifiedPair(dir + "/im2.png", dir + "/im6.png",
+                                                    dir + "/disp2.pgm", 4.0, options.sift,
+                                                    options.matching)};
 }
 
 std::optional<EvaluationPair> grafPair(const std::string& data_root, int n,
                                        const MatchOptions& options, std::string* why_not) {
   const std::string dir = dataSet(data_root, "oxford_affine_graf", why_not);
   if (dir.empty()) return std::nullopt;
-  return EvaluationPair{"graf 1-" + std::to_string(n),
-                        matchGraf(dir, n, options.sift, options.matching)};
+  // Oxford's files: img1 .. img6, H1toNp maps img1 to imgN.
+  const std::string index = std::to_string(n);
+  return EvaluationPair{"graf 1-" + index,
+                        matchPlanarPair(dir + "/img1.png", dir + "/img" + index + ".png",
+                                        dir + "/H1to" + index + "p", options.sift,
+                                        options.matching)};
 }
 
 std::string todayUtc() {

@@ -5,7 +5,8 @@
 #include <vector>
 
 #include "match_options.h"
-#include "sift_hull/evaluation.h"
+#include "sift_hull/eval/match_evaluation.h"
+#include "sift_hull/features/labelled_matches.h"
 
 namespace sift_hull {
 namespace cli {

@@ -2,6 +2,8 @@
 
 #include <sstream>
 
+#include "sift_hull/hull/silhouette.h"
+
 namespace sift_hull {
 namespace cli {
 

@@ -1,7 +1,8 @@
 #pragma once
 
 #include "args.h"
-#include "sift_hull/dataset.h"
+#include "sift_hull/io/calibration.h"
+#include "sift_hull/hull/silhouette.h"
 
 namespace sift_hull {
 namespace cli {

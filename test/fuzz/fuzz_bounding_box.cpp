@@ -23,8 +23,8 @@
 #include <exception>
 #include <vector>
 
-#include "sift_hull/bounding_box.h"
-#include "sift_hull/camera.h"
+#include "sift_hull/hull/bounding_box.h"
+#include "sift_hull/geometry/camera.h"
 
 namespace {
 

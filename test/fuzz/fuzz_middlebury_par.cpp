@@ -1,7 +1,7 @@
 // libFuzzer harness: sift_hull::readMiddleburyPar (dataset.h) on arbitrary file contents. Any std::exception
 // is accepted; a crash, abort, sanitizer report, leak or time-out is a finding.
 #include "fuzz_input_file.h"
-#include "sift_hull/dataset.h"
+#include "sift_hull/io/calibration.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   sift_hull::fuzz::readAsFile("input_par.txt", data, size,

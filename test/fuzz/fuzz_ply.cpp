@@ -1,7 +1,8 @@
 // libFuzzer harness: sift_hull::readPly (mesh.h) on arbitrary file contents. Any std::exception
 // is accepted; a crash, abort, sanitizer report, leak or time-out is a finding.
 #include "fuzz_input_file.h"
-#include "sift_hull/mesh.h"
+#include "sift_hull/hull/mesh.h"
+#include "sift_hull/io/ply.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   sift_hull::fuzz::readAsFile("input.ply", data, size,

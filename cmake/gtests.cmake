@@ -1,0 +1,24 @@
+# The gtests of the ROS-free libraries (test/core), each with the one library it links: the layer
+# it tests, or sift_hull_eval where its ground truth is the synthetic renderer. Pairs of
+# <test name> <library without the sift_hull_ prefix>. Read by the package's CMakeLists.txt and by
+# the sanitizer build (test/sanitize), so that both build the same tests.
+set(SIFT_HULL_CORE_GTESTS
+  test_camera core
+  test_bounding_box core
+  test_gms core
+  test_mesh core
+  test_dataset io
+  test_ply io
+  test_features eval
+  test_filters eval
+  test_evaluation eval
+  test_scene eval
+  test_mesh_render eval
+  test_hull eval
+  test_hull_data eval
+  test_hull_stream eval
+  test_hardening eval
+)
+# The harnesses of test/fuzz whose corpus test_fuzz_corpus replays: CamelCase entry point names,
+# file test/fuzz/fuzz_<snake_case>.cpp.
+set(SIFT_HULL_FUZZ_HARNESSES MiddleburyPar ProjectionList Homography Pfm Ply BoundingBox)

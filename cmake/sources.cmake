@@ -1,0 +1,53 @@
+# The sources of the ROS-free libraries, relative to the package root, one list per layer:
+#   sift_hull_core   geometry, features, filters, hull: the method itself
+#   sift_hull_io     calibration files, images, PFM, PLY, view lists, ground-truth files
+#   sift_hull_eval   the synthetic renderer and the evaluation against ground truth
+# Included by the package's CMakeLists.txt and by test/sanitize/CMakeLists.txt, so that both build
+# the libraries from the same lists (docs/ARCHITECTURE.md).
+set(SIFT_HULL_CORE_SOURCES
+  src/core/geometry/camera.cpp
+  src/core/geometry/camera_set.cpp
+  src/core/geometry/correspondence.cpp
+  src/core/features/matching.cpp
+  src/core/features/sift.cpp
+  src/core/filters/epipolar.cpp
+  src/core/filters/filter.cpp
+  src/core/filters/gms.cpp
+  src/core/filters/gsc.cpp
+  src/core/filters/ratio.cpp
+  src/core/filters/robust_fit.cpp
+  src/core/hull/bounding_box.cpp
+  src/core/hull/distance_kernel.cpp
+  src/core/hull/hull_octomap.cpp
+  src/core/hull/hull_pipeline.cpp
+  src/core/hull/hull_stream.cpp
+  src/core/hull/hull_view.cpp
+  src/core/hull/marching_cubes.cpp
+  src/core/hull/mesh.cpp
+  src/core/hull/octree.cpp
+  src/core/hull/silhouette.cpp
+)
+set(SIFT_HULL_IO_SOURCES
+  src/core/io/calibration.cpp
+  src/core/io/ground_truth_files.cpp
+  src/core/io/images.cpp
+  src/core/io/pfm.cpp
+  src/core/io/ply.cpp
+  src/core/io/view_list.cpp
+)
+set(SIFT_HULL_EVAL_SOURCES
+  src/core/synthetic/scene.cpp
+  src/core/synthetic/shape.cpp
+  src/core/synthetic/synthetic_matches.cpp
+  src/core/synthetic/texture.cpp
+  src/core/eval/hull_evaluation.cpp
+  src/core/eval/match_drawing.cpp
+  src/core/eval/match_evaluation.cpp
+  src/core/eval/mesh_render.cpp
+)
+# No contraction into fused multiply-adds: the GSC kernel's sectors must not depend on which vector
+# width the CPU dispatch picks, and the scalar and AVX2 distance look-ups must round alike.
+set(SIFT_HULL_EXACT_FLOAT_SOURCES
+  src/core/filters/gsc.cpp
+  src/core/hull/distance_kernel.cpp
+)

@@ -1,0 +1,52 @@
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "sift_hull/hull/mesh.h"
+#include "sift_hull/hull/octree.h"
+
+namespace sift_hull {
+
+/// Intersection over union of two masks (non-zero inside) of one size; 1 when both are empty.
+double maskIoU(const cv::Mat& a, const cv::Mat& b);
+
+/// IoU of the mesh's projection (rasteriseMask) with each view's silhouette.
+struct ReprojectionIoU {
+  std::vector<double> per_view;
+  double min = 0.0, mean = 0.0;
+};
+ReprojectionIoU reprojectionIoU(const TriangleMesh& mesh, const std::vector<HullView>& views);
+
+/// Dense voxel carving, the brute-force reference: a voxel is occupied when every view keeps its
+/// centre (HullView::keeps).
+struct DenseGrid {
+  Eigen::Vector3d origin_W = Eigen::Vector3d::Zero();
+  double voxel_m = 1.0;
+  int cells = 0;                  ///< per axis
+  std::vector<uint8_t> occupied;  ///< x fastest, then y, then z
+
+  Eigen::Vector3d centre(int i, int j, int k) const {
+    return origin_W + (Eigen::Vector3d(i, j, k) + Eigen::Vector3d::Constant(0.5)) * voxel_m;
+  }
+  /// Position of voxel (i, j, k) in `occupied`.
+  size_t index(int i, int j, int k) const {
+    return (static_cast<size_t>(k) * cells + j) * cells + i;
+  }
+  size_t occupiedCount() const;
+  /// Bounds of the occupied voxels (whole voxels); an empty box at the origin when none is.
+  Box3d occupiedBounds() const;
+};
+DenseGrid denseCarving(const std::vector<HullView>& views, const Box3d& cube, int cells,
+                       int threads);
+
+/// Volume IoU of the hull with a dense grid, sampled at the grid's voxel centres. The hull holds a
+/// point when its leaf is in, or is a surface cell and f_iso <= 0 at the point (the surface the
+/// mesh follows), so that the octree's in and out decisions are what is compared.
+double volumeIoU(const VisualHull& hull, const DenseGrid& dense);
+
+/// Mean distance of the mesh's vertices to a sphere's surface.
+double meanDistanceToSphere(const TriangleMesh& mesh, const Eigen::Vector3d& centre_W,
+                            double radius_m);
+
+}  // namespace sift_hull

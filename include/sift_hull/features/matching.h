@@ -1,0 +1,55 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <limits>
+#include <opencv2/core.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "sift_hull/features/sift.h"
+
+namespace sift_hull {
+
+/// Euclidean nearest-neighbour matching of descriptors from the left image to the right one.
+struct MatchConfig {
+  /// Largest descriptor distance kept (SIFT descriptors have norm 512); raising it gives denser,
+  /// dirtier matches. Infinity keeps every nearest neighbour.
+  double max_descriptor_distance = std::numeric_limits<double>::infinity();
+  /// Lowe's ratio test: keep when nearest < ratio * second nearest. 1 (or more) turns it off.
+  double ratio = 0.8;
+  bool cross_check = false;             ///< keep only mutual nearest neighbours
+  std::string backend = "brute-force";  ///< "brute-force" (exact) or "flann" (kd-trees)
+};
+
+/// Throws std::invalid_argument naming the first bad field.
+void validate(const MatchConfig& config);
+
+/// Putative matches between two images: what every match filter takes.
+struct PutativeMatches {
+  std::vector<cv::KeyPoint> left_keypoints;
+  std::vector<cv::KeyPoint> right_keypoints;
+  std::vector<cv::DMatch> matches;  ///< queryIdx indexes left_keypoints, trainIdx right_keypoints
+  cv::Size left_image_size;
+  cv::Size right_image_size;
+  /// Fundamental matrix with x_r^T F x_l = 0, when the pair is calibrated.
+  std::optional<Eigen::Matrix3d> F_right_left;
+
+  const cv::KeyPoint& left(size_t match) const { return left_keypoints[matches[match].queryIdx]; }
+  const cv::KeyPoint& right(size_t match) const { return right_keypoints[matches[match].trainIdx]; }
+  /// False when either point of the match has a NaN or infinite coordinate.
+  bool hasFinitePositions(size_t match) const;
+};
+
+/// Nearest neighbours of each left descriptor among the right ones, filtered as `config` says.
+std::vector<cv::DMatch> matchDescriptors(const cv::Mat& left, const cv::Mat& right,
+                                         const MatchConfig& config);
+
+/// Detects, describes and matches: the putative matches of two images.
+PutativeMatches matchImages(const cv::Mat& left_image, const cv::Mat& right_image,
+                            const SiftConfig& sift, const MatchConfig& matching);
+
+/// Fundamental matrix of a rectified pair: epipolar lines are image rows (y_r = y_l).
+Eigen::Matrix3d rectifiedFundamentalMatrix();
+
+}  // namespace sift_hull

@@ -1,0 +1,45 @@
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "sift_hull/features/matching.h"
+#include "sift_hull/filters/epipolar.h"
+#include "sift_hull/filters/filter_result.h"
+#include "sift_hull/filters/gms.h"
+#include "sift_hull/filters/gsc.h"
+#include "sift_hull/filters/ratio.h"
+#include "sift_hull/filters/robust_fit.h"
+
+namespace sift_hull {
+
+/// Every filter's configuration, as a node or the CLI holds them.
+struct FilterConfigs {
+  EpipolarConfig epipolar;
+  GscConfig gsc;
+  RobustFitConfig ransac;
+  RobustFitConfig magsac;
+  GmsConfig gms;
+};
+
+/// Throws std::invalid_argument naming the first bad field.
+void validate(const FilterConfigs& configs);
+
+/// One way of telling correct putative matches from mismatches.
+class MatchFilter {
+ public:
+  virtual ~MatchFilter() = default;
+  virtual std::string name() const = 0;
+  /// Throws std::invalid_argument when the input lacks what the filter needs (calibration).
+  virtual FilterResult apply(const PutativeMatches& input) const = 0;
+};
+
+/// The names makeFilter knows: ratio, epipolar, gsc, ransac, magsac, gms.
+const std::vector<std::string>& filterNames();
+
+/// A filter by name; "a+b" composes filters, keeping what all keep (score: how many rejected the
+/// match). Throws std::invalid_argument for an unknown name.
+std::unique_ptr<MatchFilter> makeFilter(const std::string& spec, const FilterConfigs& configs);
+
+}  // namespace sift_hull

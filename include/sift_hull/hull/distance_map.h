@@ -1,0 +1,40 @@
+#pragma once
+
+#include <opencv2/core.hpp>
+
+#include "sift_hull/hull/bounding_box.h"
+
+namespace sift_hull {
+
+/// Signed distance transform of a silhouette in pixels: negative inside, positive outside, zero
+/// on the boundary between inside and outside pixel squares (OpenCV's exact Euclidean
+/// distanceTransform of the mask and of its complement). The image is padded with `padding_px`
+/// pixels; a padding pixel counts as inside when it lies within the silhouette's bounds, whose
+/// sides are open where the image border cuts the silhouette. So a view does not carve beyond a
+/// side of its image where the object may go on, exactly as the bounding-box LP assumes.
+///
+/// The map covers only the inside pixels' bounding box plus `padding_px` on every side (within
+/// the padded image): exact there. Look-ups elsewhere are clamped to the map, which gives a
+/// lower bound of the distance (the map is convex and holds every inside pixel): safe for
+/// carving, and positive, as those points are outside.
+class SignedDistanceMap {
+ public:
+  SignedDistanceMap() = default;
+  /// `mask`: CV_8UC1, non-zero inside; `bounds`: silhouetteBounds() of the mask. Throws
+  /// std::invalid_argument for another type or an empty mask.
+  SignedDistanceMap(const cv::Mat& mask, const SilhouetteBounds& bounds, int padding_px);
+
+  /// Bilinear look-up at pixel coordinates (pixel centres at integers), clamped to the map.
+  float at(double u_px, double v_px) const;
+  cv::Size imageSize() const { return image_size_; }
+  /// The map (CV_32FC1, continuous, at least 2x2) and the image pixel of its first element.
+  const cv::Mat& map() const { return distance_px_; }
+  cv::Point origin() const { return origin_; }
+
+ private:
+  cv::Mat distance_px_;  ///< CV_32FC1
+  cv::Size image_size_;
+  cv::Point origin_;  ///< image pixel of map element (0, 0)
+};
+
+}  // namespace sift_hull

@@ -1,0 +1,23 @@
+#pragma once
+
+namespace sift_hull {
+
+/// Octree carving settings.
+struct HullConfig {
+  /// Octree levels below the root cube; resolution = cube edge / 2^max_depth.
+  int max_depth = 8;
+  /// Whether a view carves what it sees outside its image. When false, a view keeps the points
+  /// seen beyond a side of its image where the border cuts its silhouette (the object may go on
+  /// there), and carves the rest; see SignedDistanceMap.
+  bool carve_outside_image = false;
+  /// Added to a cell's projected radius before comparing with the signed distance: covers the error
+  /// of the pixel-sampled, interpolated transform.
+  double distance_slack_px = 1.0;
+  int padding_px = 16;  ///< around each distance map (see SignedDistanceMap)
+  int threads = 2;      ///< for carving and for the mesh's field samples
+};
+
+/// Throws std::invalid_argument naming the first bad field.
+void validate(const HullConfig& config);
+
+}  // namespace sift_hull

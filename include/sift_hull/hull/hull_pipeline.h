@@ -1,0 +1,43 @@
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "sift_hull/hull/mesh.h"
+#include "sift_hull/geometry/camera.h"
+#include "sift_hull/hull/bounding_box.h"
+#include "sift_hull/hull/hull_view.h"
+#include "sift_hull/hull/octree.h"
+
+namespace sift_hull {
+
+/// Calibrated silhouettes, one entry per view in each vector.
+struct HullInput {
+  std::vector<std::string> names;
+  std::vector<PinholeCamera> cameras;
+  std::vector<cv::Mat> masks;  ///< CV_8UC1, non-zero inside
+};
+
+/// Wall-clock times of the stages of buildHull, in milliseconds.
+struct HullTimings {
+  double distance_ms = 0.0, bbox_ms = 0.0, octree_ms = 0.0, mesh_ms = 0.0, total_ms = 0.0;
+};
+
+struct HullResult {
+  Box3d box;  ///< from the LP, or the one given
+  VisualHull hull;
+  TriangleMesh mesh;
+  MeshCheck mesh_check;
+  HullTimings time;
+};
+
+/// Distance transforms, bounding box (the LP of eq. 8 unless `box` is given), octree carving and
+/// marching cubes. Throws HullBoxError when no box exists, std::invalid_argument for bad input.
+HullResult buildHull(const HullInput& input, const HullConfig& config,
+                     const std::optional<Box3d>& box = std::nullopt);
+
+/// The LP box of prepared views (hullBoundingBox of their cameras and bounds).
+Box3d boundingBoxOf(const std::vector<HullView>& views);
+
+}  // namespace sift_hull

@@ -1,0 +1,122 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include "sift_hull/hull/bounding_box.h"
+#include "sift_hull/hull/hull_config.h"
+#include "sift_hull/hull/hull_view.h"
+#include "sift_hull/hull/marching_cubes.h"
+#include "sift_hull/hull/mesh.h"
+
+namespace sift_hull {
+
+namespace detail {
+struct OctreeNode;
+}  // namespace detail
+
+/// The octree's root cube: the box's longest edge plus at least one voxel on every side, its
+/// corner on the voxel grid (integer multiples of the resolution), so that cells line up with an
+/// OctoMap of the same resolution.
+struct HullCube {
+  Eigen::Vector3i origin_voxels = Eigen::Vector3i::Zero();  ///< corner / resolution
+  double resolution_m = 1.0;                                ///< finest cell edge
+  int depth = 1;
+
+  static HullCube around(const Box3d& box, int depth);
+  Eigen::Vector3d origin_W() const { return origin_voxels.cast<double>() * resolution_m; }
+  double edge_m() const { return resolution_m * (1 << depth); }
+  Box3d box() const;
+};
+
+enum class CellState : uint8_t { kOut, kIn, kSurface };
+
+/// A leaf of the octree: the cell at `depth` with integer index `index` (in cells of that depth)
+/// spans cube.origin_W() + cell_edge * [index, index + 1].
+struct HullCell {
+  Eigen::Vector3i index = Eigen::Vector3i::Zero();
+  int depth = 0;
+  CellState state = CellState::kIn;
+  /// For in and surface cells: the maximum of D_i at the centre over the views the cell applied
+  /// (those its parent did not see all inside). It has the sign of f_iso (eq. 9) there, and its
+  /// value where that is >= 0.
+  float centre_value = 0.0f;
+};
+
+/// Leaf counts and memory of the octree.
+struct HullStats {
+  size_t in_leaves = 0, out_leaves = 0, surface_leaves = 0, nodes = 0;
+  size_t bytes = 0;                 ///< octree nodes only
+  double occupied_volume_m3 = 0.0;  ///< in cells plus finest surface cells with centre inside
+};
+
+/// The visual hull as an octree over a cube, classified with f_iso(v) = max_i D_i(P_i v) (eq. 9):
+/// a cell is out when one view sees all of it outside its silhouette, in when every view sees all
+/// of it inside, otherwise on the surface and split down to config.max_depth. Adding views refines
+/// the existing tree and gives exactly the tree that adding them all at once gives.
+class VisualHull {
+ public:
+  /// Throws std::invalid_argument for a bad config or an empty box.
+  VisualHull(const Box3d& box, const HullConfig& config);
+  ~VisualHull();
+  VisualHull(VisualHull&&) noexcept;
+  VisualHull& operator=(VisualHull&&) noexcept;
+  VisualHull(const VisualHull&) = delete;
+  VisualHull& operator=(const VisualHull&) = delete;
+
+  /// Carves with more views. Before any view the whole cube is one in cell. Throws
+  /// std::invalid_argument, before carving with any of them, when a view's camera is too far
+  /// from the cube for single precision (HullView::useFrame).
+  void addViews(std::vector<HullView> views);
+  void addView(HullView view);
+  /// Throws std::invalid_argument when the view cannot join this hull: its camera too far from
+  /// the cube for single precision (HullView::useFrame), or within a voxel of the cube's centre
+  /// (a box far too large for the cameras).
+  void checkView(const HullView& view) const;
+  /// Removes the view added last and carves again with the others: the tree the others give.
+  void dropLastView();
+  /// Whether nothing is occupied: no in cell and no surface cell whose centre is inside.
+  bool isEmpty() const;
+  /// Back to one in cell and no views.
+  void reset();
+
+  const HullCube& cube() const { return cube_; }
+  const HullConfig& config() const { return config_; }
+  const std::vector<HullView>& views() const { return views_; }
+
+  void forEachLeaf(const std::function<void(const HullCell&)>& visit) const;
+  HullStats stats() const;
+  /// The leaf holding a world point (a point outside the cube is out).
+  HullCell leafAt(const Eigen::Vector3d& X_W) const;
+  /// f_iso at a world point over all views (-kFarOutside_px without views).
+  float valueAt(const Eigen::Vector3d& X_W) const;
+  /// f_iso at many points, on config.threads threads.
+  void sampleField(const std::vector<Eigen::Vector3d>& points_W, std::vector<float>* values) const;
+
+  /// The finest surface cells, for marching cubes.
+  SurfaceCells surfaceCells() const;
+  /// Marching cubes on f_iso over the surface cells.
+  TriangleMesh mesh() const;
+
+ private:
+  HullCube cube_;
+  HullConfig config_;
+  /// The views' local frame (HullView::useFrame): the cube's centre, half its edge.
+  Eigen::Vector3d frame_origin_W_;
+  double frame_scale_;
+  std::vector<HullView> views_;
+  std::unique_ptr<detail::OctreeNode> root_;
+};
+
+/// Occupied cells for maps: in cells of any size and surface cells at the finest level, each as
+/// (min corner in voxels relative to the world origin, edge in voxels).
+struct VoxelBlock {
+  Eigen::Vector3i min_voxels;
+  int edge_voxels;
+};
+std::vector<VoxelBlock> occupiedBlocks(const VisualHull& hull);
+
+}  // namespace sift_hull

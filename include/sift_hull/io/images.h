@@ -1,0 +1,33 @@
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "sift_hull/hull/silhouette.h"
+#include "sift_hull/io/calibration.h"
+
+namespace sift_hull {
+
+/// Reads a colour image; throws std::runtime_error "PATH: image missing or unreadable".
+cv::Mat readImage(const std::string& path);
+
+/// Reads the image a view names, from `directory`. Throws std::runtime_error naming the image and
+/// the calibration line that names it when the view has no image name or the image is missing or
+/// cannot be decoded. Colour images come back as BGR, 8 bits per channel.
+cv::Mat loadViewImage(const std::string& directory, const CalibratedView& view);
+
+/// Reads a mask file: any non-zero pixel is inside. Returns CV_8UC1 with 255 inside.
+/// Throws std::runtime_error naming the file when it is missing or unreadable.
+cv::Mat loadMask(const std::string& path);
+
+/// Silhouettes of all views, in view order: the mask file of each view's name in `mask_directory`
+/// when that is not empty, else extracted from the view's image in `image_directory` by `recipe`.
+/// Throws std::runtime_error naming a missing or unreadable file, a mask whose size differs from
+/// its image's, or an image whose size differs from the first view's.
+std::vector<cv::Mat> loadSilhouettes(const std::vector<CalibratedView>& views,
+                                     const std::string& image_directory,
+                                     const std::string& mask_directory,
+                                     const SilhouetteConfig& recipe);
+
+}  // namespace sift_hull

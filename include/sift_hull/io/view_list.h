@@ -1,0 +1,21 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "sift_hull/hull/hull_pipeline.h"
+#include "sift_hull/hull/silhouette.h"
+
+namespace sift_hull {
+
+/// Image names listed in a file, one per line; blank lines and '#' comments skipped.
+std::vector<std::string> readViewList(const std::string& path);
+
+/// The views of a calibration file named in `view_names` (all when empty), in the file's order,
+/// with silhouettes as loadSilhouettes() finds them. Throws std::runtime_error for a name that the
+/// calibration does not hold.
+HullInput loadHullInput(const std::string& calibration_path, const std::string& image_directory,
+                        const std::string& mask_directory, const SilhouetteConfig& recipe,
+                        const std::vector<std::string>& view_names);
+
+}  // namespace sift_hull

@@ -1,0 +1,75 @@
+#pragma once
+
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "sift_hull/io/calibration.h"
+#include "sift_hull/hull/hull_pipeline.h"
+#include "sift_hull/synthetic/shape.h"
+
+namespace sift_hull {
+
+/// A synthetic scene: a textured shape at the world origin seen by cameras around it.
+struct SceneConfig {
+  int views = 16;
+  int width_px = 640;
+  int height_px = 480;
+  std::string shape = Shape::defaultName();
+  std::string layout = "ring";       ///< "ring" (one elevation) or "sphere" (spread over a sphere)
+  unsigned seed = 1;                 ///< texture and camera jitter
+  double camera_distance_m = 4.0;    ///< from the shape's bounding centre
+  double ring_elevation_deg = 25.0;  ///< above the horizontal plane, for the ring layout
+  double fill_fraction = 0.8;        ///< share of the smaller image side the bounding sphere spans
+};
+
+/// Throws std::invalid_argument naming the first bad field.
+void validate(const SceneConfig& config);
+
+/// One rendered view. Pixel (u, v) is the colour seen along the ray through its centre.
+struct RenderedView {
+  CalibratedView view;
+  cv::Mat image;  ///< CV_8UC3, BGR, black background
+  cv::Mat mask;   ///< CV_8UC1, 255 where the ray hits the object
+  cv::Mat depth;  ///< CV_32FC1, depth along the optical axis in metres, +inf on the background
+};
+
+/// The cameras of a scene, looking at the shape's bounding centre, named view_NNNN.png.
+std::vector<CalibratedView> sceneCameras(const SceneConfig& config, const Shape& shape);
+
+/// Ray-casts one view: solid procedural texture, Lambertian shading under a fixed world light.
+RenderedView renderView(const Shape& shape, const CalibratedView& view, cv::Size size,
+                        unsigned seed);
+
+std::vector<RenderedView> renderScene(const SceneConfig& config);
+
+/// One view of a scene (index into sceneCameras), rendered alone.
+RenderedView renderSceneView(const SceneConfig& config, size_t index);
+
+/// Sub-directories of a scene directory holding, under each view's name, its mask (PNG) and its
+/// depth map (the name with the extension .pfm).
+inline constexpr const char* kMaskDirectory = "masks";
+inline constexpr const char* kDepthDirectory = "depth";
+
+/// Writes into `directory` (created when missing) the images view_NNNN.png, masks/view_NNNN.png,
+/// depth/view_NNNN.pfm, scene_par.txt (Middlebury format) and scene.json (the config).
+void writeScene(const std::string& directory, const SceneConfig& config,
+                const std::vector<RenderedView>& views);
+
+/// What a scene directory holds, read back: cameras, depth maps and the config that made it.
+struct SceneData {
+  SceneConfig config;
+  std::vector<CalibratedView> views;
+  std::vector<cv::Mat> depths;  ///< CV_32FC1 per view, as in RenderedView
+};
+
+/// Throws ParseError / std::runtime_error naming the file at fault.
+SceneData readScene(const std::string& directory);
+
+/// "view_0003.png" -> "view_0003.pfm".
+std::string depthFileName(const std::string& view_name);
+
+/// The names, cameras and masks of rendered views.
+HullInput hullInputOf(const std::vector<RenderedView>& views);
+
+}  // namespace sift_hull

@@ -1,0 +1,99 @@
+// bag: calibrated views as a ROS bag that drives both nodes with `rosbag play`.
+
+#include <rosbag/bag.h>
+#include <tf2_msgs/TFMessage.h>
+
+#include <opencv2/imgcodecs.hpp>
+#include <sstream>
+
+#include "lib/bag_topics.h"
+#include "lib/conversions.h"
+#include "args.h"
+#include "commands.h"
+#include "hull_options.h"
+#include "sift_hull/hull/hull_pipeline.h"
+#include "sift_hull/io/images.h"
+
+namespace sift_hull {
+namespace cli {
+namespace {
+
+using bag_topics::kCameraFrame;
+
+struct BagView {
+  std::string name;
+  PinholeCamera camera;
+  cv::Mat image, mask;
+};
+
+std::vector<BagView> loadViews(const ArgParser& parser) {
+  const HullInput input = viewSetFromArgs(parser);
+  std::vector<BagView> views;
+  for (size_t v = 0; v < input.names.size(); ++v) {
+    views.push_back({input.names[v], input.cameras[v],
+                     readImage(parser.get("images") + "/" + input.names[v]), input.masks[v]});
+  }
+  return views;
+}
+
+/// View v at time `stamp`: tf first, so that its pose is known when its images arrive.
+void writeView(rosbag::Bag* bag, const std::vector<BagView>& views, size_t v,
+               const ros::Time& stamp, const std::string& world_frame) {
+  const BagView& view = views[v];
+  tf2_msgs::TFMessage tf;
+  tf.transforms.push_back(
+      ros_conversions::cameraPoseMessage(view.camera, world_frame, kCameraFrame, stamp));
+  bag->write("/tf", stamp, tf);
+  std_msgs::Header header;
+  header.stamp = stamp;
+  header.frame_id = kCameraFrame;
+  bag->write(bag_topics::kImage, stamp, ros_conversions::imageMessage(view.image, header));
+  bag->write(bag_topics::kSilhouette, stamp, ros_conversions::imageMessage(view.mask, header));
+  bag->write(bag_topics::kCameraInfo, stamp,
+             ros_conversions::cameraInfoMessage(view.camera, view.mask.size(), header));
+  // The stereo pair for the matcher: this view and the next one round the ring.
+  header.frame_id = "left";
+  bag->write(bag_topics::kLeftImage, stamp, ros_conversions::imageMessage(view.image, header));
+  header.frame_id = "right";
+  bag->write(bag_topics::kRightImage, stamp,
+             ros_conversions::imageMessage(views[(v + 1) % views.size()].image, header));
+}
+
+}  // namespace
+
+int runBag(const std::vector<std::string>& args) {
+  ArgParser parser("bag",
+                   "Writes calibrated views as a ROS bag for `rosbag play`: per view, tf\n"
+                   "(world -> camera), /camera/image, /camera/silhouette, /camera/camera_info,\n"
+                   "and the pair (view, next view) on /stereo/left/image and /stereo/right/image.");
+  addViewSetOptions(&parser);
+  parser.addOption("out", "BAG", "bag file to write");
+  parser.addOption("rate", "HZ", "views per second", "2");
+  parser.addOption("world-frame", "FRAME", "frame of the camera poses", "world");
+  parser.addFlag("json", "print the result as one JSON object");
+  if (!parser.parse(args)) return 0;
+  const double rate = parser.getDouble("rate");
+  // Stamps 1 us apart at the most stay distinct; 1000 s apart at the least keep a million views
+  // within ros::Time's range.
+  if (!(rate >= 1e-3 && rate <= 1e6)) {
+    throw UsageError("--rate must lie in [0.001, 1000000] views per second");
+  }
+
+  const std::vector<BagView> views = loadViews(parser);
+  rosbag::Bag bag(parser.get("out"), rosbag::bagmode::Write);
+  const ros::Time start(1.0);
+  for (size_t v = 0; v < views.size(); ++v) {
+    writeView(&bag, views, v, start + ros::Duration(v / rate), parser.get("world-frame"));
+  }
+  bag.close();
+  const nlohmann::json result = {{"out", parser.get("out")},
+                                 {"views", views.size()},
+                                 {"duration_s", (views.size() - 1) / rate}};
+  std::ostringstream text;
+  text << "wrote " << views.size() << " views to " << parser.get("out") << '\n';
+  printResult(parser.flag("json"), result, text.str());
+  return 0;
+}
+
+}  // namespace cli
+}  // namespace sift_hull

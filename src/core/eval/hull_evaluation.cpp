@@ -1,0 +1,112 @@
+#include "sift_hull/eval/hull_evaluation.h"
+#include "sift_hull/eval/mesh_render.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <opencv2/core.hpp>
+#include <stdexcept>
+#include <thread>
+
+#include "common/parallel.h"
+
+namespace sift_hull {
+namespace {
+
+void carveSlice(const std::vector<HullView>& views, int k, DenseGrid* grid) {
+  for (int j = 0; j < grid->cells; ++j) {
+    for (int i = 0; i < grid->cells; ++i) {
+      const Eigen::Vector3d centre = grid->centre(i, j, k);
+      const bool kept = std::all_of(views.begin(), views.end(),
+                                    [&](const HullView& view) { return view.keeps(centre); });
+      grid->occupied[grid->index(i, j, k)] = kept;
+    }
+  }
+}
+
+}  // namespace
+
+double maskIoU(const cv::Mat& a, const cv::Mat& b) {
+  if (a.size() != b.size()) throw std::invalid_argument("maskIoU: masks differ in size");
+  const int intersection = cv::countNonZero((a != 0) & (b != 0));
+  const int union_count = cv::countNonZero((a != 0) | (b != 0));
+  return union_count == 0 ? 1.0 : static_cast<double>(intersection) / union_count;
+}
+
+ReprojectionIoU reprojectionIoU(const TriangleMesh& mesh, const std::vector<HullView>& views) {
+  ReprojectionIoU result;
+  for (const HullView& view : views) {
+    result.per_view.push_back(
+        maskIoU(rasteriseMask(mesh, view.camera(), view.imageSize()), view.mask()));
+  }
+  if (result.per_view.empty()) return result;
+  result.min = *std::min_element(result.per_view.begin(), result.per_view.end());
+  double sum = 0.0;
+  for (double iou : result.per_view) sum += iou;
+  result.mean = sum / result.per_view.size();
+  return result;
+}
+
+size_t DenseGrid::occupiedCount() const {
+  return static_cast<size_t>(std::count(occupied.begin(), occupied.end(), uint8_t{1}));
+}
+
+Box3d DenseGrid::occupiedBounds() const {
+  Eigen::Vector3i low = Eigen::Vector3i::Constant(cells), high = Eigen::Vector3i::Constant(-1);
+  for (int k = 0; k < cells; ++k) {
+    for (int j = 0; j < cells; ++j) {
+      for (int i = 0; i < cells; ++i) {
+        if (!occupied[index(i, j, k)]) continue;
+        low = low.cwiseMin(Eigen::Vector3i(i, j, k));
+        high = high.cwiseMax(Eigen::Vector3i(i, j, k));
+      }
+    }
+  }
+  Box3d box;
+  if (high.x() < 0) return box;
+  box.min_W = origin_W + low.cast<double>() * voxel_m;
+  box.max_W = origin_W + (high + Eigen::Vector3i::Ones()).cast<double>() * voxel_m;
+  return box;
+}
+
+DenseGrid denseCarving(const std::vector<HullView>& views, const Box3d& cube, int cells,
+                       int threads) {
+  DenseGrid grid;
+  grid.origin_W = cube.min_W;
+  grid.voxel_m = cube.size().maxCoeff() / cells;
+  grid.cells = cells;
+  grid.occupied.assign(static_cast<size_t>(cells) * cells * cells, 0);
+  detail::parallelFor(static_cast<size_t>(cells), threads,
+                      [&](size_t k) { carveSlice(views, static_cast<int>(k), &grid); });
+  return grid;
+}
+
+double volumeIoU(const VisualHull& hull, const DenseGrid& dense) {
+  size_t both = 0, either = 0;
+  for (int k = 0; k < dense.cells; ++k) {
+    for (int j = 0; j < dense.cells; ++j) {
+      for (int i = 0; i < dense.cells; ++i) {
+        const Eigen::Vector3d centre = dense.centre(i, j, k);
+        const CellState state = hull.leafAt(centre).state;
+        const bool in_hull = state == CellState::kIn ||
+                             (state == CellState::kSurface && hull.valueAt(centre) <= 0.0f);
+        const bool in_dense = dense.occupied[dense.index(i, j, k)];
+        both += in_hull && in_dense;
+        either += in_hull || in_dense;
+      }
+    }
+  }
+  return either == 0 ? 1.0 : static_cast<double>(both) / either;
+}
+
+double meanDistanceToSphere(const TriangleMesh& mesh, const Eigen::Vector3d& centre_W,
+                            double radius_m) {
+  if (mesh.vertices_W.empty()) return 0.0;
+  double sum = 0.0;
+  for (const Eigen::Vector3f& vertex : mesh.vertices_W) {
+    sum += std::abs((vertex.cast<double>() - centre_W).norm() - radius_m);
+  }
+  return sum / mesh.vertices_W.size();
+}
+
+}  // namespace sift_hull

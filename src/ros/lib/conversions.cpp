@@ -1,0 +1,292 @@
+#include "lib/conversions.h"
+
+#include <cv_bridge/cv_bridge.h>
+#include <octomap/OcTree.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+#include <pcl_conversions/pcl_conversions.h>
+#include <sensor_msgs/image_encodings.h>
+#include <tf2_eigen/tf2_eigen.h>
+
+#include <cmath>
+#include <map>
+#include <sstream>
+
+#include "sift_hull/limits.h"
+#include "sift_hull/hull/mesh.h"
+
+namespace sift_hull {
+namespace ros_conversions {
+
+bool holdsPixels(const sensor_msgs::Image& image, size_t bytes_per_pixel, std::string* why_not) {
+  const std::string size = std::to_string(image.width) + "x" + std::to_string(image.height);
+  if (image.width == 0 || image.height == 0) {
+    *why_not = "the image is empty (" + size + ")";
+    return false;
+  }
+  if (image.width > limits::kMaxImageSidePx || image.height > limits::kMaxImageSidePx) {
+    *why_not = "the image is " + size + ", wider or higher than " +
+               std::to_string(limits::kMaxImageSidePx) + " pixels";
+    return false;
+  }
+  // Every factor is below 2^32, so no product of two wraps in size_t.
+  const size_t pixels = static_cast<size_t>(image.width) * static_cast<size_t>(image.height);
+  if (pixels > limits::kMaxDecodedImagePixels) {
+    *why_not = "the image is " + size + ", more than " +
+               std::to_string(limits::kMaxDecodedImagePixels) + " pixels";
+    return false;
+  }
+  const size_t row_bytes = static_cast<size_t>(image.width) * bytes_per_pixel;
+  const size_t needed = static_cast<size_t>(image.step) * static_cast<size_t>(image.height);
+  if (image.step < row_bytes || image.data.size() < needed) {
+    *why_not = "the image data (" + std::to_string(image.data.size()) + " bytes, step " +
+               std::to_string(image.step) + ") does not hold " + size + " pixels of " +
+               std::to_string(bytes_per_pixel) + " bytes";
+    return false;
+  }
+  return true;
+}
+
+bool withinPixelLimit(const sensor_msgs::Image& image, size_t max_pixels, std::string* why_not) {
+  const size_t pixels = static_cast<size_t>(image.width) * static_cast<size_t>(image.height);
+  if (pixels <= max_pixels) return true;
+  *why_not = "the image is " + std::to_string(image.width) + "x" + std::to_string(image.height) +
+             " = " + std::to_string(pixels) + " pixels, more than max_image_pixels (" +
+             std::to_string(max_pixels) + ")";
+  return false;
+}
+
+cv::Mat maskFromImage(const sensor_msgs::Image& image, std::string* why_not) {
+  if (image.encoding != "mono8") {
+    *why_not = "silhouette encoding is '" + image.encoding + "', expected mono8";
+    return {};
+  }
+  if (!holdsPixels(image, 1, why_not)) {
+    *why_not = "silhouette: " + *why_not;
+    return {};
+  }
+  const cv::Mat view(image.height, image.width, CV_8UC1, const_cast<uint8_t*>(image.data.data()),
+                     image.step);
+  return view.clone();
+}
+
+cv::Mat eightBitImage(const sensor_msgs::ImageConstPtr& image, std::string* why_not) {
+  namespace enc = sensor_msgs::image_encodings;
+  if (!enc::isColor(image->encoding) && !enc::isMono(image->encoding)) {
+    *why_not = "encoding '" + image->encoding + "' is neither colour nor mono";
+    return {};
+  }
+  if (enc::bitDepth(image->encoding) != 8) {
+    *why_not = "encoding '" + image->encoding + "' is not 8 bits per channel";
+    return {};
+  }
+  if (!holdsPixels(*image, static_cast<size_t>(enc::numChannels(image->encoding)), why_not)) {
+    return {};
+  }
+  try {
+    return cv_bridge::toCvShare(image, enc::isMono(image->encoding) ? "mono8" : "bgr8")->image;
+  } catch (const cv_bridge::Exception& e) {
+    *why_not = e.what();
+    return {};
+  }
+}
+
+namespace {
+
+bool intrinsicsFromInfo(const sensor_msgs::CameraInfo& info, Eigen::Matrix3d* K,
+                        std::string* why_not) {
+  for (int i = 0; i < 9; ++i) (*K)(i / 3, i % 3) = info.K[i];
+  if (!K->allFinite()) {
+    *why_not = "camera_info K holds a value that is not finite";
+    return false;
+  }
+  if ((*K)(2, 2) == 0.0) {
+    *why_not = K->isZero() ? "camera_info K is all zero (an uncalibrated camera?)"
+                           : "camera_info K[8] is 0";
+    return false;
+  }
+  *K /= (*K)(2, 2);
+  if ((*K)(1, 0) != 0.0 || (*K)(2, 0) != 0.0 || (*K)(2, 1) != 0.0 || !((*K)(0, 0) > 0.0) ||
+      !((*K)(1, 1) > 0.0)) {
+    *why_not = "camera_info K is not upper triangular with positive focal lengths";
+    return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+bool cameraFromInfo(const sensor_msgs::CameraInfo& info, const Eigen::Isometry3d& T_W_C,
+                    cv::Size image_size, PinholeCamera* camera, std::string* why_not) {
+  Eigen::Matrix3d K;
+  if (!intrinsicsFromInfo(info, &K, why_not)) return false;
+  if (image_size.area() > 0 && (static_cast<int>(info.width) != image_size.width ||
+                                static_cast<int>(info.height) != image_size.height)) {
+    std::ostringstream message;
+    message << "camera_info is " << info.width << "x" << info.height << " but the silhouette is "
+            << image_size.width << "x" << image_size.height;
+    *why_not = message.str();
+    return false;
+  }
+  if (!T_W_C.matrix().allFinite()) {
+    *why_not = "camera pose is not finite";
+    return false;
+  }
+  const Eigen::Isometry3d T_C_W = T_W_C.inverse();
+  try {
+    *camera = PinholeCamera(K, T_C_W.linear(), T_C_W.translation());
+  } catch (const std::invalid_argument& e) {
+    *why_not = std::string("camera: ") + e.what();
+    return false;
+  }
+  return true;
+}
+
+sensor_msgs::Image imageMessage(const cv::Mat& image, const std_msgs::Header& header) {
+  if (image.type() != CV_8UC1 && image.type() != CV_8UC3) {
+    throw std::invalid_argument("imageMessage: expected an 8-bit grey or BGR image");
+  }
+  sensor_msgs::Image message;
+  message.header = header;
+  message.width = image.cols;
+  message.height = image.rows;
+  message.encoding = image.channels() == 1 ? "mono8" : "bgr8";
+  message.step = static_cast<uint32_t>(image.cols * image.elemSize());
+  message.data.resize(static_cast<size_t>(message.step) * image.rows);
+  for (int row = 0; row < image.rows; ++row) {
+    std::copy(image.ptr<uint8_t>(row), image.ptr<uint8_t>(row) + message.step,
+              message.data.begin() + static_cast<size_t>(row) * message.step);
+  }
+  return message;
+}
+
+sensor_msgs::CameraInfo cameraInfoMessage(const PinholeCamera& camera, cv::Size size,
+                                          const std_msgs::Header& header) {
+  sensor_msgs::CameraInfo info;
+  info.header = header;
+  info.width = size.width;
+  info.height = size.height;
+  info.distortion_model = "plumb_bob";
+  info.D.assign(5, 0.0);
+  for (int i = 0; i < 9; ++i) {
+    info.K[i] = camera.K()(i / 3, i % 3);
+    info.R[i] = i % 4 == 0 ? 1.0 : 0.0;
+    info.P[i / 3 * 4 + i % 3] = camera.K()(i / 3, i % 3);
+  }
+  return info;
+}
+
+geometry_msgs::TransformStamped cameraPoseMessage(const PinholeCamera& camera,
+                                                  const std::string& world_frame,
+                                                  const std::string& camera_frame,
+                                                  const ros::Time& stamp) {
+  Eigen::Isometry3d T_W_C = Eigen::Isometry3d::Identity();
+  T_W_C.linear() = camera.R().transpose();
+  T_W_C.translation() = camera.centre();
+  geometry_msgs::TransformStamped pose = tf2::eigenToTransform(T_W_C);
+  pose.header.stamp = stamp;
+  pose.header.frame_id = world_frame;
+  pose.child_frame_id = camera_frame;
+  return pose;
+}
+
+sift_hull::Octomap octomapMessage(const octomap::OcTree& tree, const std_msgs::Header& header) {
+  sift_hull::Octomap message;
+  message.header = header;
+  message.binary = true;
+  message.id = tree.getTreeType();
+  message.resolution = tree.getResolution();
+  std::stringstream stream;
+  tree.writeBinaryData(stream);
+  const std::string bytes = stream.str();
+  message.data.assign(bytes.begin(), bytes.end());
+  return message;
+}
+
+sensor_msgs::PointCloud2 pointCloudMessage(const std::vector<Eigen::Vector3d>& points,
+                                           const std_msgs::Header& header) {
+  pcl::PointCloud<pcl::PointXYZ> cloud;
+  for (const Eigen::Vector3d& point : points) {
+    cloud.push_back(pcl::PointXYZ(point.x(), point.y(), point.z()));
+  }
+  sensor_msgs::PointCloud2 message;
+  pcl::toROSMsg(cloud, message);
+  message.header = header;
+  return message;
+}
+
+sensor_msgs::PointCloud2 occupiedCellsCloud(const octomap::OcTree& tree,
+                                            const std_msgs::Header& header) {
+  std::vector<Eigen::Vector3d> centres;
+  for (auto leaf = tree.begin_leafs(); leaf != tree.end_leafs(); ++leaf) {
+    if (tree.isNodeOccupied(*leaf)) centres.emplace_back(leaf.getX(), leaf.getY(), leaf.getZ());
+  }
+  return pointCloudMessage(centres, header);
+}
+
+namespace {
+
+std_msgs::ColorRGBA heightColour(double fraction) {
+  std_msgs::ColorRGBA colour;
+  colour.r = static_cast<float>(std::clamp(1.5 - std::abs(4.0 * fraction - 3.0), 0.0, 1.0));
+  colour.g = static_cast<float>(std::clamp(1.5 - std::abs(4.0 * fraction - 2.0), 0.0, 1.0));
+  colour.b = static_cast<float>(std::clamp(1.5 - std::abs(4.0 * fraction - 1.0), 0.0, 1.0));
+  colour.a = 1.0f;
+  return colour;
+}
+
+}  // namespace
+
+visualization_msgs::MarkerArray occupiedCellsMarkers(const octomap::OcTree& tree,
+                                                     const std_msgs::Header& header) {
+  double min_x, min_y, min_z, max_x, max_y, max_z;
+  tree.getMetricMin(min_x, min_y, min_z);
+  tree.getMetricMax(max_x, max_y, max_z);
+  const double height = std::max(max_z - min_z, 1e-9);
+  std::map<unsigned, visualization_msgs::Marker> by_depth;
+  for (auto leaf = tree.begin_leafs(); leaf != tree.end_leafs(); ++leaf) {
+    if (!tree.isNodeOccupied(*leaf)) continue;
+    visualization_msgs::Marker& marker = by_depth[leaf.getDepth()];
+    geometry_msgs::Point centre;
+    centre.x = leaf.getX(), centre.y = leaf.getY(), centre.z = leaf.getZ();
+    marker.points.push_back(centre);
+    marker.colors.push_back(heightColour((centre.z - min_z) / height));
+    marker.scale.x = marker.scale.y = marker.scale.z = leaf.getSize();
+  }
+  visualization_msgs::MarkerArray array;
+  for (auto& [depth, marker] : by_depth) {
+    marker.header = header;
+    marker.ns = "occupied_cells";
+    marker.id = static_cast<int>(depth);
+    marker.type = visualization_msgs::Marker::CUBE_LIST;
+    marker.action = visualization_msgs::Marker::ADD;
+    marker.pose.orientation.w = 1.0;
+    array.markers.push_back(marker);
+  }
+  return array;
+}
+
+visualization_msgs::Marker meshMarker(const TriangleMesh& mesh, const std_msgs::Header& header) {
+  visualization_msgs::Marker marker;
+  marker.header = header;
+  marker.ns = "hull_mesh";
+  marker.type = visualization_msgs::Marker::TRIANGLE_LIST;
+  marker.action = visualization_msgs::Marker::ADD;
+  marker.pose.orientation.w = 1.0;
+  marker.scale.x = marker.scale.y = marker.scale.z = 1.0;
+  marker.color.r = marker.color.g = marker.color.b = 0.8f;
+  marker.color.a = 1.0f;
+  marker.points.reserve(3 * mesh.faces.size());
+  for (const Eigen::Vector3i& face : mesh.faces) {
+    for (int corner = 0; corner < 3; ++corner) {
+      const Eigen::Vector3f& vertex = mesh.vertices_W[face[corner]];
+      geometry_msgs::Point point;
+      point.x = vertex.x(), point.y = vertex.y(), point.z = vertex.z();
+      marker.points.push_back(point);
+    }
+  }
+  return marker;
+}
+
+}  // namespace ros_conversions
+}  // namespace sift_hull

@@ -1,0 +1,90 @@
+#pragma once
+
+// Every conversion between sift_hull's core types and ROS messages.
+
+#include <geometry_msgs/TransformStamped.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <visualization_msgs/Marker.h>
+#include <visualization_msgs/MarkerArray.h>
+
+#include <Eigen/Geometry>
+#include <opencv2/core.hpp>
+#include <string>
+
+#include "sift_hull/Octomap.h"
+#include "sift_hull/geometry/camera.h"
+#include "sift_hull/hull/mesh.h"
+
+namespace octomap {
+class OcTree;
+}
+
+namespace sift_hull {
+namespace ros_conversions {
+
+/// Whether the message's data holds its width x height pixels of `bytes_per_pixel` bytes, all
+/// sizes in size_t before any pointer arithmetic: false, with `why_not`, for an empty image, a
+/// side over limits::kMaxImageSidePx, more than limits::kMaxDecodedImagePixels pixels, a step
+/// shorter than a row, or data shorter than
+/// step x height (a height x step that would wrap in 32 bits is caught).
+bool holdsPixels(const sensor_msgs::Image& image, size_t bytes_per_pixel, std::string* why_not);
+
+/// Whether the image has at most `max_pixels` pixels (SiftConfig::max_image_pixels); false, with
+/// `why_not`, otherwise. Reads only the header fields.
+bool withinPixelLimit(const sensor_msgs::Image& image, size_t max_pixels, std::string* why_not);
+
+/// A silhouette message as a CV_8UC1 mask sharing nothing with the message. Accepts mono8 only
+/// (non-zero inside); returns an empty Mat and sets `why_not` for another encoding or pixels the
+/// data does not hold (holdsPixels).
+cv::Mat maskFromImage(const sensor_msgs::Image& image, std::string* why_not);
+
+/// An 8-bit colour or mono image as BGR or grey, sharing the message's pixels (keep the message
+/// while the Mat is in use). Returns an empty Mat and sets `why_not` for another encoding or
+/// pixels the data does not hold (holdsPixels).
+cv::Mat eightBitImage(const sensor_msgs::ImageConstPtr& image, std::string* why_not);
+
+/// The camera of a view: K from `info` (pixels) and the pose T_W_C (the camera frame in the world
+/// frame, as tf gives it). Returns false and sets `why_not` for a K that is zero, not finite or not
+/// upper triangular with K(2,2) = 1 (after scaling), a pose that is not finite, or an image size
+/// that disagrees with `image_size` (when non-zero).
+bool cameraFromInfo(const sensor_msgs::CameraInfo& info, const Eigen::Isometry3d& T_W_C,
+                    cv::Size image_size, PinholeCamera* camera, std::string* why_not);
+
+/// An 8-bit image as a message: CV_8UC1 as mono8, CV_8UC3 as bgr8. Throws std::invalid_argument
+/// for another type.
+sensor_msgs::Image imageMessage(const cv::Mat& image, const std_msgs::Header& header);
+
+/// camera_info of a pinhole camera of the given image size: K, P = K [I | 0], R = I, no
+/// distortion (plumb_bob with zero coefficients).
+sensor_msgs::CameraInfo cameraInfoMessage(const PinholeCamera& camera, cv::Size size,
+                                          const std_msgs::Header& header);
+
+/// The camera's pose T_W_C: the transform from `world_frame` to `camera_frame` that tf needs.
+geometry_msgs::TransformStamped cameraPoseMessage(const PinholeCamera& camera,
+                                                  const std::string& world_frame,
+                                                  const std::string& camera_frame,
+                                                  const ros::Time& stamp);
+
+/// The tree as an Octomap message (binary stream, as octomap_msgs::binaryMapToMsg writes it).
+sift_hull::Octomap octomapMessage(const octomap::OcTree& tree, const std_msgs::Header& header);
+
+/// Points (metres, in the header's frame) as an XYZ PointCloud2 (via pcl_conversions).
+sensor_msgs::PointCloud2 pointCloudMessage(const std::vector<Eigen::Vector3d>& points,
+                                           const std_msgs::Header& header);
+
+/// Occupied leaf centres of the tree, metres, as an XYZ PointCloud2 (via pcl_conversions).
+sensor_msgs::PointCloud2 occupiedCellsCloud(const octomap::OcTree& tree,
+                                            const std_msgs::Header& header);
+
+/// Occupied leaves as CUBE_LIST markers, one per leaf size (octomap_server's
+/// occupied_cells_vis_array), coloured by height.
+visualization_msgs::MarkerArray occupiedCellsMarkers(const octomap::OcTree& tree,
+                                                     const std_msgs::Header& header);
+
+/// The mesh as a TRIANGLE_LIST marker in the header's frame, metres.
+visualization_msgs::Marker meshMarker(const TriangleMesh& mesh, const std_msgs::Header& header);
+
+}  // namespace ros_conversions
+}  // namespace sift_hull

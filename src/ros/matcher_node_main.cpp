@@ -1,6 +1,0 @@
-#include "matcher_node.h"
-#include "node_main.h"
-
-int main(int argc, char** argv) {
-  return sift_hull::runNode<sift_hull::MatcherNode>(argc, argv, "matcher_node");
-}

@@ -1,0 +1,127 @@
+#pragma once
+
+#include <message_filters/subscriber.h>
+#include <message_filters/time_synchronizer.h>
+#include <octomap/OcTree.h>
+#include <ros/ros.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+#include <std_srvs/Empty.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/message_filter.h>
+#include <tf2_ros/transform_listener.h>
+
+#include <atomic>
+#include <memory>
+#include <mutex>
+#include <string>
+
+#include "lib/node_diagnostics.h"
+#include "lib/pose_gate.h"
+#include "lib/pose_waits.h"
+#include "sift_hull/Save.h"
+#include "sift_hull/io/calibration.h"
+#include "sift_hull/hull/hull_stream.h"
+#include "sift_hull/hull/mesh.h"
+#include "sift_hull/hull/silhouette.h"
+#include "lib/throttled_log.h"
+#include "lib/work_queue.h"
+
+namespace sift_hull {
+
+/// Node settings besides the hull's own (HullStreamConfig).
+struct HullNodeConfig {
+  std::string world_frame = "world";
+  /// Silhouettes waiting for their camera_info or their pose; when more wait, the oldest is
+  /// dropped with an error (a pose that never arrives). Also the views waiting to be carved:
+  /// when more come, the oldest is dropped and counted in /diagnostics.
+  int queue_size = 10;
+  /// A silhouette whose pose is not in tf this long after it arrived is reported and, should the
+  /// pose come later still, not carved. <= 0: wait as long as the queue allows.
+  double pose_timeout_s = 5.0;
+  /// Subscribe `image` (8-bit colour or mono) instead of `silhouette`, and extract each
+  /// silhouette by `recipe` (the Middlebury threshold, dilation and erosion).
+  bool from_image = false;
+  SilhouetteConfig recipe;
+};
+
+/// The hull node: silhouettes (mono8) with their camera_info, once tf knows the camera's pose in
+/// the world frame, refine a visual hull; the results are published latched after every view.
+class HullNode {
+ public:
+  /// Reads the private parameters (ros_params.h) and subscribes.
+  HullNode(ros::NodeHandle nh, ros::NodeHandle private_nh);
+  /// With config structs, no parameter server needed.
+  HullNode(ros::NodeHandle nh, ros::NodeHandle private_nh, HullNodeConfig node_config,
+           HullStreamConfig hull_config);
+
+ private:
+  using Sync = message_filters::TimeSynchronizer<sensor_msgs::Image, sensor_msgs::CameraInfo>;
+  /// A checked view waiting to be carved.
+  struct View {
+    std::string name;
+    PinholeCamera camera;
+    cv::Mat mask;
+    ros::Time stamp;
+    uint64_t generation = 0;  ///< of ~reset, so that views from before one are not carved
+  };
+
+  void onView(const sensor_msgs::ImageConstPtr& silhouette,
+              const sensor_msgs::CameraInfoConstPtr& info);
+  /// The view's mask: the silhouette message, or the one extracted from the image.
+  cv::Mat maskOf(const sensor_msgs::ImageConstPtr& message, std::string* why_not) const;
+  bool cameraOf(const sensor_msgs::Image& silhouette, const sensor_msgs::CameraInfo& info,
+                PinholeCamera* camera);
+  void integrate(View& view);
+  /// Whether the view changed the hull.
+  bool carve(const View& view);
+  void publish(const ros::Time& stamp);
+  /// Markers and mesh for a new subscriber (they are built only while someone looks).
+  void publishMarkersNow();
+  void publishMeshNow();
+  void publishEmpty();
+  /// The published hull's mesh (marching cubes once per hull, shared by `mesh`, new subscribers
+  /// and ~save). Requires octree_.
+  const TriangleMesh& publishedMesh();
+  void reportDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& status);
+  void onPoseMissing(const sensor_msgs::ImageConstPtr& silhouette,
+                     tf2_ros::filter_failure_reasons::FilterFailureReason reason);
+  void onArrival(const sensor_msgs::ImageConstPtr& silhouette);
+  void onPoseTooLate(const sensor_msgs::ImageConstPtr& silhouette);
+  void reportPoseTimeouts();
+  void subscribe();
+  bool reset(std_srvs::Empty::Request& request, std_srvs::Empty::Response& response);
+  bool save(sift_hull::Save::Request& request, sift_hull::Save::Response& response);
+
+  // Destroyed bottom up: subscriptions and services first, then the worker, then what it uses.
+  ros::NodeHandle nh_, private_nh_;
+  HullNodeConfig config_;
+  /// Guards stream_, octree_, mesh_, header_ and generation_ (the worker, ~reset, ~save, new
+  /// subscribers).
+  std::mutex hull_mutex_;
+  HullStream stream_;
+  std::unique_ptr<octomap::OcTree> octree_;  ///< the hull as last published
+  std::unique_ptr<TriangleMesh> mesh_;       ///< its mesh, made when first asked for
+  std_msgs::Header header_;                  ///< of the last publication
+  std::atomic<uint64_t> generation_{0};
+  ThrottledLog log_;
+  ros::Publisher octomap_pub_, cloud_pub_, markers_pub_, mesh_pub_;
+  std::atomic<double> last_carve_ms_{0.0}, last_publish_ms_{0.0}, last_view_stamp_{0.0};
+  std::atomic<size_t> redundant_views_{0};
+  std::atomic<size_t> refused_views_{0};
+  WorkQueue<View> work_;
+  NodeDiagnostics diagnostics_;
+  PoseWaits pose_waits_;
+  ros::WallTimer pose_timer_;
+  tf2_ros::Buffer tf_buffer_;
+  tf2_ros::TransformListener tf_listener_;
+  // Subscribed last, once every callback is in place.
+  message_filters::Subscriber<sensor_msgs::Image> silhouette_sub_;
+  message_filters::Subscriber<sensor_msgs::CameraInfo> info_sub_;
+  tf2_ros::MessageFilter<sensor_msgs::Image> pose_filter_;
+  PoseGate pose_gate_;
+  Sync sync_;
+  ros::ServiceServer reset_srv_, save_srv_;
+};
+
+}  // namespace sift_hull

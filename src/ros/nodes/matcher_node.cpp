@@ -1,0 +1,329 @@
+#include "nodes/matcher_node.h"
+
+#include <cv_bridge/cv_bridge.h>
+#include <tf2_eigen/tf2_eigen.h>
+
+#include <algorithm>
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "lib/conversions.h"
+#include "lib/node_diagnostics.h"
+#include "lib/ros_params.h"
+#include "sift_hull/eval/match_drawing.h"
+#include "sift_hull/filters/filter.h"
+#include "sift_hull/filters/filter_result.h"
+#include "lib/wall_wait.h"
+
+namespace sift_hull {
+namespace {
+
+std::vector<std::unique_ptr<MatchFilter>> makeFilters(const MatcherSettings& settings) {
+  std::vector<std::unique_ptr<MatchFilter>> filters;
+  for (const std::string& spec : settings.node.filters) {
+    if (spec.find("epipolar") != std::string::npos && !settings.node.calibrated) {
+      throw std::invalid_argument("filter '" + spec +
+                                  "': the epipolar filter needs ~calibrated: true (camera_info "
+                                  "of both images and tf between their frames)");
+    }
+    filters.push_back(makeFilter(spec, settings.filters));
+  }
+  if (filters.empty()) throw std::invalid_argument("~filters names no filter");
+  if (settings.node.frame_to_frame && settings.node.calibrated) {
+    throw std::invalid_argument("~frame_to_frame and ~calibrated do not go together yet");
+  }
+  return filters;
+}
+
+std::string settingsJson(const MatcherSettings& settings) {
+  const FilterConfigs& f = settings.filters;
+  const nlohmann::json json = {
+      {"ratio", settings.matching.ratio},
+      {"max_descriptor_distance", std::isfinite(settings.matching.max_descriptor_distance)
+                                      ? nlohmann::json(settings.matching.max_descriptor_distance)
+                                      : nlohmann::json(nullptr)},
+      {"cross_check", settings.matching.cross_check},
+      {"gsc_max_histogram_distance", f.gsc.max_histogram_distance},
+      {"ransac_max_epipolar_px", f.ransac.max_epipolar_px},
+      {"magsac_max_epipolar_px", f.magsac.max_epipolar_px},
+      {"gms_threshold_factor", f.gms.threshold_factor}};
+  return json.dump();
+}
+
+sift_hull::Keypoint keypointMessage(const cv::KeyPoint& keypoint) {
+  sift_hull::Keypoint message;
+  message.x = keypoint.pt.x;
+  message.y = keypoint.pt.y;
+  message.size = keypoint.size;
+  message.angle = keypoint.angle;
+  message.response = keypoint.response;
+  message.octave = keypoint.octave;
+  return message;
+}
+
+}  // namespace
+
+MatcherNode::MatcherNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
+    : MatcherNode(nh, private_nh, ros_params::readMatcherSettings(private_nh)) {}
+
+MatcherNode::MatcherNode(ros::NodeHandle nh, ros::NodeHandle private_nh, MatcherSettings settings)
+    : nh_(nh),
+      private_nh_(private_nh),
+      settings_(std::move(settings)),
+      pipeline_(std::make_shared<const Pipeline>(
+          Pipeline{settings_, makeFilters(settings_), settingsJson(settings_)})),
+      transport_(nh_),
+      correspondences_pub_(
+          nh_.advertise<sift_hull::Correspondences>("correspondences", settings_.node.queue_size)),
+      matches_image_pub_(transport_.advertise("matches_image", 1)),
+      tf_listener_(tf_buffer_),
+      work_(settings_.node.max_waiting_pairs, settings_.node.workers,
+            [this](Pair& pair) { matchPair(pair); }),
+      diagnostics_(nh_, private_nh_, "matcher",
+                   [this](diagnostic_updater::DiagnosticStatusWrapper& status) {
+                     reportDiagnostics(status);
+                   }) {
+  if (settings_.node.calibrated) points_pub_ = nh_.advertise<sensor_msgs::PointCloud2>("points", 1);
+  serveReconfigure();
+  subscribe();
+}
+
+std::shared_ptr<const MatcherNode::Pipeline> MatcherNode::pipeline() const {
+  std::lock_guard<std::mutex> lock(pipeline_mutex_);
+  return pipeline_;
+}
+
+void MatcherNode::reportDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  reportQueue(work_.counts(), "pairs", &status);
+  status.add("last pair ms", last_pair_ms_.load());
+}
+
+void MatcherNode::serveReconfigure() {
+  sift_hull::MatcherConfig config;
+  config.ratio = settings_.matching.ratio;
+  config.max_descriptor_distance =
+      ros_params::descriptorDistanceParam(settings_.matching.max_descriptor_distance);
+  config.cross_check = settings_.matching.cross_check;
+  config.gsc_max_histogram_distance = settings_.filters.gsc.max_histogram_distance;
+  config.ransac_max_epipolar_px = settings_.filters.ransac.max_epipolar_px;
+  config.magsac_max_epipolar_px = settings_.filters.magsac.max_epipolar_px;
+  config.max_epipolar_px = settings_.filters.epipolar.max_epipolar_px;
+  config.gms_threshold_factor = settings_.filters.gms.threshold_factor;
+  reconfigure_ = std::make_unique<dynamic_reconfigure::Server<sift_hull::MatcherConfig>>(
+      reconfigure_mutex_, private_nh_);
+  reconfigure_->updateConfig(config);
+  reconfigure_->setCallback(
+      [this](sift_hull::MatcherConfig& changed, uint32_t level) { onReconfigure(changed, level); });
+}
+
+void MatcherNode::onReconfigure(sift_hull::MatcherConfig& config, uint32_t) {
+  MatcherSettings changed = pipeline()->settings;
+  changed.matching.ratio = config.ratio;
+  changed.matching.max_descriptor_distance =
+      ros_params::descriptorDistanceFromParam(config.max_descriptor_distance);
+  changed.matching.cross_check = config.cross_check;
+  changed.filters.gsc.max_histogram_distance = config.gsc_max_histogram_distance;
+  changed.filters.ransac.max_epipolar_px = config.ransac_max_epipolar_px;
+  changed.filters.magsac.max_epipolar_px = config.magsac_max_epipolar_px;
+  changed.filters.epipolar.max_epipolar_px = config.max_epipolar_px;
+  changed.filters.gms.threshold_factor = config.gms_threshold_factor;
+  std::shared_ptr<const Pipeline> replacement;
+  try {
+    validate(changed.matching);
+    validate(changed.filters);
+    replacement = std::make_shared<const Pipeline>(
+        Pipeline{changed, makeFilters(changed), settingsJson(changed)});
+  } catch (const std::invalid_argument& e) {
+    log_.error("matcher: reconfiguration refused: ", e.what());
+    return;
+  }
+  std::lock_guard<std::mutex> lock(pipeline_mutex_);
+  pipeline_ = std::move(replacement);
+}
+
+std::unique_ptr<ImageInput> MatcherNode::imageInput(const std::string& topic) {
+  return std::make_unique<ImageInput>(transport_, nh_, private_nh_, topic,
+                                      settings_.node.queue_size, settings_.node.image_transport);
+}
+
+void MatcherNode::subscribe() {
+  const int queue = settings_.node.queue_size;
+  if (settings_.node.frame_to_frame) {
+    frame_sub_ = imageInput("image");
+    frame_sub_->registerCallback(&MatcherNode::onFrame, this);
+    return;
+  }
+  left_sub_ = imageInput("left/image");
+  right_sub_ = imageInput("right/image");
+  if (settings_.node.calibrated) {
+    left_info_sub_.subscribe(nh_, "left/camera_info", queue);
+    right_info_sub_.subscribe(nh_, "right/camera_info", queue);
+    calibrated_sync_ = std::make_unique<CalibratedSync>(
+        message_filters::sync_policies::ExactTime<Image, Image, Info, Info>(queue), *left_sub_,
+        *right_sub_, left_info_sub_, right_info_sub_);
+    calibrated_sync_->registerCallback(&MatcherNode::onCalibratedPair, this);
+  } else if (settings_.node.approximate_sync) {
+    approximate_sync_ = std::make_unique<ApproximateSync>(
+        message_filters::sync_policies::ApproximateTime<Image, Image>(queue), *left_sub_,
+        *right_sub_);
+    approximate_sync_->registerCallback(&MatcherNode::onPair, this);
+  } else {
+    exact_sync_ = std::make_unique<ExactSync>(
+        message_filters::sync_policies::ExactTime<Image, Image>(queue), *left_sub_, *right_sub_);
+    exact_sync_->registerCallback(&MatcherNode::onPair, this);
+  }
+}
+
+void MatcherNode::onCalibratedPair(const sensor_msgs::ImageConstPtr& left,
+                                   const sensor_msgs::ImageConstPtr& right,
+                                   const sensor_msgs::CameraInfoConstPtr& left_info,
+                                   const sensor_msgs::CameraInfoConstPtr& right_info) {
+  enqueue({left, right, left_info, right_info});
+}
+
+bool MatcherNode::stereoCameras(const Image& left, const Image& right, const Info& left_info,
+                                const Info& right_info, StereoCameras* cameras) {
+  Eigen::Isometry3d T_L_R;
+  try {
+    waitForTransform(left.header.frame_id, right.header.frame_id, left.header.stamp);
+    T_L_R = tf2::transformToEigen(
+        tf_buffer_.lookupTransform(left.header.frame_id, right.header.frame_id, left.header.stamp));
+  } catch (const tf2::TransformException& e) {
+    log_.error("matcher: pair ignored: ", e.what());
+    return false;
+  }
+  std::string why_not;
+  const bool ok =
+      ros_conversions::cameraFromInfo(left_info, Eigen::Isometry3d::Identity(),
+                                      cv::Size(left.width, left.height), &cameras->left,
+                                      &why_not) &&
+      ros_conversions::cameraFromInfo(right_info, T_L_R, cv::Size(right.width, right.height),
+                                      &cameras->right, &why_not);
+  if (!ok) {
+    log_.error("matcher: pair ignored: ", why_not);
+  }
+  return ok;
+}
+
+void MatcherNode::onFrame(const sensor_msgs::ImageConstPtr& frame) {
+  if (previous_frame_ && frame->header.stamp <= previous_frame_->header.stamp) {
+    log_.error("matcher: frame ignored: ", "its stamp is not after the previous frame's");
+    return;
+  }
+  if (previous_frame_) enqueue({previous_frame_, frame, nullptr, nullptr});
+  previous_frame_ = frame;
+}
+
+void MatcherNode::onPair(const sensor_msgs::ImageConstPtr& left,
+                         const sensor_msgs::ImageConstPtr& right) {
+  enqueue({left, right, nullptr, nullptr});
+}
+
+void MatcherNode::enqueue(Pair pair) {
+  // Checked on arrival, from the headers alone, so that oversized images never reach a worker.
+  const size_t max_pixels = pipeline()->settings.sift.max_image_pixels;
+  std::string why_not;
+  if (!ros_conversions::withinPixelLimit(*pair.left, max_pixels, &why_not) ||
+      !ros_conversions::withinPixelLimit(*pair.right, max_pixels, &why_not)) {
+    log_.error("matcher: pair ignored: ", why_not);
+    return;
+  }
+  pushCounted(&work_, std::move(pair), "matcher: pairs waiting for a worker (~max_waiting_pairs)");
+}
+
+/// Up to 0.5 s of wall time for tf to catch up: tf2's own timeout sleeps in ROS time, which never
+/// passes once a bag's clock has stopped.
+void MatcherNode::waitForTransform(const std::string& target, const std::string& source,
+                                   const ros::Time& stamp) const {
+  waitOnWallClock([&] { return tf_buffer_.canTransform(target, source, stamp); }, 0.5, 0.01);
+}
+
+void MatcherNode::matchPair(Pair& pair) {
+  const ros::WallTime start = ros::WallTime::now();
+  try {
+    StereoCameras cameras;
+    const bool calibrated = pair.left_info && pair.right_info;
+    if (calibrated &&
+        !stereoCameras(*pair.left, *pair.right, *pair.left_info, *pair.right_info, &cameras)) {
+      return;
+    }
+    process(*pipeline(), pair.left, pair.right, calibrated ? &cameras : nullptr);
+  } catch (const std::exception& e) {
+    log_.error("matcher: pair failed: ", e.what());
+  }
+  last_pair_ms_ = (ros::WallTime::now() - start).toSec() * 1e3;
+}
+
+void MatcherNode::process(const Pipeline& pipeline, const sensor_msgs::ImageConstPtr& left,
+                          const sensor_msgs::ImageConstPtr& right, const StereoCameras* cameras) {
+  std::string why_not;
+  const cv::Mat left_image = ros_conversions::eightBitImage(left, &why_not);
+  const cv::Mat right_image =
+      left_image.empty() ? cv::Mat() : ros_conversions::eightBitImage(right, &why_not);
+  if (left_image.empty() || right_image.empty()) {
+    log_.error("matcher: pair ignored: ", why_not);
+    return;
+  }
+  PutativeMatches matches =
+      matchImages(left_image, right_image, pipeline.settings.sift, pipeline.settings.matching);
+  if (matches.left_keypoints.size() < 2 || matches.right_keypoints.size() < 2) {
+    log_.error("matcher: pair ignored: ", "fewer than two keypoints in an image (" +
+                                              std::to_string(matches.left_keypoints.size()) +
+                                              " and " +
+                                              std::to_string(matches.right_keypoints.size()) + ")");
+    return;
+  }
+  if (cameras != nullptr) matches.F_right_left = fundamentalMatrix(cameras->left, cameras->right);
+  std::vector<FilterResult> results;
+  for (const auto& filter : pipeline.filters) results.push_back(filter->apply(matches));
+  correspondences_pub_.publish(message(pipeline, *left, *right, matches, results));
+  if (cameras != nullptr) publishPoints(left->header, *cameras, matches, results.front());
+  if (matches_image_pub_.getNumSubscribers() > 0) {
+    const cv::Mat drawing = drawMatchDecisions(left_image, right_image, matches, results.front());
+    matches_image_pub_.publish(cv_bridge::CvImage(left->header, "bgr8", drawing).toImageMsg());
+  }
+}
+
+void MatcherNode::publishPoints(const std_msgs::Header& header, const StereoCameras& cameras,
+                                const PutativeMatches& matches, const FilterResult& kept) {
+  std::vector<Eigen::Vector3d> points_L;
+  for (size_t m = 0; m < matches.matches.size(); ++m) {
+    if (!kept.keep[m]) continue;
+    const cv::Point2f& left = matches.left(m).pt;
+    const cv::Point2f& right = matches.right(m).pt;
+    const std::optional<Eigen::Vector3d> point =
+        triangulate(cameras.left, cameras.right, Eigen::Vector2d(left.x, left.y),
+                    Eigen::Vector2d(right.x, right.y));
+    if (point) points_L.push_back(*point);
+  }
+  points_pub_.publish(ros_conversions::pointCloudMessage(points_L, header));
+}
+
+sift_hull::Correspondences MatcherNode::message(const Pipeline& pipeline,
+                                                const sensor_msgs::Image& left,
+                                                const sensor_msgs::Image& right,
+                                                const PutativeMatches& matches,
+                                                const std::vector<FilterResult>& results) {
+  sift_hull::Correspondences out;
+  out.header = left.header;
+  out.right_header = right.header;
+  for (const auto& filter : pipeline.filters) out.filters.push_back(filter->name());
+  out.filter_settings = pipeline.settings_json;
+  const auto gsc = std::find(out.filters.begin(), out.filters.end(), "gsc");
+  const FilterResult* gsc_result =
+      gsc == out.filters.end() ? nullptr : &results[gsc - out.filters.begin()];
+  for (size_t m = 0; m < matches.matches.size(); ++m) {
+    sift_hull::Correspondence correspondence;
+    correspondence.left = keypointMessage(matches.left(m));
+    correspondence.right = keypointMessage(matches.right(m));
+    correspondence.descriptor_distance = matches.matches[m].distance;
+    correspondence.gsc_score = gsc_result ? gsc_result->score[m] : std::nanf("");
+    for (size_t f = 0; f < results.size(); ++f) {
+      if (results[f].keep[m]) correspondence.kept_by |= 1u << f;
+    }
+    out.matches.push_back(correspondence);
+  }
+  return out;
+}
+
+}  // namespace sift_hull

@@ -1,0 +1,161 @@
+#pragma once
+
+#include <diagnostic_updater/diagnostic_updater.h>
+#include <dynamic_reconfigure/server.h>
+#include <image_transport/image_transport.h>
+#include <message_filters/subscriber.h>
+#include <message_filters/sync_policies/approximate_time.h>
+#include <message_filters/sync_policies/exact_time.h>
+#include <message_filters/synchronizer.h>
+#include <ros/ros.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_listener.h>
+
+#include <atomic>
+#include <boost/thread/recursive_mutex.hpp>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "lib/image_input.h"
+#include "lib/node_diagnostics.h"
+#include "sift_hull/Correspondences.h"
+#include "sift_hull/MatcherConfig.h"
+#include "sift_hull/geometry/camera.h"
+#include "sift_hull/features/sift.h"
+#include "sift_hull/filters/filter.h"
+#include "sift_hull/features/matching.h"
+#include "sift_hull/filters/filter_result.h"
+#include "lib/throttled_log.h"
+#include "lib/work_queue.h"
+
+namespace sift_hull {
+
+/// Node settings besides the matching's own (SiftConfig, MatchConfig, FilterConfigs).
+struct MatcherNodeConfig {
+  /// Filters to run, by makeFilter name ("gsc", "magsac", "epipolar+gsc", ...). The epipolar
+  /// filter needs `calibrated`.
+  std::vector<std::string> filters = {"gsc"};
+  int queue_size = 10;  ///< images waiting for their partner
+  /// Paired images waiting for a worker; when more come, the oldest pair is dropped (counted in
+  /// /diagnostics), so a stream faster than matching costs neither memory nor latency.
+  int max_waiting_pairs = 2;
+  /// Threads matching pairs side by side; with more than one, correspondences of pairs close in
+  /// time may be published out of stamp order.
+  int workers = 2;
+  bool approximate_sync = false;  ///< pair images by nearest stamps instead of equal ones
+  /// Also take left/camera_info and right/camera_info (paired by equal stamps with the images)
+  /// and the right camera's pose relative to the left from tf: the epipolar filter's F, and the
+  /// `points` of the matches the first filter keeps.
+  bool calibrated = false;
+  /// Subscribe one `image` topic instead, and match each frame with the one before it (the
+  /// earlier frame is the left image). Not with `calibrated`.
+  bool frame_to_frame = false;
+  /// How the images arrive: "raw", "compressed" (decoded here when no plugin provides it), or
+  /// another installed image_transport plugin.
+  std::string image_transport = "raw";
+};
+
+/// Everything the matcher node is configured with.
+struct MatcherSettings {
+  MatcherNodeConfig node;
+  SiftConfig sift;
+  MatchConfig matching;
+  FilterConfigs filters;
+};
+
+/// The matcher node: a left and a right image, paired by stamp, give SIFT matches and the
+/// verdicts of each filter on them (`correspondences`), and, when someone subscribes, a drawing of
+/// the first filter's verdicts (`matches_image`).
+class MatcherNode {
+ public:
+  /// Reads the private parameters (ros_params.h) and subscribes.
+  MatcherNode(ros::NodeHandle nh, ros::NodeHandle private_nh);
+  /// With config structs, no parameter server needed. Throws std::invalid_argument for a filter
+  /// name makeFilter does not know, or one this node cannot run.
+  MatcherNode(ros::NodeHandle nh, ros::NodeHandle private_nh, MatcherSettings settings);
+
+ private:
+  using Image = sensor_msgs::Image;
+  using ExactSync =
+      message_filters::Synchronizer<message_filters::sync_policies::ExactTime<Image, Image>>;
+  using ApproximateSync =
+      message_filters::Synchronizer<message_filters::sync_policies::ApproximateTime<Image, Image>>;
+  using Info = sensor_msgs::CameraInfo;
+  using CalibratedSync = message_filters::Synchronizer<
+      message_filters::sync_policies::ExactTime<Image, Image, Info, Info>>;
+
+  /// The pair's cameras, the left one at the origin of its own frame.
+  struct StereoCameras {
+    PinholeCamera left, right;
+  };
+  /// What pairs are matched with. dynamic_reconfigure replaces it whole, so a pair is matched
+  /// with one consistent set of settings even while they change.
+  struct Pipeline {
+    MatcherSettings settings;
+    std::vector<std::unique_ptr<MatchFilter>> filters;
+    std::string settings_json;
+  };
+  /// A pair waiting for a worker; the camera_infos only with ~calibrated.
+  struct Pair {
+    sensor_msgs::ImageConstPtr left, right;
+    sensor_msgs::CameraInfoConstPtr left_info, right_info;
+  };
+
+  void subscribe();
+  std::unique_ptr<ImageInput> imageInput(const std::string& topic);
+  /// Serves the run-time thresholds (cfg/Matcher.cfg), starting from the node's own settings.
+  void serveReconfigure();
+  void onReconfigure(sift_hull::MatcherConfig& config, uint32_t level);
+  void onPair(const sensor_msgs::ImageConstPtr& left, const sensor_msgs::ImageConstPtr& right);
+  void onFrame(const sensor_msgs::ImageConstPtr& frame);
+  void onCalibratedPair(const sensor_msgs::ImageConstPtr& left,
+                        const sensor_msgs::ImageConstPtr& right,
+                        const sensor_msgs::CameraInfoConstPtr& left_info,
+                        const sensor_msgs::CameraInfoConstPtr& right_info);
+  void enqueue(Pair pair);
+  void waitForTransform(const std::string& target, const std::string& source,
+                        const ros::Time& stamp) const;
+  void matchPair(Pair& pair);
+  void process(const Pipeline& pipeline, const sensor_msgs::ImageConstPtr& left,
+               const sensor_msgs::ImageConstPtr& right, const StereoCameras* cameras);
+  std::shared_ptr<const Pipeline> pipeline() const;
+  void reportDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& status);
+  bool stereoCameras(const Image& left, const Image& right, const Info& left_info,
+                     const Info& right_info, StereoCameras* cameras);
+  void publishPoints(const std_msgs::Header& header, const StereoCameras& cameras,
+                     const PutativeMatches& matches, const FilterResult& kept);
+  static sift_hull::Correspondences message(const Pipeline& pipeline,
+                                            const sensor_msgs::Image& left,
+                                            const sensor_msgs::Image& right,
+                                            const PutativeMatches& matches,
+                                            const std::vector<FilterResult>& results);
+
+  // Destroyed bottom up: subscriptions first, then the workers, then what they publish with.
+  ros::NodeHandle nh_, private_nh_;
+  const MatcherSettings settings_;  ///< as started; the reconfigurable part lives in pipeline_
+  mutable std::mutex pipeline_mutex_;
+  std::shared_ptr<const Pipeline> pipeline_;
+  ThrottledLog log_;
+  image_transport::ImageTransport transport_;
+  ros::Publisher correspondences_pub_, points_pub_;
+  image_transport::Publisher matches_image_pub_;
+  tf2_ros::Buffer tf_buffer_;
+  tf2_ros::TransformListener tf_listener_;
+  std::atomic<double> last_pair_ms_{0.0};
+  WorkQueue<Pair> work_;
+  NodeDiagnostics diagnostics_;
+  boost::recursive_mutex reconfigure_mutex_;  // the server's, so updateConfig cannot race it
+  std::unique_ptr<dynamic_reconfigure::Server<sift_hull::MatcherConfig>> reconfigure_;
+  std::unique_ptr<ImageInput> left_sub_, right_sub_, frame_sub_;
+  sensor_msgs::ImageConstPtr previous_frame_;
+  std::unique_ptr<ExactSync> exact_sync_;
+  std::unique_ptr<ApproximateSync> approximate_sync_;
+  message_filters::Subscriber<Info> left_info_sub_, right_info_sub_;
+  std::unique_ptr<CalibratedSync> calibrated_sync_;
+};
+
+}  // namespace sift_hull

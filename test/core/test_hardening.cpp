@@ -1,0 +1,490 @@
+// Hostile input to the core and the command-line program: every case of docs/RELIABILITY.md that
+// needs no ROS ends in a clear error (or a documented refusal) instead of a crash, a hang, an
+// exhausted memory or a silently wrong result. The inputs of ../shared/repro are rebuilt here from
+// the renderer, so these tests run without that directory; where it is present, its files are
+// run as well.
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <atomic>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <stdexcept>
+#include <thread>
+
+#include "hull/distance_kernel.h"
+#include "common/parallel.h"
+#include "sift_hull/hull/bounding_box.h"
+#include "sift_hull/io/calibration.h"
+#include "sift_hull/io/pfm.h"
+#include "sift_hull/eval/match_evaluation.h"
+#include "sift_hull/features/sift.h"
+#include "sift_hull/filters/filter.h"
+#include "sift_hull/hull/hull_pipeline.h"
+#include "sift_hull/hull/hull_stream.h"
+#include "sift_hull/limits.h"
+#include "sift_hull/synthetic/scene.h"
+#include "sift_hull/hull/hull_config.h"
+#include "sift_hull/hull/hull_view.h"
+#include "sift_hull/hull/octree.h"
+#include "sift_hull/hull/silhouette.h"
+#include "sift_hull/io/ground_truth_files.h"
+#include "common/test_data.h"
+
+namespace sift_hull {
+namespace {
+
+using test::ring;
+using test::streamConfig;
+
+void writeText(const std::string& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+}
+
+bool contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+/// A leaf-by-leaf summary of a hull: equal summaries of the same cube mean equal trees.
+struct HullSummary {
+  HullStats stats;
+  size_t views;
+  bool operator==(const HullSummary& o) const {
+    return stats.in_leaves == o.stats.in_leaves && stats.out_leaves == o.stats.out_leaves &&
+           stats.surface_leaves == o.stats.surface_leaves &&
+           stats.occupied_volume_m3 == o.stats.occupied_volume_m3 && views == o.views;
+  }
+};
+HullSummary summary(const VisualHull& hull) { return {hull.stats(), hull.views().size()}; }
+
+TEST(LookUp, NonFiniteCoordinatesStayInsideTheMap) {
+  const float map[] = {1, 2, 3, 4};  // 2x2
+  const float high = detail::lookUpLimit(2);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+  EXPECT_EQ(detail::lookUp(map, 2, high, high, nan, nan), 1.0f);
+  EXPECT_EQ(detail::lookUp(map, 2, high, high, -inf, nan), 1.0f);
+  EXPECT_NEAR(detail::lookUp(map, 2, high, high, inf, inf), 4.0f, 0.01f);
+}
+
+TEST(ParallelFor, AnExceptionInAWorkerReachesTheCaller) {
+  EXPECT_THROW(detail::parallelFor(1000, 4,
+                                   [&](size_t i) {
+                                     if (i == 10) throw std::bad_alloc();
+                                   }),
+               std::bad_alloc);
+  // On the caller's thread alone the order is fixed: the hand-out stops at the exception.
+  int calls = 0;
+  EXPECT_THROW(detail::parallelFor(1000, 1,
+                                   [&](size_t i) {
+                                     ++calls;
+                                     if (i == 10) throw std::runtime_error("stop");
+                                   }),
+               std::runtime_error);
+  EXPECT_EQ(calls, 11);
+}
+
+TEST(Limits, SettingsBeyondALimitAreRefusedNamingIt) {
+  HullConfig hull;
+  hull.max_depth = limits::kMaxHullDepth + 1;
+  EXPECT_THROW(validate(hull), std::invalid_argument);
+  hull.max_depth = 8;
+  hull.threads = 100000;
+  try {
+    validate(hull);
+    FAIL() << "threads 100000 accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_TRUE(contains(e.what(), "threads")) << e.what();
+  }
+  FilterConfigs filters;
+  filters.gms.grid_cells = 46341;  // its square overflowed int
+  EXPECT_THROW(validate(filters), std::invalid_argument);
+  SilhouetteConfig recipe;
+  recipe.dilate_px = 100000;
+  EXPECT_THROW(validate(recipe), std::invalid_argument);
+  SiftConfig sift;
+  sift.max_image_pixels = 1000;
+  EXPECT_THROW(detectSift(cv::Mat(100, 100, CV_8UC1, cv::Scalar(0)), sift), std::invalid_argument);
+}
+
+TEST(Readers, APfmHeaderCannotAskForMoreThanTheFileHolds) {
+  const std::string dir = test::temporaryDirectory();
+  writeText(dir + "/big.pfm", "Pf\n32768 32768\n-1\n");  // 18 bytes announcing 4 GiB
+  try {
+    readPfm(dir + "/big.pfm");
+    FAIL() << "accepted";
+  } catch (const std::exception& e) {
+    EXPECT_TRUE(contains(e.what(), "announces")) << e.what();
+  }
+  writeText(dir + "/nan.pfm", "Pf\n1 1\nnan\n....");
+  EXPECT_THROW(readPfm(dir + "/nan.pfm"), std::exception);
+}
+
+TEST(Readers, NumbersWithTrailingBytesAreRefused) {
+  const std::string dir = test::temporaryDirectory();
+  writeText(dir + "/H", std::string("1 0 0\n0 1 0\n0 0 1.5\0garbage\n", 28));
+  EXPECT_THROW(readHomography(dir + "/H"), std::exception);
+  writeText(dir + "/H10", "1 0 0 0 1 0 0 0 1 1\n");
+  EXPECT_THROW(readHomography(dir + "/H10"), std::exception);
+  const std::vector<CalibratedView> views = {
+      {"a.png",
+       PinholeCamera(Eigen::Matrix3d::Identity(), Eigen::Matrix3d::Identity(),
+                     Eigen::Vector3d(0, 0, 1)),
+       ""}};
+  writeMiddleburyPar(dir + "/good.txt", views);
+  std::ifstream in(dir + "/good.txt");
+  std::string text((std::istreambuf_iterator<char>(in)), {});
+  const size_t last_digit = text.find_last_of("0123456789");
+  text.insert(last_digit + 1, std::string("\0garbage", 8));
+  writeText(dir + "/nul.txt", text);
+  try {
+    readMiddleburyPar(dir + "/nul.txt");
+    FAIL() << "a NUL byte inside a number was accepted";
+  } catch (const std::exception& e) {
+    EXPECT_TRUE(contains(e.what(), "NUL")) << e.what();
+  }
+}
+
+TEST(BoundingBox, HugeTranslationsEndInAnErrorNotAnAbort) {
+  HullInput input = ring(8);
+  std::vector<SilhouetteBounds> bounds;
+  for (const cv::Mat& mask : input.masks) bounds.push_back(silhouetteBounds(mask, false));
+  for (double t : {1e307, 1e39, 1e20}) {
+    std::vector<PinholeCamera> cameras = input.cameras;
+    cameras[3] = PinholeCamera(cameras[3].K(), cameras[3].R(), Eigen::Vector3d(0, 0, t));
+    try {
+      const Box3d box = hullBoundingBox(cameras, bounds);
+      // A box may come out (the far view's cone is nearly a ray); carving must then refuse it.
+      VisualHull hull(box, HullConfig());
+      EXPECT_THROW(hull.addViews(makeHullViews(input.names, cameras, input.masks, HullConfig())),
+                   std::invalid_argument)
+          << "t = " << t;
+    } catch (const std::exception& e) {
+      SUCCEED() << e.what();
+    }
+  }
+}
+
+TEST(BoundingBox, ASolveOnAThreadThatEndsLeavesNoGlpkMemory) {
+  // The hull node solves on a worker thread. GLPK keeps an environment per thread; under
+  // LeakSanitizer (scripts/sanitize.sh) whatever it keeps after the thread ends is a failure.
+  const HullInput input = ring(8);
+  std::vector<SilhouetteBounds> bounds;
+  for (const cv::Mat& mask : input.masks) bounds.push_back(silhouetteBounds(mask, false));
+  Box3d box;
+  std::thread worker([&] { box = hullBoundingBox(input.cameras, bounds); });
+  worker.join();
+  EXPECT_TRUE((box.size().array() > 0.0).all());
+}
+
+TEST(BoundingBox, DegenerateBoundsEndInAnError) {
+  HullInput input = ring(4);
+  std::vector<SilhouetteBounds> bounds;
+  for (const cv::Mat& mask : input.masks) {
+    SilhouetteBounds b = silhouetteBounds(mask, false);
+    b.u_max_px = b.u_min_px;  // zero width
+    b.v_max_px = b.v_min_px;
+    bounds.push_back(b);
+  }
+  EXPECT_THROW(hullBoundingBox(input.cameras, bounds), HullBoxError);
+  bounds[0].u_max_px = bounds[0].u_min_px - 1.0;  // not ordered
+  EXPECT_THROW(hullBoundingBox(input.cameras, bounds), std::invalid_argument);
+}
+
+TEST(VisualHull, BoxesTheCamerasCannotResolveAreRefused) {
+  const HullInput input = ring(8);
+  HullConfig config;
+  config.max_depth = 6;
+  for (double half_edge : {1e39, 1e6}) {  // a voxel wider than the cameras' distance
+    Box3d box;
+    box.min_W = Eigen::Vector3d::Constant(-half_edge);
+    box.max_W = Eigen::Vector3d::Constant(half_edge);
+    VisualHull hull(box, config);
+    EXPECT_THROW(hull.addViews(makeHullViews(input.names, input.cameras, input.masks, config)),
+                 std::invalid_argument)
+        << half_edge;
+    EXPECT_EQ(hull.views().size(), 0u);  // nothing carved
+  }
+  Box3d tiny;  // cameras a million box sizes away and more
+  tiny.min_W = Eigen::Vector3d::Zero();
+  tiny.max_W = Eigen::Vector3d::Constant(1e-300);
+  VisualHull hull(tiny, config);
+  EXPECT_THROW(hull.addViews(makeHullViews(input.names, input.cameras, input.masks, config)),
+               std::invalid_argument);
+}
+
+TEST(VisualHull, ABoxBeyondIntVoxelIndicesIsRefused) {
+  Box3d earth_centred;  // a 1 m box 6400 km from the origin at depth 10: 6e9 voxels out
+  earth_centred.min_W = Eigen::Vector3d(6.4e6, 0, 0);
+  earth_centred.max_W = Eigen::Vector3d(6.4e6 + 1, 1, 1);
+  HullConfig config;
+  config.max_depth = 10;
+  EXPECT_THROW(VisualHull(earth_centred, config), std::invalid_argument);
+  HullStreamConfig stream;
+  stream.box = earth_centred;
+  stream.hull = config;
+  EXPECT_THROW(validate(stream), std::invalid_argument);
+}
+
+TEST(VisualHull, AWorldFrameFarFromItsOriginGivesTheSameHull) {
+  // A map frame 100 km from its origin: the local frame keeps single precision's accuracy.
+  const HullInput input = ring(8);
+  HullConfig config;
+  config.max_depth = 6;
+  const HullResult near = buildHull(input, config);
+  HullInput far = input;
+  const Eigen::Vector3d shift(1e5, -2e5, 3e4);
+  for (PinholeCamera& camera : far.cameras) {
+    camera = PinholeCamera::fromCentre(camera.K(), camera.R(), camera.centre() + shift);
+  }
+  const HullResult moved = buildHull(far, config);
+  const double relative =
+      std::abs(moved.hull.stats().occupied_volume_m3 - near.hull.stats().occupied_volume_m3) /
+      near.hull.stats().occupied_volume_m3;
+  EXPECT_LT(relative, 0.02) << "volumes " << near.hull.stats().occupied_volume_m3 << " and "
+                            << moved.hull.stats().occupied_volume_m3;
+}
+
+TEST(HullStream, RefusesSilhouettesThatCoverNothingOrEverything) {
+  const HullInput input = ring(8);
+  HullStream stream(streamConfig(6));
+  const cv::Mat black = cv::Mat::zeros(input.masks[0].size(), CV_8UC1);
+  const cv::Mat white(input.masks[0].size(), CV_8UC1, cv::Scalar(255));
+  EXPECT_EQ(stream.add("black", input.cameras[0], black), HullStream::Outcome::kRefused);
+  EXPECT_EQ(stream.waitingViews(), 0u);
+  for (size_t i = 0; i < input.masks.size(); ++i) {
+    stream.add(input.names[i], input.cameras[i], input.masks[i]);
+  }
+  ASSERT_TRUE(stream.hasHull());
+  const HullSummary before = summary(stream.hull());
+  const PinholeCamera other = PinholeCamera::fromCentre(input.cameras[0].K(), input.cameras[0].R(),
+                                                        input.cameras[0].centre() * 1.1);
+  EXPECT_EQ(stream.add("black", other, black), HullStream::Outcome::kRefused);
+  EXPECT_EQ(stream.add("white", other, white), HullStream::Outcome::kRefused);
+  EXPECT_TRUE(summary(stream.hull()) == before);
+  EXPECT_EQ(stream.refusedViews(), 3u);
+  const std::vector<std::string> refusals = stream.takeRefusals();
+  ASSERT_EQ(refusals.size(), 3u);
+  EXPECT_TRUE(contains(refusals[0], "covers no pixel")) << refusals[0];
+  EXPECT_TRUE(contains(refusals[2], "covers the whole image")) << refusals[2];
+  EXPECT_TRUE(stream.takeRefusals().empty());
+}
+
+TEST(HullStream, RefusesAViewThatWouldCarveTheHullToNothing) {
+  const HullInput input = ring(8);
+  HullStream stream(streamConfig(6));
+  for (size_t i = 0; i < input.masks.size(); ++i) {
+    stream.add(input.names[i], input.cameras[i], input.masks[i]);
+  }
+  ASSERT_TRUE(stream.hasHull());
+  const HullSummary before = summary(stream.hull());
+  // A blob in the image's corner, where the sphere does not project, seen from a new place.
+  cv::Mat corner = cv::Mat::zeros(input.masks[0].size(), CV_8UC1);
+  corner(cv::Rect(0, 0, 10, 10)).setTo(255);
+  const PinholeCamera other = PinholeCamera::fromCentre(input.cameras[0].K(), input.cameras[0].R(),
+                                                        input.cameras[0].centre() * 1.1);
+  EXPECT_EQ(stream.add("corner", other, corner), HullStream::Outcome::kRefused);
+  EXPECT_TRUE(summary(stream.hull()) == before);
+  const std::vector<std::string> refusals = stream.takeRefusals();
+  ASSERT_EQ(refusals.size(), 1u);
+  EXPECT_TRUE(contains(refusals[0], "carve the hull to nothing")) << refusals[0];
+  // A good view after it refines the hull as usual.
+  const HullInput more = ring(9);
+  EXPECT_EQ(stream.add("more", more.cameras[4], more.masks[4]), HullStream::Outcome::kCarved);
+}
+
+TEST(HullStream, WithAGivenBoxAFirstViewThatCarvesItToNothingIsRefused) {
+  const HullInput input = ring(8);
+  HullStreamConfig config = streamConfig(6);
+  config.box = buildHull(input, config.hull).box;
+  HullStream without(config), with(config);
+  cv::Mat corner = cv::Mat::zeros(input.masks[0].size(), CV_8UC1);
+  corner(cv::Rect(0, 0, 10, 10)).setTo(255);
+  const PinholeCamera other = PinholeCamera::fromCentre(input.cameras[0].K(), input.cameras[0].R(),
+                                                        input.cameras[0].centre() * 1.1);
+  EXPECT_EQ(with.add("corner", other, corner), HullStream::Outcome::kRefused);
+  EXPECT_FALSE(with.hasHull());
+  for (size_t i = 0; i < input.masks.size(); ++i) {
+    without.add(input.names[i], input.cameras[i], input.masks[i]);
+    with.add(input.names[i], input.cameras[i], input.masks[i]);
+  }
+  ASSERT_TRUE(with.hasHull());
+  EXPECT_TRUE(summary(with.hull()) == summary(without.hull()));
+}
+
+/// View 0's camera moved sideways by 3 m along its own x axis: its cone runs beside the others'.
+PinholeCamera besideTheOthers(const PinholeCamera& camera) {
+  return PinholeCamera::fromCentre(camera.K(), camera.R(),
+                                   camera.centre() + 3.0 * camera.R().row(0).transpose());
+}
+
+TEST(HullStream, AViewWhoseConeMissesTheOthersIsDroppedAsIfItNeverCame) {
+  const HullInput input = ring(8);
+  HullStream without(streamConfig(6)), with(streamConfig(6));
+  EXPECT_EQ(with.add("beside", besideTheOthers(input.cameras[0]), input.masks[0]),
+            HullStream::Outcome::kWaiting);
+  for (size_t i = 0; i < input.masks.size(); ++i) {
+    without.add(input.names[i], input.cameras[i], input.masks[i]);
+    with.add(input.names[i], input.cameras[i], input.masks[i]);
+  }
+  ASSERT_TRUE(without.hasHull());
+  ASSERT_TRUE(with.hasHull()) << with.whyNoBox();
+  EXPECT_TRUE(with.hull().cube().box().min_W.isApprox(without.hull().cube().box().min_W));
+  EXPECT_TRUE(summary(with.hull()) == summary(without.hull()));
+  EXPECT_EQ(with.refusedViews(), 1u);
+  const std::vector<std::string> refusals = with.takeRefusals();
+  ASSERT_EQ(refusals.size(), 1u);
+  EXPECT_TRUE(contains(refusals[0], "'beside'")) << refusals[0];
+  EXPECT_TRUE(contains(refusals[0], "misses the other views")) << refusals[0];
+}
+
+TEST(HullStream, WaitingIsBoundedByMaxWaitingViews) {
+  // Views that never bound a box (one camera turning on the spot) do not pile up.
+  const HullInput input = ring(8);
+  HullStreamConfig config = streamConfig(6);
+  config.max_waiting_views = 4;
+  HullStream stream(config);
+  for (int i = 0; i < 10; ++i) {
+    const Eigen::Matrix3d turn =
+        Eigen::AngleAxisd(i * 2.0 * M_PI / 180.0, Eigen::Vector3d::UnitY()).toRotationMatrix();
+    const PinholeCamera camera = PinholeCamera::fromCentre(
+        input.cameras[0].K(), turn * input.cameras[0].R(), input.cameras[0].centre());
+    stream.add("turning_" + std::to_string(i), camera, input.masks[0]);
+    EXPECT_LE(stream.waitingViews(), 4u);
+  }
+  EXPECT_FALSE(stream.hasHull());
+  EXPECT_EQ(stream.refusedViews(), 6u);
+  EXPECT_TRUE(contains(stream.takeRefusals().front(), "max_waiting_views"));
+}
+
+TEST(HullStream, ViewsBeyondMaxViewsAreRefused) {
+  const HullInput input = ring(8);
+  HullStreamConfig config = streamConfig(6);
+  config.max_views = 5;
+  HullStream stream(config);
+  for (size_t i = 0; i < input.masks.size(); ++i) {
+    stream.add(input.names[i], input.cameras[i], input.masks[i]);
+  }
+  ASSERT_TRUE(stream.hasHull());
+  EXPECT_EQ(stream.hull().views().size(), 5u);
+  EXPECT_EQ(stream.refusedViews(), 3u);
+}
+
+TEST(HullStream, ACameraFarBeyondTheBoxIsRefusedAndTheOthersCarve) {
+  const HullInput input = ring(8);
+  HullStream stream(streamConfig(6));
+  for (size_t i = 0; i < input.masks.size(); ++i) {
+    PinholeCamera camera = input.cameras[i];
+    if (i == 5) camera = PinholeCamera(camera.K(), camera.R(), Eigen::Vector3d(0, 0, 1e39));
+    if (i == 6) camera = PinholeCamera(camera.K(), camera.R(), Eigen::Vector3d(0, 0, 1e307));
+    stream.add(input.names[i], camera, input.masks[i]);
+  }
+  ASSERT_TRUE(stream.hasHull());
+  EXPECT_EQ(stream.hull().views().size(), 6u);
+  EXPECT_EQ(stream.refusedViews(), 2u);
+}
+
+// ---- the command-line program --------------------------------------------------------------
+
+class HostileCommandLine : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    scene_ = new std::string(test::temporaryDirectory());
+    std::string out, err;
+    ASSERT_EQ(test::runProgram("scene --out " + *scene_ + " --views 8 --size 320x240", &out, &err),
+              0)
+        << err;
+  }
+  static void TearDownTestSuite() { delete scene_; }
+
+  /// Runs `hull` on the scene with `calib` (the scene's own by default) and extra arguments.
+  int hull(const std::string& extra, std::string* err, const std::string& calib = "") {
+    std::string out;
+    const std::string par = calib.empty() ? *scene_ + "/scene_par.txt" : calib;
+    return test::runProgram("hull --calib " + par + " --images " + *scene_ + " --silhouettes " +
+                                *scene_ + "/masks --depth 6 " + extra,
+                            &out, err);
+  }
+
+  /// The scene's par file with one camera moved: `line` (1-based view) centre z set to `z`.
+  std::string parWithCameraAt(double z, bool translation) {
+    std::vector<CalibratedView> views = readCalibration(*scene_ + "/scene_par.txt");
+    PinholeCamera& camera = views[1].camera;
+    if (translation) {
+      camera = PinholeCamera(camera.K(), camera.R(), Eigen::Vector3d(0, 0, z));
+    } else {
+      camera = PinholeCamera::fromCentre(camera.K(), camera.R(), Eigen::Vector3d(0, 0, z));
+    }
+    const std::string path = test::temporaryDirectory() + "/par.txt";
+    writeMiddleburyPar(path, views);
+    return path;
+  }
+
+  static std::string* scene_;
+};
+std::string* HostileCommandLine::scene_ = nullptr;
+
+TEST_F(HostileCommandLine, HugeCoordinatesEndInAClearError) {
+  std::string err;
+  EXPECT_EQ(hull("--box -0.8,-0.8,-1.3,0.8,0.8,0.9", &err, parWithCameraAt(1e39, false)), 1);
+  EXPECT_TRUE(contains(err, "half cube edges")) << err;
+  EXPECT_EQ(hull("", &err, parWithCameraAt(1e307, true)), 1) << err;
+  EXPECT_EQ(hull("--box -1e39,-1e39,-1e39,1e39,1e39,1e39", &err), 1);
+  EXPECT_TRUE(contains(err, "too large")) << err;
+  EXPECT_EQ(hull("--box 0,0,0,1e-300,1e-300,1e-300", &err), 1);
+}
+
+TEST_F(HostileCommandLine, OutOfRangeSettingsAreUsageErrors) {
+  std::string err, out;
+  EXPECT_EQ(hull("--depth 12", &err), 2);
+  EXPECT_TRUE(contains(err, "max_depth")) << err;
+  EXPECT_EQ(hull("--threads 100000", &err), 2);
+  EXPECT_EQ(hull("--views ,", &err), 2);
+  const std::string left = *scene_ + "/view_0000.png", right = *scene_ + "/view_0001.png";
+  EXPECT_EQ(test::runProgram("match " + left + " " + right + " --filter gms --gms-cells 100000",
+                             &out, &err),
+            2);
+  EXPECT_EQ(test::runProgram("match " + left + " " + right + " --filter +gsc", &out, &err), 2);
+  EXPECT_EQ(test::runProgram("match " + left + " " + right + " --filter epipolar", &out, &err), 2);
+  EXPECT_EQ(test::runProgram("bag --calib " + *scene_ + "/scene_par.txt --images " + *scene_ +
+                                 " --silhouettes " + *scene_ + "/masks --out " +
+                                 test::temporaryDirectory() + "/x.bag --rate 1e300",
+                             &out, &err),
+            2);
+}
+
+TEST_F(HostileCommandLine, AViewOfAnotherSizeIsRefused) {
+  const std::string dir = test::temporaryDirectory();
+  std::string out, err;
+  ASSERT_EQ(test::runCommand("cp -r " + *scene_ + "/. " + dir, &out, &err), 0);
+  cv::Mat big;
+  cv::resize(cv::imread(dir + "/view_0003.png"), big, cv::Size(640, 480));
+  cv::imwrite(dir + "/view_0003.png", big);
+  EXPECT_EQ(test::runProgram("hull --calib " + dir + "/scene_par.txt --images " + dir +
+                                 " --threshold 0.1 --depth 6",
+                             &out, &err),
+            1);
+  EXPECT_TRUE(contains(err, "image size differs")) << err;
+}
+
+TEST_F(HostileCommandLine, TheReproducersOfSharedReproEndInClearErrors) {
+  const std::string repro = std::string(SIFT_HULL_SOURCE_DIR) + "/../shared/repro";
+  if (!test::fileExists(repro + "/README.md")) GTEST_SKIP() << repro << " not found";
+  std::string err, out;
+  EXPECT_EQ(hull("--box -0.8,-0.8,-1.3,0.8,0.8,0.9", &err, repro + "/par_c_1e39.txt"), 1) << err;
+  EXPECT_EQ(hull("", &err, repro + "/par_t_1e307.txt"), 1) << err;
+  EXPECT_EQ(test::runProgram("match " + *scene_ + "/view_0000.png " + *scene_ +
+                                 "/view_0001.png --filter gsc --gt-disparity " + repro +
+                                 "/pfm_4GiB_header.pfm",
+                             &out, &err),
+            1);
+  EXPECT_TRUE(contains(err, "announces")) << err;
+}
+
+}  // namespace
+}  // namespace sift_hull

@@ -1,0 +1,241 @@
+// The visual hull on synthetic scenes with known answers: signed distances, the LP box against
+// dense carving, octree volume, mesh, incremental carving and the OctoMap output.
+
+#include <gtest/gtest.h>
+#include <octomap/OcTree.h>
+
+#include <cmath>
+
+#include "sift_hull/eval/hull_evaluation.h"
+#include "sift_hull/hull/hull_octomap.h"
+#include "sift_hull/hull/hull_pipeline.h"
+#include "sift_hull/synthetic/scene.h"
+#include "sift_hull/hull/distance_map.h"
+#include "sift_hull/hull/hull_config.h"
+#include "sift_hull/hull/hull_view.h"
+#include "sift_hull/hull/octree.h"
+#include "common/test_data.h"
+
+namespace sift_hull {
+namespace {
+
+HullConfig depth(int max_depth) {
+  HullConfig config;
+  config.max_depth = max_depth;
+  return config;
+}
+
+cv::Mat discMask(cv::Size size, cv::Point2d centre, double radius) {
+  cv::Mat mask(size, CV_8UC1);
+  for (int v = 0; v < size.height; ++v) {
+    for (int u = 0; u < size.width; ++u) {
+      mask.at<uint8_t>(v, u) = std::hypot(u - centre.x, v - centre.y) <= radius ? 255 : 0;
+    }
+  }
+  return mask;
+}
+
+TEST(SignedDistanceMap, FollowsTheDiscsDistanceNearItAndBoundsItFarAway) {
+  const cv::Point2d centre(60.3, 50.6);
+  const double radius = 15.0;
+  const int padding = 8;
+  const cv::Mat disc = discMask({120, 100}, centre, radius);
+  const SignedDistanceMap map(disc, silhouetteBounds(disc, false), padding);
+  for (double u = -20; u < 140; u += 3.7) {
+    for (double v = -20; v < 120; v += 2.9) {
+      const double expected = std::hypot(u - centre.x, v - centre.y) - radius;
+      const bool near =
+          std::abs(u - centre.x) < radius + padding && std::abs(v - centre.y) < radius + padding;
+      if (near) {
+        EXPECT_NEAR(map.at(u, v), expected, 1.0) << "at " << u << ", " << v;
+      } else {  // a lower bound, and outside
+        EXPECT_LT(map.at(u, v), expected + 1.0) << "at " << u << ", " << v;
+        EXPECT_GT(map.at(u, v), padding - 1.0) << "at " << u << ", " << v;
+      }
+    }
+  }
+}
+
+TEST(SignedDistanceMap, PaddingDecidesWhatLiesOutsideTheImage) {
+  // A disc cut by the left border: its left side is open unless the border bounds it.
+  const cv::Mat mask = discMask({40, 40}, {2, 20}, 10);
+  const SignedDistanceMap carving(mask, silhouetteBounds(mask, true), 4);
+  const SignedDistanceMap keeping(mask, silhouetteBounds(mask, false), 4);
+  EXPECT_GT(carving.at(-100, 20), 0.0f);
+  EXPECT_LT(keeping.at(-100, 20), 0.0f);
+  EXPECT_LT(keeping.at(-3, 20), 0.0f);
+  EXPECT_GT(keeping.at(-3, 2), 0.0f);   // beyond the disc's bounded top side
+  EXPECT_GT(keeping.at(20, 20), 0.0f);  // inside the image, outside the disc
+}
+
+TEST(HullCube, HoldsTheBoxWithAVoxelOfMarginOnTheVoxelGrid) {
+  Box3d box;
+  box.min_W = Eigen::Vector3d(-0.3, 0.1, 2.0);
+  box.max_W = Eigen::Vector3d(0.5, 0.4, 2.2);
+  for (int depth : {3, 7, 9}) {
+    const HullCube cube = HullCube::around(box, depth);
+    EXPECT_NEAR(cube.resolution_m, 0.8 / ((1 << depth) - 3), 1e-12);
+    const Box3d outer = cube.box();
+    EXPECT_TRUE(((box.min_W - outer.min_W).array() >= cube.resolution_m - 1e-9).all());
+    EXPECT_TRUE(((outer.max_W - box.max_W).array() >= cube.resolution_m - 1e-9).all());
+  }
+}
+
+/// One scene carved at depth 7, with the dense reference at twice the resolution.
+class SphereHull : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    result_ = new HullResult(buildHull(test::sceneHullInput("sphere", 12), depth(7)));
+    dense_ = new DenseGrid(denseCarving(result_->hull.views(), result_->hull.cube().box(), 256, 2));
+  }
+  static void TearDownTestSuite() {
+    delete result_;
+    delete dense_;
+  }
+  static HullResult* result_;
+  static DenseGrid* dense_;
+};
+HullResult* SphereHull::result_ = nullptr;
+DenseGrid* SphereHull::dense_ = nullptr;
+
+/// The LP box holds the dense hull (to a dense voxel) and exceeds it by at most 5 % of its edge.
+void expectTightBox(const Box3d& box, const DenseGrid& dense_grid) {
+  const Box3d dense = dense_grid.occupiedBounds();
+  const double edge = box.size().maxCoeff();
+  for (int axis = 0; axis < 3; ++axis) {
+    EXPECT_LE(box.min_W[axis], dense.min_W[axis] + dense_grid.voxel_m) << "axis " << axis;
+    EXPECT_GE(box.max_W[axis], dense.max_W[axis] - dense_grid.voxel_m) << "axis " << axis;
+    EXPECT_LE(dense.min_W[axis] - box.min_W[axis], 0.05 * edge) << "axis " << axis;
+    EXPECT_LE(box.max_W[axis] - dense.max_W[axis], 0.05 * edge) << "axis " << axis;
+  }
+}
+
+TEST_F(SphereHull, LpBoxHoldsTheDenseHullAndExceedsItByAtMostFivePercent) {
+  expectTightBox(result_->box, *dense_);
+}
+
+TEST_F(SphereHull, VolumeMatchesDenseCarvingAtTwiceTheResolution) {
+  EXPECT_GE(volumeIoU(result_->hull, *dense_), 0.99);
+}
+
+TEST_F(SphereHull, MeshIsWatertightAndReprojectsOntoEverySilhouette) {
+  EXPECT_TRUE(result_->mesh_check.watertight)
+      << result_->mesh_check.boundary_edges << " boundary, "
+      << result_->mesh_check.non_manifold_edges << " non-manifold edges";
+  const ReprojectionIoU iou = reprojectionIoU(result_->mesh, result_->hull.views());
+  EXPECT_GE(iou.min, 0.99);
+}
+
+TEST_F(SphereHull, MeshLiesNearTheSphere) {
+  // Twelve views leave the hull a little larger than the sphere (radius 0.8 m).
+  const double voxel = result_->hull.cube().resolution_m;
+  EXPECT_LT(meanDistanceToSphere(result_->mesh, Eigen::Vector3d::Zero(), 0.8), 2.0 * voxel);
+}
+
+TEST_F(SphereHull, OctomapHoldsTheOccupiedCells) {
+  const std::unique_ptr<octomap::OcTree> tree = toOctomap(result_->hull);
+  EXPECT_DOUBLE_EQ(tree->getResolution(), result_->hull.cube().resolution_m);
+  const octomap::OcTreeNode* centre = tree->search(0.0, 0.0, 0.0);
+  ASSERT_NE(centre, nullptr);
+  EXPECT_TRUE(tree->isNodeOccupied(centre));
+  EXPECT_EQ(tree->search(0.0, 0.0, 0.95), nullptr);  // outside the sphere: unknown
+  double octomap_m3 = 0.0, hull_m3 = 0.0;
+  for (auto leaf = tree->begin_leafs(); leaf != tree->end_leafs(); ++leaf) {
+    octomap_m3 += std::pow(leaf.getSize(), 3);
+  }
+  const double voxel_m3 = std::pow(result_->hull.cube().resolution_m, 3);
+  result_->hull.forEachLeaf([&](const HullCell& cell) {
+    if (cell.state != CellState::kOut) hull_m3 += voxel_m3 * std::pow(8, 7 - cell.depth);
+  });
+  EXPECT_NEAR(octomap_m3, hull_m3, 1e-9 * hull_m3);
+  // The hull's own volume (surface cells by their centre) lies close above the sphere's.
+  const double sphere_m3 = 4.0 / 3.0 * M_PI * std::pow(0.8, 3);
+  EXPECT_GT(result_->hull.stats().occupied_volume_m3, sphere_m3);
+  EXPECT_LT(result_->hull.stats().occupied_volume_m3, 1.03 * sphere_m3);
+
+  const std::string path = test::temporaryDirectory() + "/hull.bt";
+  writeOctomap(*tree, path);
+  octomap::OcTree read(path);
+  EXPECT_EQ(read.getNumLeafNodes(), tree->getNumLeafNodes());
+}
+
+std::vector<HullCell> leavesOf(const VisualHull& hull) {
+  std::vector<HullCell> leaves;
+  hull.forEachLeaf([&](const HullCell& cell) { leaves.push_back(cell); });
+  return leaves;
+}
+
+TEST(VisualHull, AddingViewsOneAtATimeGivesTheSameTreeAsAllAtOnce) {
+  const HullInput input = test::sceneHullInput("sculpture", 8, "ring");
+  const HullConfig config = depth(6);
+  std::vector<HullView> views = makeHullViews(input.names, input.cameras, input.masks, config);
+  const Box3d box = boundingBoxOf(views);
+  VisualHull at_once(box, config), one_by_one(box, config);
+  at_once.addViews(views);
+  for (const HullView& view : views) one_by_one.addView(view);
+  const std::vector<HullCell> expected = leavesOf(at_once), actual = leavesOf(one_by_one);
+  ASSERT_EQ(actual.size(), expected.size());
+  for (size_t i = 0; i < actual.size(); ++i) {
+    EXPECT_EQ(actual[i].index, expected[i].index);
+    EXPECT_EQ(actual[i].depth, expected[i].depth);
+    EXPECT_EQ(actual[i].state, expected[i].state);
+    if (actual[i].state != CellState::kOut) {
+      EXPECT_EQ(actual[i].centre_value, expected[i].centre_value);
+    }
+  }
+}
+
+TEST(VisualHull, BoxShapeMatchesDenseCarving) {
+  const HullResult result = buildHull(test::sceneHullInput("box", 10), depth(7));
+  const DenseGrid dense = denseCarving(result.hull.views(), result.hull.cube().box(), 256, 2);
+  EXPECT_GE(volumeIoU(result.hull, dense), 0.99);
+  EXPECT_TRUE(result.mesh_check.watertight);
+  EXPECT_GE(reprojectionIoU(result.mesh, result.hull.views()).min, 0.99);
+}
+
+/// The input with view 0's image shifted right by half its width: the object leaves the image.
+HullInput withFirstViewCutByTheBorder(HullInput input) {
+  const PinholeCamera& camera = input.cameras[0];
+  Eigen::Matrix3d K = camera.K();
+  const int shift = input.masks[0].cols / 2;
+  K(0, 2) += shift;
+  input.cameras[0] = PinholeCamera(K, camera.R(), camera.t());
+  cv::Mat shifted = cv::Mat::zeros(input.masks[0].size(), CV_8UC1);
+  input.masks[0](cv::Rect(0, 0, shift, shifted.rows))
+      .copyTo(shifted(cv::Rect(shift, 0, shift, shifted.rows)));
+  input.masks[0] = shifted;
+  return input;
+}
+
+TEST(VisualHull, ViewsCarveOutsideTheirImageOnlyWhenAsked) {
+  const HullInput full = test::sceneHullInput("sphere", 8);
+  const HullInput cut = withFirstViewCutByTheBorder(full);
+  HullInput without_first = full;
+  without_first.names.erase(without_first.names.begin());
+  without_first.cameras.erase(without_first.cameras.begin());
+  without_first.masks.erase(without_first.masks.begin());
+  const Box3d box = buildHull(full, depth(6)).box;  // one box for all three
+  const double all_m3 = buildHull(full, depth(6), box).hull.stats().occupied_volume_m3;
+  const double rest_m3 = buildHull(without_first, depth(6), box).hull.stats().occupied_volume_m3;
+  HullConfig carving = depth(6);
+  carving.carve_outside_image = true;
+  const double kept_m3 = buildHull(cut, depth(6), box).hull.stats().occupied_volume_m3;
+  const double carved_m3 = buildHull(cut, carving, box).hull.stats().occupied_volume_m3;
+  // Kept: the half the cut view still sees carves as the whole view did; the other half is left
+  // to the other views.
+  EXPECT_GE(kept_m3, all_m3 * 0.999);
+  EXPECT_LE(kept_m3, rest_m3 * 1.001);
+  EXPECT_LT(carved_m3, 0.7 * all_m3);
+}
+
+TEST(VisualHull, ResetLeavesOneInCellAndNoViews) {
+  HullResult result = buildHull(test::sceneHullInput("sphere", 6), depth(5));
+  result.hull.reset();
+  EXPECT_TRUE(result.hull.views().empty());
+  const HullStats stats = result.hull.stats();
+  EXPECT_EQ(stats.in_leaves, 1u);
+  EXPECT_EQ(stats.surface_leaves + stats.out_leaves, 0u);
+}
+
+}  // namespace
+}  // namespace sift_hull

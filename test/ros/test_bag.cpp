@@ -1,0 +1,59 @@
+// The bag command: a synthetic scene written as a bag holds, per view, tf, the image, the
+// silhouette, camera_info and a stereo pair, with the scene's cameras.
+
+#include <gtest/gtest.h>
+#include <rosbag/bag.h>
+#include <rosbag/view.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+#include <tf2_msgs/TFMessage.h>
+
+#include <map>
+
+#include "sift_hull/io/calibration.h"
+#include "common/test_data.h"
+
+namespace sift_hull {
+namespace {
+
+TEST(BagCommand, WritesEveryViewOfASceneWithItsCamera) {
+  const std::string dir = test::temporaryDirectory();
+  std::string out, err;
+  ASSERT_EQ(test::runProgram("scene --out " + dir + " --views 4 --size 160x120", &out, &err), 0)
+      << err;
+  ASSERT_EQ(
+      test::runRosProgram("bag --calib " + dir + "/scene_par.txt --images " + dir + " --silhouettes " +
+                           dir + "/masks --rate 4 --out " + dir + "/scene.bag",
+                       &out, &err),
+      0)
+      << err;
+  const std::vector<CalibratedView> views = readCalibration(dir + "/scene_par.txt");
+  rosbag::Bag bag(dir + "/scene.bag", rosbag::bagmode::Read);
+  std::map<std::string, int> counts;
+  int info_index = 0;
+  for (const rosbag::MessageInstance& message : rosbag::View(bag)) {
+    ++counts[message.getTopic()];
+    if (const auto info = message.instantiate<sensor_msgs::CameraInfo>()) {
+      EXPECT_EQ(info->width, 160u);
+      EXPECT_NEAR(info->K[0], views[info_index].camera.K()(0, 0), 1e-9);
+      EXPECT_NEAR(info->header.stamp.toSec(), 1.0 + 0.25 * info_index, 1e-9);
+      ++info_index;
+    }
+    if (message.getTopic() == "/camera/silhouette") {
+      EXPECT_EQ(message.instantiate<sensor_msgs::Image>()->encoding, "mono8");
+    }
+    if (const auto tf = message.instantiate<tf2_msgs::TFMessage>()) {
+      ASSERT_EQ(tf->transforms.size(), 1u);
+      const Eigen::Vector3d centre = views[counts["/tf"] - 1].camera.centre();
+      EXPECT_NEAR(tf->transforms[0].transform.translation.x, centre.x(), 1e-9);
+      EXPECT_EQ(tf->transforms[0].child_frame_id, "camera");
+    }
+  }
+  for (const char* topic : {"/tf", "/camera/image", "/camera/silhouette", "/camera/camera_info",
+                            "/stereo/left/image", "/stereo/right/image"}) {
+    EXPECT_EQ(counts[topic], 4) << topic;
+  }
+}
+
+}  // namespace
+}  // namespace sift_hull

@@ -1,0 +1,93 @@
+// launch/demo.launch end to end: a synthetic scene's bag played through both nodes (as nodes and
+// as nodelets), the results saved by save_results once the last view is in, and the saved hull
+// compared with the offline `sift_hull hull` of the same views.
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "sift_hull/hull/mesh.h"
+#include "sift_hull/io/ply.h"
+#include "lib/free_port.h"
+#include "common/test_data.h"
+
+namespace sift_hull {
+namespace {
+
+constexpr int kViews = 8;
+constexpr int kDepth = 6;
+
+class DemoLaunch : public ::testing::TestWithParam<bool> {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = test::temporaryDirectory();
+    std::string out, err;
+    ASSERT_EQ(test::runProgram(
+                  "scene --out " + dir_ + " --views " + std::to_string(kViews) + " --size 320x240",
+                  &out, &err),
+              0)
+        << err;
+    const std::string views = " --calib " + dir_ + "/scene_par.txt --images " + dir_ +
+                              " --silhouettes " + dir_ + "/masks";
+    ASSERT_EQ(
+        test::runRosProgram("bag" + views + " --rate 8 --out " + dir_ + "/scene.bag", &out, &err), 0)
+        << err;
+    ASSERT_EQ(test::runProgram("hull" + views + " --depth " + std::to_string(kDepth) +
+                                   " --out-mesh " + dir_ + "/offline.ply",
+                               &out, &err),
+              0)
+        << err;
+  }
+
+  /// Runs demo.launch with a master of its own on a port no other test uses; returns its exit code.
+  static int runDemoLaunch(const std::string& out_dir, bool nodelets, std::string* log) {
+    const int port = freeTcpPort();
+    const std::string uri = "http://localhost:" + std::to_string(port);
+    const std::string command = "ROS_MASTER_URI=" + uri + " timeout 150 roslaunch -p " +
+                                std::to_string(port) + " sift_hull demo.launch bag:=" + dir_ +
+                                "/scene.bag out:=" + out_dir + " depth:=" + std::to_string(kDepth) +
+                                " nodelets:=" + (nodelets ? "true" : "false");
+    std::string err;
+    const int status = test::runCommand(command, log, &err);
+    *log += err;
+    return status;
+  }
+
+  static std::string dir_;
+};
+std::string DemoLaunch::dir_;
+
+TEST_P(DemoLaunch, PlaysTheBagThroughBothNodesAndSavesTheResults) {
+  const std::string out = dir_ + (GetParam() ? "/nodelets" : "/nodes");
+  std::string log;
+  ASSERT_EQ(runDemoLaunch(out, GetParam(), &log), 0) << log;
+  std::ifstream summary_file(out + "/summary.json");
+  ASSERT_TRUE(summary_file) << "no summary.json; roslaunch said:\n" << log;
+  const nlohmann::json summary = nlohmann::json::parse(summary_file);
+  EXPECT_TRUE(summary["complete"].get<bool>()) << summary.dump(2);
+  EXPECT_EQ(summary["hull"]["views_in_bag"], kViews);
+  EXPECT_EQ(summary["matcher"]["pairs_matched"], kViews);
+  EXPECT_GT(summary["matcher"]["last_pair"]["kept"]["gsc"].get<int>(), 20);
+  for (const char* key : {"octree", "mesh", "point_cloud", "matches_image"}) {
+    const std::string path = summary["files"][key];
+    EXPECT_TRUE(std::filesystem::file_size(path) > 0) << key;
+  }
+  EXPECT_FALSE(cv::imread(summary["files"]["matches_image"]).empty());
+
+  // The node's hull lies in another box than the offline one (it is fixed by the first views
+  // whose LP is bounded), so the volumes agree to the sampling of a depth-6 grid, not exactly.
+  const TriangleMesh node_mesh = readPly(summary["files"]["mesh"]);
+  const TriangleMesh offline_mesh = readPly(dir_ + "/offline.ply");
+  EXPECT_TRUE(checkMesh(node_mesh).watertight);
+  EXPECT_NEAR(meshVolume(node_mesh), meshVolume(offline_mesh), 0.05 * meshVolume(offline_mesh));
+}
+
+INSTANTIATE_TEST_SUITE_P(NodesAndNodelets, DemoLaunch, ::testing::Bool(),
+                         [](const auto& info) { return info.param ? "Nodelets" : "Nodes"; });
+
+}  // namespace
+}  // namespace sift_hull

@@ -1,0 +1,241 @@
+// The hull node wired up: synthetic silhouettes, camera_info and tf in; octomap and cloud out;
+// ~reset; bad input answered with an error while later good input still counts. Every wait has a
+// deadline.
+
+#include <geometry_msgs/TransformStamped.h>
+#include <gtest/gtest.h>
+#include <octomap/OcTree.h>
+#include <ros/ros.h>
+#include <rosgraph_msgs/Log.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <std_srvs/Empty.h>
+#include <tf2_eigen/tf2_eigen.h>
+#include <tf2_ros/static_transform_broadcaster.h>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <mutex>
+#include <sstream>
+
+#include "lib/conversions.h"
+#include "common/octomap_volume.h"
+#include "ros_wait.h"
+#include "sift_hull/Octomap.h"
+#include "sift_hull/hull/hull_octomap.h"
+#include "sift_hull/hull/hull_pipeline.h"
+#include "sift_hull/synthetic/scene.h"
+#include "sift_hull/hull/hull_config.h"
+#include "sift_hull/hull/hull_view.h"
+
+namespace sift_hull {
+namespace {
+
+using test::kDeadline_s;
+using test::occupiedVolume;
+using test::waitFor;
+
+constexpr int kViews = 8;
+
+std::vector<RenderedView> sphereViews() {
+  SceneConfig config;
+  config.shape = "sphere";
+  config.views = kViews;
+  config.layout = "sphere";
+  config.width_px = 320;
+  config.height_px = 240;
+  return renderScene(config);
+}
+
+std::string frameOf(int view) { return "camera_" + std::to_string(view); }
+
+class HullNodeTest : public ::testing::Test {
+ protected:
+  /// Whether the node extracts silhouettes from images (hull_from_image.test).
+  virtual bool fromImage() const { return false; }
+
+  void SetUp() override {
+    views_ = sphereViews();
+    std::vector<geometry_msgs::TransformStamped> poses;
+    for (int v = 0; v < kViews; ++v) {
+      poses.push_back(
+          ros_conversions::cameraPoseMessage(views_[v].view.camera, "world", frameOf(v), {}));
+    }
+    // A pose that is not a number: tf refuses it, so views in this frame never get a pose.
+    poses.push_back(
+        ros_conversions::cameraPoseMessage(views_[0].view.camera, "world", "camera_nan", {}));
+    poses.back().transform.translation.x = std::nan("");
+    tf_.sendTransform(poses);
+    silhouette_pub_ = nh_.advertise<sensor_msgs::Image>(fromImage() ? "image" : "silhouette", 20);
+    info_pub_ = nh_.advertise<sensor_msgs::CameraInfo>("camera_info", 20);
+    octomap_sub_ = nh_.subscribe("octomap_binary", 20, &HullNodeTest::onOctomap, this);
+    cloud_sub_ = nh_.subscribe("occupied_cells", 20, &HullNodeTest::onCloud, this);
+    ASSERT_TRUE(waitFor([&] {
+      return silhouette_pub_.getNumSubscribers() > 0 && info_pub_.getNumSubscribers() > 0;
+    })) << "the hull node did not subscribe";
+  }
+
+  /// Publishes view `v` with `stamp` (default: now); `change` may spoil the messages first.
+  ros::Time publishView(
+      int v, const std::function<void(sensor_msgs::Image*, sensor_msgs::CameraInfo*)>& change = {},
+      const ros::Time& stamp = {}) {
+    std_msgs::Header header;
+    header.stamp = stamp.isZero() ? ros::Time::now() : stamp;
+    header.frame_id = frameOf(v);
+    sensor_msgs::Image image =
+        ros_conversions::imageMessage(fromImage() ? views_[v].image : views_[v].mask, header);
+    sensor_msgs::CameraInfo info =
+        ros_conversions::cameraInfoMessage(views_[v].view.camera, views_[v].mask.size(), header);
+    if (change) change(&image, &info);
+    info_pub_.publish(info);
+    silhouette_pub_.publish(image);
+    ros::WallDuration(0.05).sleep();
+    return header.stamp;
+  }
+
+  bool octomapStampedAtLeast(const ros::Time& stamp) {
+    return waitFor([&] { return last_octomap_ && last_octomap_->header.stamp >= stamp; });
+  }
+
+  void onOctomap(const sift_hull::OctomapConstPtr& message) { last_octomap_ = message; }
+  void onCloud(const sensor_msgs::PointCloud2ConstPtr& message) { last_cloud_ = message; }
+
+  ros::NodeHandle nh_;
+  tf2_ros::StaticTransformBroadcaster tf_;
+  ros::Publisher silhouette_pub_, info_pub_;
+  ros::Subscriber octomap_sub_, cloud_sub_;
+  std::vector<RenderedView> views_;
+  sift_hull::OctomapConstPtr last_octomap_;
+  sensor_msgs::PointCloud2ConstPtr last_cloud_;
+};
+
+TEST_F(HullNodeTest, CarvesTheSphereResetsAndSurvivesBadInput) {
+  ros::Time last;
+  for (int v = 0; v < kViews; ++v) last = publishView(v);
+  ASSERT_TRUE(octomapStampedAtLeast(last)) << "no octomap for the last view";
+
+  // The node's hull equals the offline one of the same views in the box of the first two (the
+  // first views whose LP bounds a box), and is near the sphere.
+  const HullInput input = hullInputOf(views_);
+  HullConfig config;
+  config.max_depth = 6;
+  const std::vector<HullView> first_two =
+      makeHullViews({input.names[0], input.names[1]}, {input.cameras[0], input.cameras[1]},
+                    {input.masks[0], input.masks[1]}, config);
+  const HullResult offline = buildHull(input, config, boundingBoxOf(first_two));
+  double offline_m3 = 0.0;
+  const std::unique_ptr<octomap::OcTree> tree = toOctomap(offline.hull);
+  for (auto leaf = tree->begin_leafs(); leaf != tree->end_leafs(); ++leaf) {
+    offline_m3 += std::pow(leaf.getSize(), 3);
+  }
+  EXPECT_EQ(last_octomap_->header.frame_id, "world");
+  EXPECT_NEAR(occupiedVolume(*last_octomap_), offline_m3, 1e-6 * offline_m3);
+  const double sphere_m3 = 4.0 / 3.0 * M_PI * std::pow(0.8, 3);
+  EXPECT_NEAR(occupiedVolume(*last_octomap_), sphere_m3, 0.3 * sphere_m3);
+  ASSERT_TRUE(waitFor([&] { return last_cloud_ && last_cloud_->header.stamp >= last; }));
+  EXPECT_GT(last_cloud_->width * last_cloud_->height, 100u);
+
+  std_srvs::Empty reset;
+  ASSERT_TRUE(ros::service::waitForService("/hull/reset", ros::Duration(kDeadline_s)));
+  ASSERT_TRUE(ros::service::call("/hull/reset", reset));
+  ASSERT_TRUE(waitFor([&] { return occupiedVolume(*last_octomap_) == 0.0; }));
+
+  // Bad input: each is refused with an error, and the node carries on.
+  publishView(
+      0, [](sensor_msgs::Image* image, sensor_msgs::CameraInfo*) { image->encoding = "rgb8"; });
+  publishView(1, [](sensor_msgs::Image*, sensor_msgs::CameraInfo* info) { info->width = 640; });
+  publishView(2, [](sensor_msgs::Image*, sensor_msgs::CameraInfo* info) { info->K.fill(0.0); });
+  publishView(
+      3, [](sensor_msgs::Image*, sensor_msgs::CameraInfo* info) { info->K[0] = std::nan(""); });
+  publishView(4, [](sensor_msgs::Image* image, sensor_msgs::CameraInfo*) { image->data.clear(); });
+  publishView(5, [](sensor_msgs::Image* image, sensor_msgs::CameraInfo* info) {
+    image->header.frame_id = info->header.frame_id = "camera_without_pose";
+  });
+  publishView(6, [](sensor_msgs::Image* image, sensor_msgs::CameraInfo* info) {
+    image->header.frame_id = info->header.frame_id = "camera_nan";
+  });
+  // Out of order: newest first. The node carves them all the same.
+  const ros::Time now = ros::Time::now();
+  for (int v = 0; v < kViews; ++v) publishView(v, {}, now - ros::Duration(0.1 * v));
+  ASSERT_TRUE(waitFor([&] { return occupiedVolume(*last_octomap_) > 0.5 * sphere_m3; }))
+      << "views out of order were not carved";
+  ASSERT_TRUE(ros::service::call("/hull/reset", reset));
+  ASSERT_TRUE(waitFor([&] { return occupiedVolume(*last_octomap_) == 0.0; }));
+  for (int v = 0; v < kViews; ++v) last = publishView(v);
+  ASSERT_TRUE(octomapStampedAtLeast(last)) << "good views after bad ones were not carved";
+  EXPECT_NEAR(occupiedVolume(*last_octomap_), offline_m3, 1e-6 * offline_m3);
+}
+
+/// The camera of view 0 turned by 40 degrees about the world's z axis through the origin: a
+/// viewpoint none of the views has.
+PinholeCamera turnedCamera(const PinholeCamera& camera) {
+  const Eigen::Matrix3d turn =
+      Eigen::AngleAxisd(40.0 * M_PI / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  return PinholeCamera::fromCentre(camera.K(), camera.R() * turn.transpose(),
+                                   turn * camera.centre());
+}
+
+TEST_F(HullNodeTest, ASilhouetteWhosePoseComesAfterTheTimeoutIsReportedAndNotCarved) {
+  std::vector<std::string> errors;
+  std::mutex errors_mutex;
+  ros::Subscriber rosout =
+      nh_.subscribe<rosgraph_msgs::Log>("/rosout", 50, [&](const rosgraph_msgs::LogConstPtr& log) {
+        std::lock_guard<std::mutex> lock(errors_mutex);
+        if (log->level == rosgraph_msgs::Log::ERROR) errors.push_back(log->msg);
+      });
+  std_srvs::Empty reset;  // views the node has already taken would be left out as redundant
+  ASSERT_TRUE(ros::service::waitForService("/hull/reset", ros::Duration(kDeadline_s)));
+  ASSERT_TRUE(ros::service::call("/hull/reset", reset));
+  ros::Time last;
+  for (int v = 0; v < kViews; ++v) last = publishView(v);
+  ASSERT_TRUE(octomapStampedAtLeast(last));
+  const ros::Time late =
+      publishView(0, [](sensor_msgs::Image* image, sensor_msgs::CameraInfo* info) {
+        image->header.frame_id = info->header.frame_id = "camera_late";
+      });
+  // hull_node.test sets ~pose_timeout_s to 1 s.
+  ASSERT_TRUE(waitFor([&] {
+    std::lock_guard<std::mutex> lock(errors_mutex);
+    return std::any_of(errors.begin(), errors.end(), [](const std::string& error) {
+      return error.find("no pose of 'camera_late'") != std::string::npos &&
+             error.find("pose_timeout_s") != std::string::npos;
+    });
+  })) << "no error for a pose that did not come in time";
+  const PinholeCamera camera = turnedCamera(views_[0].view.camera);
+  tf_.sendTransform(ros_conversions::cameraPoseMessage(camera, "world", "camera_late", {}));
+  ros::WallDuration(2.0).sleep();  // the pose is in tf now: the view would be carved by then
+  ros::spinOnce();
+  EXPECT_LT(last_octomap_->header.stamp, late) << "a view whose pose came too late was carved";
+  // The same viewpoint in time is carved.
+  const ros::Time timely =
+      publishView(0, [](sensor_msgs::Image* image, sensor_msgs::CameraInfo* info) {
+        image->header.frame_id = info->header.frame_id = "camera_late";
+      });
+  EXPECT_TRUE(octomapStampedAtLeast(timely)) << "a view with its pose in time was not carved";
+}
+
+class HullFromImageTest : public HullNodeTest {
+ protected:
+  bool fromImage() const override { return true; }
+};
+
+TEST_F(HullFromImageTest, ExtractsSilhouettesFromImagesAndCarves) {
+  ros::Time last;
+  for (int v = 0; v < kViews; ++v) last = publishView(v);
+  ASSERT_TRUE(octomapStampedAtLeast(last)) << "no octomap for the last view";
+  // The Middlebury recipe on the rendered images gives close to the rendered masks' hull.
+  const double sphere_m3 = 4.0 / 3.0 * M_PI * std::pow(0.8, 3);
+  EXPECT_NEAR(occupiedVolume(*last_octomap_), sphere_m3, 0.3 * sphere_m3);
+}
+
+}  // namespace
+}  // namespace sift_hull
+
+int main(int argc, char** argv) {
+  ::testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_hull_node");
+  ros::NodeHandle nh;  // keeps the node alive through the tests
+  return RUN_ALL_TESTS();
+}

@@ -1,0 +1,317 @@
+// The matcher node wired up: a synthetic stereo pair in, correspondences out with the input stamps
+// and a precision against the scene's ground truth; bad pairs answered with an error while later
+// good pairs still count. Every wait has a deadline.
+
+#include <dynamic_reconfigure/Reconfigure.h>
+#include <gtest/gtest.h>
+#include <ros/ros.h>
+#include <sensor_msgs/CompressedImage.h>
+#include <sensor_msgs/Image.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <sensor_msgs/point_cloud2_iterator.h>
+#include <tf2_ros/static_transform_broadcaster.h>
+
+#include <functional>
+#include <opencv2/imgcodecs.hpp>
+#include <set>
+
+#include "lib/conversions.h"
+#include "ros_wait.h"
+#include "sift_hull/Correspondences.h"
+#include "sift_hull/eval/match_evaluation.h"
+#include "sift_hull/synthetic/scene.h"
+#include "sift_hull/features/labelled_matches.h"
+
+namespace sift_hull {
+namespace {
+
+using test::kDeadline_s;
+using test::waitFor;
+
+sensor_msgs::Image bgrImage(const cv::Mat& image, const ros::Time& stamp,
+                            const std::string& frame) {
+  std_msgs::Header header;
+  header.stamp = stamp;
+  header.frame_id = frame;
+  return ros_conversions::imageMessage(image, header);
+}
+
+PutativeMatches putativesOf(const sift_hull::Correspondences& message, cv::Size size) {
+  PutativeMatches matches;
+  matches.left_image_size = matches.right_image_size = size;
+  for (const sift_hull::Correspondence& c : message.matches) {
+    const int index = static_cast<int>(matches.matches.size());
+    matches.left_keypoints.emplace_back(c.left.x, c.left.y, c.left.size, c.left.angle);
+    matches.right_keypoints.emplace_back(c.right.x, c.right.y, c.right.size, c.right.angle);
+    matches.matches.emplace_back(index, index, c.descriptor_distance);
+  }
+  return matches;
+}
+
+class MatcherNodeTest : public ::testing::Test {
+ protected:
+  /// Whether the node subscribes the inputs this test publishes.
+  virtual bool inputsConnected() const {
+    return left_pub_.getNumSubscribers() > 0 && right_pub_.getNumSubscribers() > 0;
+  }
+  virtual void advertise() {
+    left_pub_ = nh_.advertise<sensor_msgs::Image>("left/image", 5);
+    right_pub_ = nh_.advertise<sensor_msgs::Image>("right/image", 5);
+  }
+
+  void SetUp() override {
+    SceneConfig config;
+    config.width_px = 320;
+    config.height_px = 240;
+    left_ = renderSceneView(config, 0);
+    right_ = renderSceneView(config, 1);
+    advertise();
+    sub_ = nh_.subscribe("correspondences", 5, &MatcherNodeTest::onCorrespondences, this);
+    ASSERT_TRUE(waitFor([&] { return inputsConnected() && sub_.getNumPublishers() > 0; }))
+        << "the matcher node did not connect";
+  }
+
+  ros::Time publishPair(const cv::Mat& left, const cv::Mat& right) {
+    const ros::Time stamp = ros::Time::now();
+    if (!left.empty()) left_pub_.publish(bgrImage(left, stamp, "left"));
+    if (!right.empty()) right_pub_.publish(bgrImage(right, stamp, "right"));
+    return stamp;
+  }
+
+  bool answeredAtLeast(const ros::Time& stamp) {
+    return waitFor([&] { return last_ && last_->header.stamp >= stamp; });
+  }
+
+  void onCorrespondences(const sift_hull::CorrespondencesConstPtr& message) {
+    last_ = message;
+    answered_.insert(message->header.stamp);
+  }
+
+  /// None of `stamps` was answered, however late (the node matches on worker threads).
+  void expectNoneAnswered(const std::vector<ros::Time>& stamps) {
+    for (const ros::Time& stamp : stamps) EXPECT_EQ(answered_.count(stamp), 0u) << stamp;
+  }
+
+  ros::NodeHandle nh_;
+  ros::Publisher left_pub_, right_pub_, frame_pub_;
+  ros::Subscriber sub_;
+  RenderedView left_, right_;
+  sift_hull::CorrespondencesConstPtr last_;
+  std::set<ros::Time> answered_;
+};
+
+TEST_F(MatcherNodeTest, MatchesAPairWithTheInputStampsAndGoodPrecision) {
+  const ros::Time stamp = publishPair(left_.image, right_.image);
+  ASSERT_TRUE(answeredAtLeast(stamp)) << "no correspondences for the pair";
+  EXPECT_EQ(last_->header.stamp, stamp);
+  EXPECT_EQ(last_->header.frame_id, "left");
+  EXPECT_EQ(last_->right_header.frame_id, "right");
+  ASSERT_EQ(last_->filters, (std::vector<std::string>{"gsc", "magsac"}));
+  ASSERT_GE(last_->matches.size(), 50u);
+
+  const PutativeMatches putatives = putativesOf(*last_, left_.image.size());
+  const std::vector<MatchTruth> truth = judgeBySceneDepth(
+      putatives, {left_.view.camera, left_.depth}, {right_.view.camera, right_.depth});
+  size_t kept = 0, kept_correct = 0;
+  for (size_t m = 0; m < truth.size(); ++m) {
+    if (!(last_->matches[m].kept_by & 1u) || truth[m] == MatchTruth::kUnknown) continue;
+    ++kept;
+    kept_correct += truth[m] == MatchTruth::kCorrect;
+  }
+  ASSERT_GT(kept, 20u);
+  EXPECT_GE(static_cast<double>(kept_correct) / kept, 0.9);  // gsc's precision on this pair
+}
+
+TEST_F(MatcherNodeTest, RefusesBadPairsAndCarriesOn) {
+  const cv::Mat black = cv::Mat::zeros(left_.image.size(), CV_8UC3);
+  std::vector<ros::Time> bad;
+  bad.push_back(publishPair(black, black));             // fewer than two keypoints
+  bad.push_back(publishPair(left_.image, cv::Mat()));   // a left image without its right partner
+  bad.push_back(publishPair(cv::Mat(), right_.image));  // a right image without its left partner
+  sensor_msgs::Image empty = bgrImage(left_.image, ros::Time::now(), "left");
+  empty.width = empty.height = empty.step = 0;  // an empty image
+  empty.data.clear();
+  left_pub_.publish(empty);
+  right_pub_.publish(bgrImage(right_.image, empty.header.stamp, "right"));
+  bad.push_back(empty.header.stamp);
+  sensor_msgs::Image depth = bgrImage(right_.image, ros::Time::now(), "right");
+  depth.encoding = "16UC1";  // not an 8-bit image
+  depth.step = right_.image.cols * 2;
+  depth.data.resize(depth.step * depth.height);
+  left_pub_.publish(bgrImage(left_.image, depth.header.stamp, "left"));
+  right_pub_.publish(depth);
+  bad.push_back(depth.header.stamp);
+  const ros::Time stamp = publishPair(left_.image, right_.image);
+  ASSERT_TRUE(answeredAtLeast(stamp)) << "a good pair after bad ones was not matched";
+  ros::WallDuration(0.5).sleep();  // a bad pair that was matched after all would be in by now
+  ros::spinOnce();
+  expectNoneAnswered(bad);
+  EXPECT_EQ(answered_.size(), 1u);
+}
+
+TEST_F(MatcherNodeTest, ThresholdsChangeAtRunTime) {
+  const auto keptByGsc = [&] {
+    size_t kept = 0;
+    for (const sift_hull::Correspondence& c : last_->matches) kept += c.kept_by & 1u;
+    return kept;
+  };
+  ros::Time stamp = publishPair(left_.image, right_.image);
+  ASSERT_TRUE(answeredAtLeast(stamp));
+  ASSERT_GT(keptByGsc(), 20u);
+  dynamic_reconfigure::Reconfigure change;
+  dynamic_reconfigure::DoubleParameter threshold;
+  threshold.name = "gsc_max_histogram_distance";
+  threshold.value = 0.0;
+  change.request.config.doubles.push_back(threshold);
+  ASSERT_TRUE(ros::service::waitForService("/matcher/set_parameters", ros::Duration(kDeadline_s)));
+  ASSERT_TRUE(ros::service::call("/matcher/set_parameters", change));
+  stamp = publishPair(left_.image, right_.image);
+  ASSERT_TRUE(answeredAtLeast(stamp));
+  EXPECT_LT(keptByGsc(), 3u);  // histograms equal to the last bin: hardly any
+  EXPECT_NE(last_->filter_settings.find("\"gsc_max_histogram_distance\":0.0"), std::string::npos)
+      << last_->filter_settings;
+}
+
+/// One image topic: each frame is matched with the one before it.
+class FrameToFrameMatcherTest : public MatcherNodeTest {
+ protected:
+  bool inputsConnected() const override { return frame_pub_.getNumSubscribers() > 0; }
+  void advertise() override { frame_pub_ = nh_.advertise<sensor_msgs::Image>("image", 5); }
+};
+
+/// Compressed images (PNG and JPEG) on left/image/compressed and right/image/compressed, with
+/// ~image_transport: compressed: decoded by the node when no image_transport plugin does it.
+class CompressedMatcherTest : public MatcherNodeTest {
+ protected:
+  bool inputsConnected() const override {
+    return left_compressed_pub_.getNumSubscribers() > 0 &&
+           right_compressed_pub_.getNumSubscribers() > 0;
+  }
+  void advertise() override {
+    left_compressed_pub_ = nh_.advertise<sensor_msgs::CompressedImage>("left/image/compressed", 5);
+    right_compressed_pub_ =
+        nh_.advertise<sensor_msgs::CompressedImage>("right/image/compressed", 5);
+  }
+  static sensor_msgs::CompressedImage compressed(const cv::Mat& image, const ros::Time& stamp,
+                                                 const std::string& frame,
+                                                 const std::string& format) {
+    sensor_msgs::CompressedImage message;
+    message.header.stamp = stamp;
+    message.header.frame_id = frame;
+    message.format = "bgr8; " + format + " compressed bgr8";
+    cv::imencode("." + format, image, message.data);
+    return message;
+  }
+
+  ros::Publisher left_compressed_pub_, right_compressed_pub_;
+};
+
+TEST_F(CompressedMatcherTest, DecodesCompressedPairsAndRefusesUndecodableOnes) {
+  sensor_msgs::CompressedImage garbage = compressed(left_.image, ros::Time::now(), "left", "png");
+  garbage.data.resize(100);  // truncated: not decodable
+  left_compressed_pub_.publish(garbage);
+  right_compressed_pub_.publish(compressed(right_.image, garbage.header.stamp, "right", "png"));
+  for (const char* format : {"png", "jpg"}) {
+    const ros::Time stamp = ros::Time::now();
+    left_compressed_pub_.publish(compressed(left_.image, stamp, "left", format));
+    right_compressed_pub_.publish(compressed(right_.image, stamp, "right", format));
+    ASSERT_TRUE(answeredAtLeast(stamp)) << format << ": no correspondences";
+    EXPECT_EQ(last_->header.stamp, stamp);
+    EXPECT_EQ(last_->right_header.frame_id, "right");
+    EXPECT_GE(last_->matches.size(), 50u) << format;
+  }
+  expectNoneAnswered({garbage.header.stamp});
+}
+
+TEST_F(FrameToFrameMatcherTest, MatchesEachFrameWithThePreviousOne) {
+  const ros::Time first = ros::Time::now();
+  frame_pub_.publish(bgrImage(left_.image, first, "camera"));
+  ros::WallDuration(0.2).sleep();
+  const ros::Time second = first + ros::Duration(0.5);
+  frame_pub_.publish(bgrImage(right_.image, second, "camera"));
+  ASSERT_TRUE(waitFor([&] { return last_ && last_->right_header.stamp == second; }));
+  EXPECT_EQ(last_->header.stamp, first);  // the earlier frame is the left image
+  EXPECT_GE(last_->matches.size(), 50u);
+  // A frame older than the previous one is refused; the next newer one is matched.
+  frame_pub_.publish(bgrImage(left_.image, first, "camera"));
+  const ros::Time third = second + ros::Duration(0.5);
+  frame_pub_.publish(bgrImage(left_.image, third, "camera"));
+  ASSERT_TRUE(waitFor([&] { return last_->right_header.stamp == third; }));
+  EXPECT_EQ(last_->header.stamp, second);
+}
+
+/// The same pair with camera_info and the right camera's pose relative to the left in tf.
+class CalibratedMatcherTest : public MatcherNodeTest {
+ protected:
+  void SetUp() override {
+    MatcherNodeTest::SetUp();
+    left_info_pub_ = nh_.advertise<sensor_msgs::CameraInfo>("left/camera_info", 5);
+    right_info_pub_ = nh_.advertise<sensor_msgs::CameraInfo>("right/camera_info", 5);
+    points_sub_ = nh_.subscribe("points", 5, &CalibratedMatcherTest::onPoints, this);
+    // The left camera's frame is the "world" of the right camera's pose.
+    const PinholeCamera& left = left_.view.camera;
+    const PinholeCamera& right = right_.view.camera;
+    const PinholeCamera right_in_left(right.K(), right.R() * left.R().transpose(),
+                                      right.t() - right.R() * left.R().transpose() * left.t());
+    tf_.sendTransform(ros_conversions::cameraPoseMessage(right_in_left, "left", "right", {}));
+    ASSERT_TRUE(waitFor([&] {
+      return left_info_pub_.getNumSubscribers() > 0 && right_info_pub_.getNumSubscribers() > 0 &&
+             points_sub_.getNumPublishers() > 0;
+    }));
+  }
+
+  ros::Time publishCalibratedPair() {
+    const ros::Time stamp = ros::Time::now();
+    std_msgs::Header header;
+    header.stamp = stamp;
+    header.frame_id = "left";
+    left_info_pub_.publish(
+        ros_conversions::cameraInfoMessage(left_.view.camera, left_.image.size(), header));
+    header.frame_id = "right";
+    right_info_pub_.publish(
+        ros_conversions::cameraInfoMessage(right_.view.camera, right_.image.size(), header));
+    left_pub_.publish(bgrImage(left_.image, stamp, "left"));
+    right_pub_.publish(bgrImage(right_.image, stamp, "right"));
+    return stamp;
+  }
+
+  void onPoints(const sensor_msgs::PointCloud2ConstPtr& message) { points_ = message; }
+
+  tf2_ros::StaticTransformBroadcaster tf_;
+  ros::Publisher left_info_pub_, right_info_pub_;
+  ros::Subscriber points_sub_;
+  sensor_msgs::PointCloud2ConstPtr points_;
+};
+
+TEST_F(CalibratedMatcherTest, FiltersByEpipolarLinesAndTriangulatesOntoTheScene) {
+  const ros::Time stamp = publishCalibratedPair();
+  ASSERT_TRUE(answeredAtLeast(stamp)) << "no correspondences for the calibrated pair";
+  ASSERT_EQ(last_->filters, (std::vector<std::string>{"epipolar", "gsc"}));
+  ASSERT_TRUE(waitFor([&] { return points_ && points_->header.stamp == stamp; }));
+  EXPECT_EQ(points_->header.frame_id, "left");
+  // Each point, in the left camera's frame, lies where the left depth map says (within 2 %).
+  const PinholeCamera camera(left_.view.camera.K(), Eigen::Matrix3d::Identity(),
+                             Eigen::Vector3d::Zero());
+  size_t points = 0, on_surface = 0;
+  for (sensor_msgs::PointCloud2ConstIterator<float> p(*points_, "x"); p != p.end(); ++p) {
+    const Eigen::Vector3d X(p[0], p[1], p[2]);
+    const Eigen::Vector2d pixel = camera.project(X);
+    const int u = static_cast<int>(std::lround(pixel.x())),
+              v = static_cast<int>(std::lround(pixel.y()));
+    ++points;
+    if (u < 0 || v < 0 || u >= left_.depth.cols || v >= left_.depth.rows) continue;
+    on_surface += std::abs(left_.depth.at<float>(v, u) - X.z()) < 0.02 * X.z();
+  }
+  ASSERT_GE(points, 20u);
+  EXPECT_GE(static_cast<double>(on_surface) / points, 0.9);
+}
+
+}  // namespace
+}  // namespace sift_hull
+
+int main(int argc, char** argv) {
+  ::testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_matcher_node");
+  ros::NodeHandle nh;
+  return RUN_ALL_TESTS();
+}

@@ -1,0 +1,46 @@
+// The hull node's record of silhouettes waiting for their pose: reported once after the timeout,
+// refused when the pose comes too late, forgotten when tf gives up, bounded in size.
+
+#include <gtest/gtest.h>
+
+#include "lib/pose_waits.h"
+
+namespace sift_hull {
+namespace {
+
+using std::chrono::milliseconds;
+
+TEST(PoseWaits, ReportsAWaitOnceAfterTheTimeoutAndRefusesItsLatePose) {
+  PoseWaits waits(1.0, 10);
+  const auto t0 = PoseWaits::Clock::now();
+  waits.arrived("camera_a", 1.0, t0);
+  waits.arrived("camera_b", 1.0, t0 + milliseconds(600));
+  EXPECT_TRUE(waits.expire(t0 + milliseconds(900)).empty());
+  EXPECT_EQ(waits.expire(t0 + milliseconds(1100)), std::vector<std::string>{"camera_a"});
+  EXPECT_TRUE(waits.expire(t0 + milliseconds(1200)).empty());  // once
+  EXPECT_FALSE(waits.posed("camera_a", 1.0));                  // too late: not carved
+  EXPECT_TRUE(waits.posed("camera_b", 1.0));                   // in time
+  EXPECT_EQ(waits.size(), 0u);
+  EXPECT_TRUE(waits.posed("camera_unknown", 2.0));
+}
+
+TEST(PoseWaits, ForgetsWhatTfGaveUpOnAndStaysBounded) {
+  PoseWaits waits(1.0, 3);
+  const auto t0 = PoseWaits::Clock::now();
+  for (int i = 0; i < 5; ++i) waits.arrived("camera", i, t0 + milliseconds(i));
+  EXPECT_EQ(waits.size(), 3u);
+  EXPECT_TRUE(waits.posed("camera", 0.0));  // forgotten as the oldest: unknown
+  waits.forget("camera", 4.0);
+  EXPECT_EQ(waits.size(), 2u);
+}
+
+TEST(PoseWaits, NoTimeoutWhenNotPositive) {
+  PoseWaits waits(0.0, 3);
+  const auto t0 = PoseWaits::Clock::now();
+  waits.arrived("camera", 1.0, t0);
+  EXPECT_TRUE(waits.expire(t0 + std::chrono::hours(1)).empty());
+  EXPECT_TRUE(waits.posed("camera", 1.0));
+}
+
+}  // namespace
+}  // namespace sift_hull
