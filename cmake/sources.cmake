@@ -10,6 +10,7 @@ set(SIFT_HULL_CORE_SOURCES
   src/core/geometry/correspondence.cpp
   src/core/features/matching.cpp
   src/core/features/sift.cpp
+  src/core/features/triangulation.cpp
   src/core/filters/epipolar.cpp
   src/core/filters/filter.cpp
   src/core/filters/gms.cpp

@@ -8,9 +8,12 @@
 #include <sensor_msgs/image_encodings.h>
 #include <tf2_eigen/tf2_eigen.h>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <sstream>
+#include <stdexcept>
 
 #include "sift_hull/limits.h"
 #include "sift_hull/hull/mesh.h"
@@ -286,6 +289,71 @@ visualization_msgs::Marker meshMarker(const TriangleMesh& mesh, const std_msgs::
     }
   }
   return marker;
+}
+
+sift_hull::Keypoint keypointMessage(const cv::KeyPoint& keypoint) {
+  sift_hull::Keypoint message;
+  message.x = keypoint.pt.x;
+  message.y = keypoint.pt.y;
+  message.size = keypoint.size;
+  message.angle = keypoint.angle;
+  message.response = keypoint.response;
+  message.octave = keypoint.octave;
+  return message;
+}
+
+sift_hull::Correspondences correspondencesMessage(const std_msgs::Header& left_header,
+                                                  const std_msgs::Header& right_header,
+                                                  const std::vector<std::string>& filter_names,
+                                                  const std::string& settings_json,
+                                                  const PutativeMatches& matches,
+                                                  const std::vector<FilterResult>& results) {
+  if (filter_names.size() != results.size() || results.size() > 32) {
+    throw std::invalid_argument("correspondencesMessage: " + std::to_string(filter_names.size()) +
+                                " filter names for " + std::to_string(results.size()) +
+                                " results (at most 32)");
+  }
+  for (const FilterResult& result : results) {
+    if (result.keep.size() != matches.matches.size() ||
+        result.score.size() != matches.matches.size()) {
+      throw std::invalid_argument("correspondencesMessage: a filter result has not one entry "
+                                  "per match");
+    }
+  }
+  sift_hull::Correspondences out;
+  out.header = left_header;
+  out.right_header = right_header;
+  out.filters = filter_names;
+  out.filter_settings = settings_json;
+  const auto gsc = std::find(filter_names.begin(), filter_names.end(), "gsc");
+  const FilterResult* gsc_result =
+      gsc == filter_names.end() ? nullptr : &results[gsc - filter_names.begin()];
+  for (size_t m = 0; m < matches.matches.size(); ++m) {
+    sift_hull::Correspondence correspondence;
+    correspondence.left = keypointMessage(matches.left(m));
+    correspondence.right = keypointMessage(matches.right(m));
+    correspondence.descriptor_distance = matches.matches[m].distance;
+    correspondence.gsc_score = gsc_result ? gsc_result->score[m] : std::nanf("");
+    for (size_t f = 0; f < results.size(); ++f) {
+      if (results[f].keep[m]) correspondence.kept_by |= 1u << f;
+    }
+    out.matches.push_back(correspondence);
+  }
+  return out;
+}
+
+std::string settingsJson(const MatchConfig& matching, const FilterConfigs& filters) {
+  const nlohmann::json json = {
+      {"ratio", matching.ratio},
+      {"max_descriptor_distance", std::isfinite(matching.max_descriptor_distance)
+                                      ? nlohmann::json(matching.max_descriptor_distance)
+                                      : nlohmann::json(nullptr)},
+      {"cross_check", matching.cross_check},
+      {"gsc_max_histogram_distance", filters.gsc.max_histogram_distance},
+      {"ransac_max_epipolar_px", filters.ransac.max_epipolar_px},
+      {"magsac_max_epipolar_px", filters.magsac.max_epipolar_px},
+      {"gms_threshold_factor", filters.gms.threshold_factor}};
+  return json.dump();
 }
 
 }  // namespace ros_conversions

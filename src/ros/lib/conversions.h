@@ -12,8 +12,13 @@
 #include <Eigen/Geometry>
 #include <opencv2/core.hpp>
 #include <string>
+#include <vector>
 
+#include "sift_hull/Correspondences.h"
+#include "sift_hull/Keypoint.h"
 #include "sift_hull/Octomap.h"
+#include "sift_hull/features/matching.h"
+#include "sift_hull/filters/filter.h"
 #include "sift_hull/geometry/camera.h"
 #include "sift_hull/hull/mesh.h"
 
@@ -85,6 +90,25 @@ visualization_msgs::MarkerArray occupiedCellsMarkers(const octomap::OcTree& tree
 
 /// The mesh as a TRIANGLE_LIST marker in the header's frame, metres.
 visualization_msgs::Marker meshMarker(const TriangleMesh& mesh, const std_msgs::Header& header);
+
+/// A keypoint as a message: position (pixels), size, angle (degrees), response, octave as OpenCV
+/// holds them.
+sift_hull::Keypoint keypointMessage(const cv::KeyPoint& keypoint);
+
+/// Every putative match with the decision of each filter: bit f of `kept_by` set when
+/// `results[f]` keeps the match (`filter_names[f]` names it), `gsc_score` the score of the filter
+/// named "gsc" (NaN without one), the left image's header, the right one's as `right_header`.
+/// Throws std::invalid_argument when names and results differ in number, a result has not one
+/// entry per match, or there are more than 32 filters.
+sift_hull::Correspondences correspondencesMessage(const std_msgs::Header& left_header,
+                                                  const std_msgs::Header& right_header,
+                                                  const std::vector<std::string>& filter_names,
+                                                  const std::string& settings_json,
+                                                  const PutativeMatches& matches,
+                                                  const std::vector<FilterResult>& results);
+
+/// The matching and filter settings as the JSON object of Correspondences.filter_settings.
+std::string settingsJson(const MatchConfig& matching, const FilterConfigs& filters);
 
 }  // namespace ros_conversions
 }  // namespace sift_hull

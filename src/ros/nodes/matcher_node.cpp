@@ -5,12 +5,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <nlohmann/json.hpp>
 
 #include "lib/conversions.h"
 #include "lib/node_diagnostics.h"
 #include "lib/ros_params.h"
 #include "sift_hull/eval/match_drawing.h"
+#include "sift_hull/features/triangulation.h"
 #include "sift_hull/filters/filter.h"
 #include "sift_hull/filters/filter_result.h"
 #include "lib/wall_wait.h"
@@ -35,32 +35,6 @@ std::vector<std::unique_ptr<MatchFilter>> makeFilters(const MatcherSettings& set
   return filters;
 }
 
-std::string settingsJson(const MatcherSettings& settings) {
-  const FilterConfigs& f = settings.filters;
-  const nlohmann::json json = {
-      {"ratio", settings.matching.ratio},
-      {"max_descriptor_distance", std::isfinite(settings.matching.max_descriptor_distance)
-                                      ? nlohmann::json(settings.matching.max_descriptor_distance)
-                                      : nlohmann::json(nullptr)},
-      {"cross_check", settings.matching.cross_check},
-      {"gsc_max_histogram_distance", f.gsc.max_histogram_distance},
-      {"ransac_max_epipolar_px", f.ransac.max_epipolar_px},
-      {"magsac_max_epipolar_px", f.magsac.max_epipolar_px},
-      {"gms_threshold_factor", f.gms.threshold_factor}};
-  return json.dump();
-}
-
-sift_hull::Keypoint keypointMessage(const cv::KeyPoint& keypoint) {
-  sift_hull::Keypoint message;
-  message.x = keypoint.pt.x;
-  message.y = keypoint.pt.y;
-  message.size = keypoint.size;
-  message.angle = keypoint.angle;
-  message.response = keypoint.response;
-  message.octave = keypoint.octave;
-  return message;
-}
-
 }  // namespace
 
 MatcherNode::MatcherNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
@@ -71,7 +45,7 @@ MatcherNode::MatcherNode(ros::NodeHandle nh, ros::NodeHandle private_nh, Matcher
       private_nh_(private_nh),
       settings_(std::move(settings)),
       pipeline_(std::make_shared<const Pipeline>(
-          Pipeline{settings_, makeFilters(settings_), settingsJson(settings_)})),
+          Pipeline{settings_, makeFilters(settings_), ros_conversions::settingsJson(settings_.matching, settings_.filters)})),
       transport_(nh_),
       correspondences_pub_(
           nh_.advertise<sift_hull::Correspondences>("correspondences", settings_.node.queue_size)),
@@ -132,7 +106,8 @@ void MatcherNode::onReconfigure(sift_hull::MatcherConfig& config, uint32_t) {
     validate(changed.matching);
     validate(changed.filters);
     replacement = std::make_shared<const Pipeline>(
-        Pipeline{changed, makeFilters(changed), settingsJson(changed)});
+        Pipeline{changed, makeFilters(changed),
+                 ros_conversions::settingsJson(changed.matching, changed.filters)});
   } catch (const std::invalid_argument& e) {
     log_.error("matcher: reconfiguration refused: ", e.what());
     return;
@@ -276,7 +251,10 @@ void MatcherNode::process(const Pipeline& pipeline, const sensor_msgs::ImageCons
   if (cameras != nullptr) matches.F_right_left = fundamentalMatrix(cameras->left, cameras->right);
   std::vector<FilterResult> results;
   for (const auto& filter : pipeline.filters) results.push_back(filter->apply(matches));
-  correspondences_pub_.publish(message(pipeline, *left, *right, matches, results));
+  std::vector<std::string> names;
+  for (const auto& filter : pipeline.filters) names.push_back(filter->name());
+  correspondences_pub_.publish(ros_conversions::correspondencesMessage(
+      left->header, right->header, names, pipeline.settings_json, matches, results));
   if (cameras != nullptr) publishPoints(left->header, *cameras, matches, results.front());
   if (matches_image_pub_.getNumSubscribers() > 0) {
     const cv::Mat drawing = drawMatchDecisions(left_image, right_image, matches, results.front());
@@ -286,44 +264,8 @@ void MatcherNode::process(const Pipeline& pipeline, const sensor_msgs::ImageCons
 
 void MatcherNode::publishPoints(const std_msgs::Header& header, const StereoCameras& cameras,
                                 const PutativeMatches& matches, const FilterResult& kept) {
-  std::vector<Eigen::Vector3d> points_L;
-  for (size_t m = 0; m < matches.matches.size(); ++m) {
-    if (!kept.keep[m]) continue;
-    const cv::Point2f& left = matches.left(m).pt;
-    const cv::Point2f& right = matches.right(m).pt;
-    const std::optional<Eigen::Vector3d> point =
-        triangulate(cameras.left, cameras.right, Eigen::Vector2d(left.x, left.y),
-                    Eigen::Vector2d(right.x, right.y));
-    if (point) points_L.push_back(*point);
-  }
-  points_pub_.publish(ros_conversions::pointCloudMessage(points_L, header));
-}
-
-sift_hull::Correspondences MatcherNode::message(const Pipeline& pipeline,
-                                                const sensor_msgs::Image& left,
-                                                const sensor_msgs::Image& right,
-                                                const PutativeMatches& matches,
-                                                const std::vector<FilterResult>& results) {
-  sift_hull::Correspondences out;
-  out.header = left.header;
-  out.right_header = right.header;
-  for (const auto& filter : pipeline.filters) out.filters.push_back(filter->name());
-  out.filter_settings = pipeline.settings_json;
-  const auto gsc = std::find(out.filters.begin(), out.filters.end(), "gsc");
-  const FilterResult* gsc_result =
-      gsc == out.filters.end() ? nullptr : &results[gsc - out.filters.begin()];
-  for (size_t m = 0; m < matches.matches.size(); ++m) {
-    sift_hull::Correspondence correspondence;
-    correspondence.left = keypointMessage(matches.left(m));
-    correspondence.right = keypointMessage(matches.right(m));
-    correspondence.descriptor_distance = matches.matches[m].distance;
-    correspondence.gsc_score = gsc_result ? gsc_result->score[m] : std::nanf("");
-    for (size_t f = 0; f < results.size(); ++f) {
-      if (results[f].keep[m]) correspondence.kept_by |= 1u << f;
-    }
-    out.matches.push_back(correspondence);
-  }
-  return out;
+  points_pub_.publish(ros_conversions::pointCloudMessage(
+      triangulateMatches(cameras.left, cameras.right, matches, kept.keep), header));
 }
 
 }  // namespace sift_hull

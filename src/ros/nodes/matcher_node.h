@@ -128,11 +128,6 @@ class MatcherNode {
                      const Info& right_info, StereoCameras* cameras);
   void publishPoints(const std_msgs::Header& header, const StereoCameras& cameras,
                      const PutativeMatches& matches, const FilterResult& kept);
-  static sift_hull::Correspondences message(const Pipeline& pipeline,
-                                            const sensor_msgs::Image& left,
-                                            const sensor_msgs::Image& right,
-                                            const PutativeMatches& matches,
-                                            const std::vector<FilterResult>& results);
 
   // Destroyed bottom up: subscriptions first, then the workers, then what they publish with.
   ros::NodeHandle nh_, private_nh_;
