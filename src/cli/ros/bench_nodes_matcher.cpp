@@ -1,0 +1,112 @@
+// bench-nodes, the matcher: a 640x480 stereo stream at a given rate and number of workers.
+
+#include "bench_nodes.h"
+
+namespace sift_hull {
+namespace cli {
+namespace bench_nodes {
+
+StereoStream stereoStream() {
+  SceneConfig config;  // 16 views, 640x480
+  StereoStream stream;
+  for (const RenderedView& view : renderScene(config)) {
+    stream.frames.push_back(ros_conversions::imageMessage(view.image, std_msgs::Header()));
+  }
+  return stream;
+}
+
+class MatcherFeed {
+ public:
+  MatcherFeed(ros::NodeHandle& nh, const StereoStream& stream)
+      : stream_(stream),
+        left_(nh.advertise<sensor_msgs::Image>("left/image", 2)),
+        right_(nh.advertise<sensor_msgs::Image>("right/image", 2)) {}
+
+  bool connected() const { return left_.getNumSubscribers() > 0 && right_.getNumSubscribers() > 0; }
+  ros::Time publish(int k, const std::string& frame_suffix = "") {
+    const size_t n = stream_.frames.size();
+    sensor_msgs::Image left = stream_.frames[k % n], right = stream_.frames[(k + 1) % n];
+    left.header.stamp = right.header.stamp = ros::Time::now();
+    left.header.frame_id = "left" + frame_suffix;
+    right.header.frame_id = "right" + frame_suffix;
+    left_.publish(left);
+    right_.publish(right);
+    return left.header.stamp;
+  }
+
+ private:
+  const StereoStream& stream_;
+  ros::Publisher left_, right_;
+};
+
+using SendTimes = std::map<ros::Time, ros::WallTime>;
+
+/// Sends pairs at `run->input_hz` for `seconds`, sampling the node's memory; when each was sent.
+SendTimes streamPairs(MatcherFeed& feed, pid_t pid, double seconds, MatcherRun* run) {
+  SendTimes sent;
+  const ros::WallTime start = ros::WallTime::now();
+  for (int k = 0; (ros::WallTime::now() - start).toSec() < seconds; ++k) {
+    const ros::WallTime due = start + ros::WallDuration(k / run->input_hz);
+    if (ros::WallTime::now() < due) (due - ros::WallTime::now()).sleep();
+    sent[feed.publish(k)] = ros::WallTime::now();
+    const double rss = residentMiB(pid);
+    if (run->rss_first_mib == 0.0 && (ros::WallTime::now() - start).toSec() > 1.0) {
+      run->rss_first_mib = rss;
+    }
+    run->rss_max_mib = std::max(run->rss_max_mib, rss);
+  }
+  return sent;
+}
+
+/// Answered rate (from the first pair sent to the last answer) and median latency.
+void summariseAnswers(const SendTimes& sent, const ArrivalLog<sift_hull::Correspondences>& answers,
+                      MatcherRun* run) {
+  std::vector<double> latencies;
+  const ros::WallTime start = sent.begin()->second;
+  ros::WallTime last_answer = start;
+  for (const auto& [stamp, when] : sent) {
+    const std::optional<ros::WallTime> arrival = answers.arrival(stamp);
+    if (!arrival) continue;
+    latencies.push_back((*arrival - when).toSec() * 1e3);
+    last_answer = std::max(last_answer, *arrival);
+  }
+  run->answered = static_cast<int>(latencies.size());
+  run->answered_per_s = run->answered / std::max((last_answer - start).toSec(), 1e-9);
+  run->latency_ms = median(latencies);
+}
+
+MatcherRun runMatcher(RosHarness& harness, const StereoStream& stream, int workers, double input_hz,
+                      double seconds) {
+  const pid_t pid = harness.startNode(
+      "matcher_node", nodeArguments("matcher", {"_workers:=" + std::to_string(workers)}));
+  ros::NodeHandle nh;
+  MatcherFeed feed(nh, stream);
+  ArrivalLog<sift_hull::Correspondences> answers(nh, "correspondences");
+  DiagnosticsListener diagnostics(nh, "matcher");
+  if (!waitUntil([&] { return feed.connected() && answers.connected(); })) {
+    throw std::runtime_error("bench-nodes: matcher_node did not connect");
+  }
+  for (int k = 0; k < 2; ++k) {  // warm-up, answered one by one
+    const ros::Time stamp = feed.publish(k);
+    waitUntil([&] { return answers.arrival(stamp).has_value(); });
+  }
+  MatcherRun run{workers, input_hz};
+  const SendTimes sent = streamPairs(feed, pid, seconds, &run);
+  run.published = static_cast<int>(sent.size());
+  waitUntil(
+      [&] {
+        const double settled =
+            diagnostics.value("pairs processed") + diagnostics.value("pairs dropped");
+        return settled >= run.published + 2;  // and the two of the warm-up
+      },
+      10.0);
+  run.rss_last_mib = residentMiB(pid);
+  run.dropped = diagnostics.value("pairs dropped");
+  summariseAnswers(sent, answers, &run);
+  harness.stopNode(pid);
+  return run;
+}
+
+}  // namespace bench_nodes
+}  // namespace cli
+}  // namespace sift_hull
