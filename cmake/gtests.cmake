@@ -6,9 +6,12 @@ set(SIFT_HULL_CORE_GTESTS
   test_camera core
   test_bounding_box core
   test_gms core
+  test_triangulation core
+  test_layout core
   test_mesh core
   test_dataset io
   test_ply io
+  test_ground_truth_files io
   test_features eval
   test_filters eval
   test_evaluation eval
@@ -17,6 +20,7 @@ set(SIFT_HULL_CORE_GTESTS
   test_hull eval
   test_hull_data eval
   test_hull_stream eval
+  test_hull_stream_refusals eval
   test_hardening eval
 )
 # The harnesses of test/fuzz whose corpus test_fuzz_corpus replays: CamelCase entry point names,

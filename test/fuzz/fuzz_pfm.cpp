@@ -1,4 +1,4 @@
-// libFuzzer harness: sift_hull::readPfm (depth_io.h) on arbitrary file contents. Any std::exception
+// libFuzzer harness: sift_hull::readPfm (io/pfm.h) on arbitrary file contents. Any std::exception
 // is accepted; a crash, abort, sanitizer report, leak or time-out is a finding.
 #include "fuzz_input_file.h"
 #include "sift_hull/io/pfm.h"

@@ -4,7 +4,7 @@
 Small, valid files of each format (plus a few edge cases), made from the formats as the readers
 and writers in src/core define them: readMiddleburyPar / writeMiddleburyPar (dataset.cpp),
 readProjectionList, readHomography (evaluation.cpp, Oxford's H1to2p layout), readPfm / writePfm
-(depth_io.cpp), readPly / writePly (mesh.cpp), and the byte layout of fuzz_bounding_box.cpp.
+(io/pfm.cpp), readPly / writePly (io/ply.cpp), and the byte layout of fuzz_bounding_box.cpp.
 Not written here: the copies of ../shared/repro's files (par_c_1e39.txt, par_t_1e307.txt,
 pfm_4GiB_header.pfm) and the regress_* files, fixed findings kept as regression inputs
 (test/fuzz/findings/README.md). Deterministic: running it again gives the same bytes.

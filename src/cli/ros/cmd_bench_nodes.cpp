@@ -60,7 +60,7 @@ nlohmann::json targetsJson(const std::vector<MatcherRun>& matcher,
 std::string markdownReport(const std::vector<MatcherRun>& matcher,
                            const std::vector<HullRun>& hulls, const nlohmann::json& targets) {
   std::ostringstream out;
-  out << "Written by `sift_hull bench-nodes --write docs/BENCHMARKS.md` on " << todayUtc() << ", "
+  out << "Written by `sift_hull_ros bench-nodes --write docs/BENCHMARKS.md` on " << todayUtc() << ", "
       << std::thread::hardware_concurrency() << " hardware threads. The nodes run as processes "
       << "of their own against a ROS master of their own; this program publishes their input and "
       << "subscribes their output over TCP, as `rosbag play` and rviz would.\n\n"

@@ -1,0 +1,147 @@
+// The layout's rules (docs/ARCHITECTURE.md), checked on the source tree: each stage includes only
+// the stages below it, the core and the offline program include no ROS header, and no source file
+// grows past 450 lines.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <map>
+#include <regex>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace sift_hull {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kRoot = SIFT_HULL_SOURCE_DIR;
+
+/// The stages each stage may include (itself always).
+const std::map<std::string, std::set<std::string>>& allowedIncludes() {
+  static const std::map<std::string, std::set<std::string>> allowed = {
+      {"geometry", {}},
+      {"features", {"geometry"}},
+      {"filters", {"geometry", "features"}},
+      {"hull", {"geometry"}},
+      {"io", {"geometry", "features", "filters", "hull"}},
+      {"synthetic", {"geometry", "features", "filters", "hull", "io"}},
+      {"eval", {"geometry", "features", "filters", "hull", "io"}},
+  };
+  return allowed;
+}
+
+std::vector<fs::path> sourcesUnder(const fs::path& directory) {
+  std::vector<fs::path> files;
+  if (!fs::exists(directory)) return files;
+  for (const auto& entry : fs::recursive_directory_iterator(directory)) {
+    const std::string extension = entry.path().extension().string();
+    if (extension == ".h" || extension == ".cpp") files.push_back(entry.path());
+  }
+  return files;
+}
+
+/// The quoted and angled includes of a file.
+std::vector<std::string> includesOf(const fs::path& file) {
+  std::ifstream in(file);
+  std::vector<std::string> includes;
+  const std::regex include(R"(^\s*#\s*include\s*[<"]([^>"]+)[>"])");
+  std::smatch match;
+  for (std::string line; std::getline(in, line);) {
+    if (std::regex_search(line, match, include)) includes.push_back(match[1]);
+  }
+  return includes;
+}
+
+/// The stage of a file under include/sift_hull/<stage>/ or src/core/<stage>/ (empty otherwise).
+std::string stageOf(const fs::path& file) {
+  const fs::path relative = fs::relative(file, kRoot);
+  auto part = relative.begin();
+  const std::string top = (part++)->string();
+  const std::string second = part == relative.end() ? "" : (part++)->string();
+  if ((top == "include" && second == "sift_hull") || (top == "src" && second == "core")) {
+    if (part == relative.end() || std::next(part) == relative.end()) return "";  // no folder
+    return part->string();
+  }
+  return "";
+}
+
+/// A header of ROS, of a ROS package, of the package's generated messages (sift_hull/Foo.h), or
+/// of its ROS library (src/ros).
+bool isRosHeader(const std::string& include) {
+  static const std::regex ros(
+      R"(^(ros|rosbag|sensor_msgs|std_msgs|geometry_msgs|visualization_msgs|tf2[a-z_]*|cv_bridge|)"
+      R"(image_transport|nodelet|pluginlib|pcl_conversions|dynamic_reconfigure|message_filters|)"
+      R"(diagnostic_[a-z_]+|std_srvs|lib|nodes|nodelets)/|^sift_hull/[A-Z]\w*\.h$|\.\./ros/)");
+  return std::regex_search(include, ros);
+}
+
+std::vector<fs::path> coreFiles() {
+  std::vector<fs::path> files = sourcesUnder(kRoot / "include" / "sift_hull");
+  for (const fs::path& file : sourcesUnder(kRoot / "src" / "core")) files.push_back(file);
+  return files;
+}
+
+TEST(LayoutTest, EachStageIncludesOnlyTheStagesBelowIt) {
+  const std::regex stage_include(R"(^(?:sift_hull/)?([a-z_]+)/[a-z_]+\.h$)");
+  std::set<std::string> stages;
+  for (const fs::path& file : coreFiles()) {
+    const std::string stage = stageOf(file);
+    if (stage.empty() || stage == "common" || fs::is_directory(file)) continue;
+    ASSERT_TRUE(allowedIncludes().count(stage)) << file << ": a folder the layout does not know";
+    stages.insert(stage);
+    for (const std::string& include : includesOf(file)) {
+      std::smatch match;
+      if (!std::regex_match(include, match, stage_include)) continue;
+      const std::string other = match[1];
+      if (other == stage || other == "common" || !allowedIncludes().count(other)) continue;
+      EXPECT_TRUE(allowedIncludes().at(stage).count(other))
+          << fs::relative(file, kRoot) << " (" << stage << ") includes " << include << " ("
+          << other << ")";
+    }
+  }
+  EXPECT_EQ(stages.size(), allowedIncludes().size()) << "a stage folder has gone missing";
+}
+
+TEST(LayoutTest, RosHeadersAreRecognised) {
+  for (const char* include : {"ros/ros.h", "sensor_msgs/Image.h", "tf2_ros/buffer.h",
+                              "sift_hull/Octomap.h", "lib/conversions.h", "../ros/free_port.h"}) {
+    EXPECT_TRUE(isRosHeader(include)) << include;
+  }
+  for (const char* include : {"sift_hull/hull/octree.h", "sift_hull/limits.h", "opencv2/core.hpp",
+                              "octomap/OcTree.h", "common/parallel.h"}) {
+    EXPECT_FALSE(isRosHeader(include)) << include;
+  }
+}
+
+TEST(LayoutTest, TheCoreAndTheOfflineProgramIncludeNoRosHeader) {
+  std::vector<fs::path> files = coreFiles();
+  for (const fs::path& file : sourcesUnder(kRoot / "src" / "cli")) {
+    if (fs::relative(file, kRoot / "src" / "cli").begin()->string() != "ros") files.push_back(file);
+  }
+  ASSERT_GT(files.size(), 50u);
+  for (const fs::path& file : files) {
+    for (const std::string& include : includesOf(file)) {
+      EXPECT_FALSE(isRosHeader(include)) << fs::relative(file, kRoot) << " includes " << include;
+    }
+  }
+}
+
+TEST(LayoutTest, NoSourceFileExceeds450Lines) {
+  std::vector<fs::path> files;
+  for (const char* directory : {"include", "src", "test"}) {
+    for (const fs::path& file : sourcesUnder(kRoot / directory)) files.push_back(file);
+  }
+  ASSERT_GT(files.size(), 100u);
+  for (const fs::path& file : files) {
+    std::ifstream in(file);
+    size_t lines = 0;
+    for (std::string line; std::getline(in, line);) ++lines;
+    EXPECT_LE(lines, 450u) << fs::relative(file, kRoot);
+  }
+}
+
+}  // namespace
+}  // namespace sift_hull
