@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "common/test_data.h"
+
 namespace sift_hull {
 namespace {
 
@@ -126,6 +128,16 @@ TEST(LayoutTest, TheCoreAndTheOfflineProgramIncludeNoRosHeader) {
     for (const std::string& include : includesOf(file)) {
       EXPECT_FALSE(isRosHeader(include)) << fs::relative(file, kRoot) << " includes " << include;
     }
+  }
+}
+
+TEST(LayoutTest, TheOfflineProgramLinksNoRosLibrary) {
+  std::string out, err;
+  ASSERT_EQ(test::runCommand("ldd " + std::string(SIFT_HULL_EXECUTABLE), &out, &err), 0) << err;
+  ASSERT_NE(out.find("libsift_hull_core"), std::string::npos) << out;  // ldd read the program
+  for (const char* library : {"libroscpp", "librosbag", "libcv_bridge", "libtf2", "librostime"}) {
+    EXPECT_EQ(out.find(library), std::string::npos) << "sift_hull links " << library << ":\n"
+                                                    << out;
   }
 }
 
