@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -123,8 +124,10 @@ bool cameraFromInfo(const sensor_msgs::CameraInfo& info, const Eigen::Isometry3d
                     cv::Size image_size, PinholeCamera* camera, std::string* why_not) {
   Eigen::Matrix3d K;
   if (!intrinsicsFromInfo(info, &K, why_not)) return false;
-  if (image_size.area() > 0 && (static_cast<int>(info.width) != image_size.width ||
-                                static_cast<int>(info.height) != image_size.height)) {
+  // Sides compared as they are: their product (cv::Size::area) overflows int for large images.
+  const bool has_size = image_size.width > 0 && image_size.height > 0;
+  if (has_size && (static_cast<int64_t>(info.width) != image_size.width ||
+                   static_cast<int64_t>(info.height) != image_size.height)) {
     std::ostringstream message;
     message << "camera_info is " << info.width << "x" << info.height << " but the silhouette is "
             << image_size.width << "x" << image_size.height;
