@@ -1,5 +1,6 @@
 #include "commands.h"
 
+#include <algorithm>
 #include <cstdlib>
 #include <cstring>
 #include <exception>
@@ -51,6 +52,13 @@ int runMain(const Program& program, int argc, char** argv) {
     return args.empty() ? 2 : 0;
   }
   const Command* command = findCommand(program, args[0]);
+  const auto& others = program.other_commands;
+  if (command == nullptr && std::find(others.begin(), others.end(), args[0]) != others.end()) {
+    std::cerr << program.name << ": '" << args[0] << "' is a command of " << program.other_name
+              << ", not of " << program.name << ": run '" << program.other_name << " " << args[0]
+              << "'\n";
+    return 2;
+  }
   if (command == nullptr) {
     std::cerr << program.name << ": unknown command '" << args[0] << "'\n\n";
     printUsage(program, std::cerr);

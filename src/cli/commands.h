@@ -20,6 +20,9 @@ struct Command {
 struct Program {
   const char* name;
   std::vector<Command> commands;
+  /// The other program and its commands, named in the error for one of them given here.
+  const char* other_name = nullptr;
+  std::vector<std::string> other_commands = {};
 };
 
 

@@ -18,7 +18,9 @@ const Program& offlineProgram() {
        runEvaluateFilters},
       {"hull", "visual hull of calibrated silhouettes: octree, OctoMap and mesh", runHull},
       {"bench-hull", "time the visual hull against dense carving on dino and temple", runBenchHull},
-  }};
+  },
+                                 "sift_hull_ros",
+                                 {"bag", "bench-nodes"}};
   return program;
 }
 

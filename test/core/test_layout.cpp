@@ -141,6 +141,15 @@ TEST(LayoutTest, TheOfflineProgramLinksNoRosLibrary) {
   }
 }
 
+TEST(LayoutTest, TheOfflineProgramNamesWhereTheRosCommandsWent) {
+  for (const char* command : {"bag", "bench-nodes"}) {
+    std::string out, err;
+    EXPECT_EQ(test::runProgram(command, &out, &err), 2) << command;
+    EXPECT_NE(err.find("run 'sift_hull_ros " + std::string(command) + "'"), std::string::npos)
+        << err;
+  }
+}
+
 TEST(LayoutTest, NoSourceFileExceeds450Lines) {
   std::vector<fs::path> files;
   for (const char* directory : {"include", "src", "test"}) {

@@ -17,6 +17,8 @@ int main(int argc, char** argv) {
       "sift_hull_ros",
       {{"bag", "write calibrated views as a ROS bag that drives both nodes", runBag},
        {"bench-nodes", "time the matcher and hull nodes as processes on topic streams",
-        runBenchNodes}}};
+        runBenchNodes}},
+      "sift_hull",
+      {"dataset-info", "scene", "match", "bench-filters", "evaluate-filters", "hull", "bench-hull"}};
   return runMain(program, argc, argv);
 }
