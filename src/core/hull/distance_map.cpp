@@ -1,0 +1,93 @@
+#include "sift_hull/hull/distance_map.h"
+
+#include "hull/distance_kernel.h"
+
+#include <algorithm>
+#include <opencv2/imgproc.hpp>
+#include <stdexcept>
+
+namespace sift_hull {
+namespace {
+
+void checkMask(const cv::Mat& mask) {
+  if (mask.empty() || mask.type() != CV_8UC1) {
+    throw std::invalid_argument("silhouette must be a non-empty CV_8UC1 mask");
+  }
+}
+
+/// Distance of each pixel of `region` (non-zero) to the nearest pixel outside it; 0 outside.
+cv::Mat distanceWithin(const cv::Mat& region) {
+  cv::Mat distance;
+  cv::distanceTransform(region, distance, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
+  return distance;
+}
+
+/// The mask with a border of `padding` pixels, inside where withinBounds: the bounds' rectangle
+/// (open sides reaching the map's edge) clipped to the map, then the mask over it.
+cv::Mat paddedMask(const cv::Mat& mask, const SilhouetteBounds& bounds, int padding) {
+  cv::Mat padded = cv::Mat::zeros(mask.rows + 2 * padding, mask.cols + 2 * padding, CV_8UC1);
+  if (!bounds.empty) {
+    // Pixel u lies within [u_min, u_max] exactly when ceil(u_min) <= u <= floor(u_max).
+    const int first_col =
+        bounds.has_u_min ? static_cast<int>(std::ceil(bounds.u_min_px)) + padding : 0;
+    const int last_col = bounds.has_u_max ? static_cast<int>(std::floor(bounds.u_max_px)) + padding
+                                          : padded.cols - 1;
+    const int first_row =
+        bounds.has_v_min ? static_cast<int>(std::ceil(bounds.v_min_px)) + padding : 0;
+    const int last_row = bounds.has_v_max ? static_cast<int>(std::floor(bounds.v_max_px)) + padding
+                                          : padded.rows - 1;
+    const cv::Rect kept =
+        cv::Rect(first_col, first_row, last_col - first_col + 1, last_row - first_row + 1) &
+        cv::Rect(0, 0, padded.cols, padded.rows);
+    padded(kept).setTo(255);
+  }
+  const cv::Mat inside = mask != 0;
+  inside.copyTo(padded(cv::Rect(padding, padding, mask.cols, mask.rows)));
+  return padded;
+}
+
+/// The inside pixels' bounding box grown by `margin` on every side, within the image; the whole
+/// image when nothing is inside; at least 2x2 (for bilinear look-ups).
+cv::Rect mapWindow(const cv::Mat& inside, int margin) {
+  const cv::Rect image(0, 0, inside.cols, inside.rows);
+  cv::Rect window = cv::boundingRect(inside);
+  if (window.empty()) return image;
+  window = cv::Rect(window.x - margin, window.y - margin, window.width + 2 * margin,
+                    window.height + 2 * margin) &
+           image;
+  window.width = std::max(window.width, 2);
+  window.height = std::max(window.height, 2);
+  return window & image;
+}
+
+}  // namespace
+
+SignedDistanceMap::SignedDistanceMap(const cv::Mat& mask, const SilhouetteBounds& bounds,
+                                     int padding_px)
+    : image_size_(mask.size()) {
+  checkMask(mask);
+  const cv::Mat padded = paddedMask(mask, bounds, padding_px);
+  const cv::Rect window = mapWindow(padded, padding_px);
+  origin_ = window.tl() - cv::Point(padding_px, padding_px);
+  const cv::Mat inside = padded(window).clone();
+  const cv::Mat to_inside = distanceWithin(inside == 0);
+  distance_px_ = distanceWithin(inside);
+  // Pixel distances are between centres; the boundary lies half a pixel from the last centre.
+  for (int row = 0; row < inside.rows; ++row) {
+    const uint8_t* is_inside = inside.ptr<uint8_t>(row);
+    const float* outside_distance = to_inside.ptr<float>(row);
+    float* distance = distance_px_.ptr<float>(row);
+    for (int col = 0; col < inside.cols; ++col) {
+      distance[col] = is_inside[col] ? 0.5f - distance[col] : outside_distance[col] - 0.5f;
+    }
+  }
+}
+
+float SignedDistanceMap::at(double u_px, double v_px) const {
+  return detail::lookUp(distance_px_.ptr<float>(), distance_px_.cols,
+                        detail::lookUpLimit(distance_px_.cols),
+                        detail::lookUpLimit(distance_px_.rows),
+                        static_cast<float>(u_px - origin_.x), static_cast<float>(v_px - origin_.y));
+}
+
+}  // namespace sift_hull
