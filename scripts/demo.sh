@@ -35,10 +35,10 @@ match=(match "$out/scene/view_0000.png" "$out/scene/view_0001.png" --gt-scene "$
 
 echo "offline: carving the visual hull of the 16 views (depth 7) ..."
 "$sift_hull" hull --calib "$out/scene/scene_par.txt" --images "$out/scene" \
-  --silhouettes "$out/scene/masks" --depth 7 --out-mesh "$out/hull.ply" \
+  --silhouettes "$out/scene/masks" --max-depth 7 --out-mesh "$out/hull.ply" \
   --out-octree "$out/hull.bt" --out-render "$out/hull.png" --json >"$out/hull.json"
 "$sift_hull" hull --calib "$out/scene/scene_par.txt" --images "$out/scene" \
-  --silhouettes "$out/scene/masks" --depth 7 | tail -n 1
+  --silhouettes "$out/scene/masks" --max-depth 7 | tail -n 1
 
 cat <<SUMMARY
 

@@ -1,5 +1,6 @@
 #include "args.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -21,13 +22,31 @@ ArgParser::ArgParser(std::string command, std::string summary)
 
 void ArgParser::addFlag(const std::string& name, const std::string& help) {
   order_.push_back(name);
-  specs_[name] = {"", help, ""};
+  specs_[name] = {"", help, "", {}};
 }
 
 void ArgParser::addOption(const std::string& name, const std::string& value_name,
                           const std::string& help, const std::string& default_value) {
   order_.push_back(name);
-  specs_[name] = {value_name, help, default_value};
+  specs_[name] = {value_name, help, default_value, {}};
+}
+
+void ArgParser::addDeprecatedAlias(const std::string& old_name,
+                                   const std::vector<std::string>& names) {
+  if (names.empty() || specs_.count(old_name) > 0) {
+    throw std::logic_error("addDeprecatedAlias: bad alias --" + old_name);
+  }
+  std::string uses;
+  for (const std::string& name : names) {
+    const auto spec = specs_.find(name);
+    if (spec == specs_.end() || !spec->second.replaced_by.empty() ||
+        spec->second.value_name.empty() != specs_.at(names.front()).value_name.empty()) {
+      throw std::logic_error("addDeprecatedAlias: --" + old_name + " cannot stand for --" + name);
+    }
+    uses += (uses.empty() ? "--" : " and --") + name;
+  }
+  order_.push_back(old_name);
+  specs_[old_name] = {specs_.at(names.front()).value_name, "deprecated: use " + uses, "", names};
 }
 
 void ArgParser::addPositional(const std::string& name, const std::string& help) {
@@ -42,6 +61,7 @@ bool ArgParser::parse(const std::vector<std::string>& args) {
     }
   }
   size_t next_positional = 0;
+  std::vector<std::pair<std::string, std::string>> aliased;  // (deprecated name, value)
   for (size_t i = 0; i < args.size(); ++i) {
     const std::string& arg = args[i];
     if (arg.rfind("--", 0) != 0) {
@@ -55,21 +75,52 @@ bool ArgParser::parse(const std::vector<std::string>& args) {
         arg.substr(2, equals == std::string::npos ? std::string::npos : equals - 2);
     const auto spec = specs_.find(name);
     if (spec == specs_.end()) throw UsageError("unknown option --" + name);
+    std::string value;
     if (spec->second.value_name.empty()) {
       if (equals != std::string::npos) throw UsageError("--" + name + " takes no value");
-      store(name, "1");
+      value = "1";
     } else if (equals != std::string::npos) {
-      store(name, arg.substr(equals + 1));
+      value = arg.substr(equals + 1);
     } else if (i + 1 < args.size()) {
-      store(name, args[++i]);
+      value = args[++i];
     } else {
       throw UsageError("--" + name + " needs a value (" + spec->second.value_name + ")");
+    }
+    if (spec->second.replaced_by.empty()) {
+      store(name, value);
+    } else {
+      aliased.emplace_back(name, value);
     }
   }
   if (next_positional < positionals_.size()) {
     throw UsageError("missing argument " + positionals_[next_positional].first);
   }
+  resolveAliases(aliased);
   return true;
+}
+
+void ArgParser::resolveAliases(const std::vector<std::pair<std::string, std::string>>& given) {
+  std::vector<std::string> warned;
+  std::map<std::string, bool> given_directly;
+  for (const auto& [old_name, value] : given) {
+    const std::vector<std::string>& names = specs_.at(old_name).replaced_by;
+    std::string uses, ignored_for;
+    for (const std::string& name : names) {
+      uses += (uses.empty() ? "--" : " and --") + name;
+      if (given_directly.count(name) == 0) given_directly[name] = values_.count(name) > 0;
+      if (given_directly[name]) {
+        ignored_for += (ignored_for.empty() ? "--" : ", --") + name;
+      } else {
+        store(name, value);
+      }
+    }
+    if (std::find(warned.begin(), warned.end(), old_name) != warned.end()) continue;
+    warned.push_back(old_name);
+    std::cerr << program_name << " " << command_ << ": warning: --" << old_name
+              << " is deprecated, use " << uses;
+    if (!ignored_for.empty()) std::cerr << " (" << ignored_for << ", given too, wins)";
+    std::cerr << '\n';
+  }
 }
 
 std::string ArgParser::help() const {
@@ -80,13 +131,24 @@ std::string ArgParser::help() const {
   for (const auto& positional : positionals_) {
     out << "\n  " << positional.first << "\n      " << positional.second;
   }
-  for (const std::string& name : order_) {
+  const auto option = [&](const std::string& name) {
     const Spec& spec = specs_.at(name);
     out << "\n  --" << name << (spec.value_name.empty() ? "" : " " + spec.value_name) << "\n      "
         << spec.help;
     if (!spec.default_value.empty()) out << " (default: " << spec.default_value << ")";
+  };
+  for (const std::string& name : order_) {
+    if (specs_.at(name).replaced_by.empty()) option(name);
   }
   out << "\n  --help\n      show this text\n";
+  bool deprecated = false;
+  for (const std::string& name : order_) {
+    if (specs_.at(name).replaced_by.empty()) continue;
+    if (!deprecated) out << "\nDeprecated names, still accepted with a warning on stderr:";
+    deprecated = true;
+    option(name);
+  }
+  if (deprecated) out << "\n";
   return out.str();
 }
 

@@ -81,7 +81,7 @@ struct DatasetRuns {
   std::string name;
   size_t views = 0;
   std::vector<DepthRun> depths;
-  /// Of a separate `sift_hull hull --depth 9` process: through buildHull, and in all.
+  /// Of a separate `sift_hull hull --max-depth 9` process: through buildHull, and in all.
   double peak_mib_depth9 = 0.0, command_peak_mib_depth9 = 0.0;
 };
 
@@ -100,7 +100,7 @@ DatasetRuns benchDataset(const HullInput& input, const std::string& name) {
 /// OctoMap, the IoU and the outputs}.
 nlohmann::json hullCommandPeakMiB(const std::string& directory, const HullDataset& dataset) {
   const std::string self = std::filesystem::read_symlink("/proc/self/exe").string();
-  std::string command = "'" + self + "' hull --depth 9 --json --threshold " +
+  std::string command = "'" + self + "' hull --max-depth 9 --json --threshold " +
                         std::to_string(dataset.threshold) + " --calib '" + directory + "/" +
                         dataset.calibration + "' --images '" + directory + "'";
   if (!dataset.view_list.empty())
@@ -175,7 +175,7 @@ std::string markdownReport(const std::vector<DatasetRuns>& all, const nlohmann::
   out << "Written by `sift_hull bench-hull --write docs/BENCHMARKS.md` on " << todayUtc() << ", "
       << std::thread::hardware_concurrency() << " hardware threads, 2 carving threads. Times are "
       << "medians of at least 3 runs (dense carving: at least 1, more within 3 s).\n\n"
-      << markdownTable(all) << "\nPeak resident memory of `sift_hull hull --depth 9`, through "
+      << markdownTable(all) << "\nPeak resident memory of `sift_hull hull --max-depth 9`, through "
       << "the hull (images, silhouettes, distance maps, octree, mesh) / the whole command (also "
       << "the OctoMap conversion and the IoU rasterisation):";
   for (const DatasetRuns& runs : all) {

@@ -31,7 +31,7 @@ void writeOutputs(const ArgParser& parser, const HullResult& result,
 
 std::string hullText(const nlohmann::json& result) {
   std::ostringstream text;
-  text << result["views"] << " views, depth " << result["depth"] << " (voxel "
+  text << result["views"] << " views, depth " << result["max_depth"] << " (voxel "
        << result["resolution"] << "), box " << result["bbox"]["min"] << " .. "
        << result["bbox"]["max"] << "\noccupied leaves " << result["occupied_leaves"] << ", mesh "
        << result["mesh"]["vertices"] << " vertices, " << result["mesh"]["faces"]

@@ -45,7 +45,7 @@ SceneConfig configFromArgs(const ArgParser& parser) {
   config.shape = parser.get("shape");
   config.layout = parser.get("layout");
   config.seed = static_cast<unsigned>(parser.getInt("seed"));
-  config.camera_distance_m = parser.getDouble("distance");
+  config.camera_distance_m = parser.getDouble("camera-distance-m");
   validateOptions(config);
   return config;
 }
@@ -65,8 +65,9 @@ int runScene(const std::vector<std::string>& args) {
   parser.addOption("shape", "NAME", "one of " + joined(Shape::names()), defaults.shape);
   parser.addOption("layout", "NAME", "camera layout: ring or sphere", defaults.layout);
   parser.addOption("seed", "S", "texture and camera jitter seed", std::to_string(defaults.seed));
-  parser.addOption("distance", "M", "camera distance from the object's centre in metres",
+  parser.addOption("camera-distance-m", "M", "camera distance from the object's centre in metres",
                    formatNumber(defaults.camera_distance_m));
+  parser.addDeprecatedAlias("distance", {"camera-distance-m"});
   parser.addFlag("json", "print the result as one JSON object");
   if (!parser.parse(args)) return 0;
   const SceneConfig config = configFromArgs(parser);

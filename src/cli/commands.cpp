@@ -72,7 +72,7 @@ int runMain(const Program& program, int argc, char** argv) {
     return 2;
   } catch (const std::bad_alloc&) {
     std::cerr << program.name << " " << command->name
-              << ": error: out of memory; lower --depth or use smaller images\n";
+              << ": error: out of memory; lower --max-depth or use smaller images\n";
     return 1;
   } catch (const std::exception& e) {
     std::cerr << program.name << " " << command->name << ": error: " << e.what() << '\n';

@@ -61,11 +61,13 @@ void addHullOptions(ArgParser* parser) {
   const HullConfig defaults;
   std::ostringstream slack;
   slack << defaults.distance_slack_px;
-  parser->addOption("depth", "L", "octree depth: resolution = cube edge / 2^L",
+  parser->addOption("max-depth", "L", "octree depth: resolution = cube edge / 2^L",
                     std::to_string(defaults.max_depth));
+  parser->addDeprecatedAlias("depth", {"max-depth"});
   parser->addFlag("carve-outside-image", "views carve what they see outside their image");
-  parser->addOption("slack", "PX", "margin added to a cell's projected radius, in pixels",
-                    slack.str());
+  parser->addOption("distance-slack-px", "PX",
+                    "margin added to a cell's projected radius, in pixels", slack.str());
+  parser->addDeprecatedAlias("slack", {"distance-slack-px"});
   parser->addOption("threads", "N", "threads for distance transforms, carving and meshing",
                     std::to_string(defaults.threads));
   parser->addOption("box", "XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX",
@@ -74,9 +76,9 @@ void addHullOptions(ArgParser* parser) {
 
 HullConfig hullConfigFromArgs(const ArgParser& parser) {
   HullConfig config;
-  config.max_depth = parser.getInt("depth");
+  config.max_depth = parser.getInt("max-depth");
   config.carve_outside_image = parser.flag("carve-outside-image");
-  config.distance_slack_px = parser.getDouble("slack");
+  config.distance_slack_px = parser.getDouble("distance-slack-px");
   config.threads = parser.getInt("threads");
   validateOptions(config);
   return config;
@@ -104,7 +106,7 @@ nlohmann::json hullJson(const HullResult& result, size_t occupied_leaves,
   const HullTimings& time = result.time;
   return {{"views", result.hull.views().size()},
           {"bbox", {{"min", vectorJson(result.box.min_W)}, {"max", vectorJson(result.box.max_W)}}},
-          {"depth", result.hull.cube().depth},
+          {"max_depth", result.hull.cube().depth},
           {"resolution", result.hull.cube().resolution_m},
           {"occupied_leaves", occupied_leaves},
           {"mesh",

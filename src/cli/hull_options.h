@@ -19,7 +19,8 @@ void addViewSetOptions(ArgParser* parser);
 /// The views those options name (all when neither --views nor --views-file is given).
 HullInput viewSetFromArgs(const ArgParser& parser);
 
-/// --depth, --carve-outside-image, --slack, --threads, with HullConfig's defaults.
+/// --max-depth, --carve-outside-image, --distance-slack-px, --threads, with HullConfig's
+/// defaults (deprecated: --depth, --slack).
 void addHullOptions(ArgParser* parser);
 HullConfig hullConfigFromArgs(const ArgParser& parser);
 

@@ -23,7 +23,8 @@ void addSiftOptions(ArgParser* parser) {
   parser->addOption("contrast-threshold", "T", "SIFT contrast threshold",
                     text(sift.contrast_threshold));
   parser->addOption("edge-threshold", "T", "SIFT edge threshold", text(sift.edge_threshold));
-  parser->addOption("sigma", "PX", "SIFT base blur in pixels", text(sift.sigma_px));
+  parser->addOption("sigma-px", "PX", "SIFT base blur in pixels", text(sift.sigma_px));
+  parser->addDeprecatedAlias("sigma", {"sigma-px"});
   parser->addOption("max-image-pixels", "N", "larger images are refused",
                     std::to_string(sift.max_image_pixels));
 }
@@ -31,36 +32,49 @@ void addSiftOptions(ArgParser* parser) {
 void addMatchingOptions(ArgParser* parser) {
   const MatchConfig matching;
   parser->addOption("ratio", "R", "Lowe's ratio test; 1 turns it off", text(matching.ratio));
-  parser->addOption("max-distance", "D",
+  parser->addOption("max-descriptor-distance", "D",
                     "largest descriptor distance kept (SIFT descriptors have norm 512)", "inf");
+  parser->addDeprecatedAlias("max-distance", {"max-descriptor-distance"});
   parser->addFlag("cross-check", "keep only mutual nearest neighbours");
-  parser->addOption("matcher", "NAME", "brute-force or flann", matching.backend);
+  parser->addOption("backend", "NAME", "brute-force or flann", matching.backend);
+  parser->addDeprecatedAlias("matcher", {"backend"});
 }
 
 void addFilterOptions(ArgParser* parser) {
   const FilterConfigs filters;
   parser->addOption("max-epipolar-px", "PX", "epipolar: largest point-to-line distance",
                     text(filters.epipolar.max_epipolar_px));
-  parser->addOption("gsc-max-distance", "D", "gsc: largest histogram distance kept",
+  parser->addOption("max-histogram-distance", "D", "gsc: largest histogram distance kept",
                     text(filters.gsc.max_histogram_distance));
+  parser->addDeprecatedAlias("gsc-max-distance", {"max-histogram-distance"});
   parser->addOption("threads", "N", "gsc: threads (0: all)", text(filters.gsc.threads));
-  parser->addOption("ransac-px", "PX", "ransac and magsac: inlier threshold",
+  parser->addOption("ransac-max-epipolar-px", "PX", "ransac: inlier threshold",
                     text(filters.ransac.max_epipolar_px));
-  parser->addOption("gms-cells", "N", "gms: grid cells per image side",
+  parser->addOption("magsac-max-epipolar-px", "PX", "magsac: inlier threshold",
+                    text(filters.magsac.max_epipolar_px));
+  parser->addDeprecatedAlias("ransac-px", {"ransac-max-epipolar-px", "magsac-max-epipolar-px"});
+  parser->addOption("grid-cells", "N", "gms: grid cells per image side",
                     text(filters.gms.grid_cells));
-  parser->addFlag("gms-rotation", "gms: try rotated neighbourhoods");
-  parser->addFlag("gms-scale", "gms: try scaled right grids");
+  parser->addDeprecatedAlias("gms-cells", {"grid-cells"});
+  parser->addOption("threshold-factor", "A", "gms: alpha in the cell-pair threshold alpha sqrt(n)",
+                    text(filters.gms.threshold_factor));
+  parser->addFlag("with-rotation", "gms: try rotated neighbourhoods");
+  parser->addDeprecatedAlias("gms-rotation", {"with-rotation"});
+  parser->addFlag("with-scale", "gms: try scaled right grids");
+  parser->addDeprecatedAlias("gms-scale", {"with-scale"});
 }
 
 FilterConfigs filterConfigsFromArgs(const ArgParser& parser) {
   FilterConfigs filters;
   filters.epipolar.max_epipolar_px = parser.getDouble("max-epipolar-px");
-  filters.gsc.max_histogram_distance = parser.getDouble("gsc-max-distance");
+  filters.gsc.max_histogram_distance = parser.getDouble("max-histogram-distance");
   filters.gsc.threads = parser.getInt("threads");
-  filters.ransac.max_epipolar_px = filters.magsac.max_epipolar_px = parser.getDouble("ransac-px");
-  filters.gms.grid_cells = parser.getInt("gms-cells");
-  filters.gms.with_rotation = parser.flag("gms-rotation");
-  filters.gms.with_scale = parser.flag("gms-scale");
+  filters.ransac.max_epipolar_px = parser.getDouble("ransac-max-epipolar-px");
+  filters.magsac.max_epipolar_px = parser.getDouble("magsac-max-epipolar-px");
+  filters.gms.grid_cells = parser.getInt("grid-cells");
+  filters.gms.threshold_factor = parser.getDouble("threshold-factor");
+  filters.gms.with_rotation = parser.flag("with-rotation");
+  filters.gms.with_scale = parser.flag("with-scale");
   return filters;
 }
 
@@ -77,16 +91,16 @@ MatchOptions matchOptionsFromArgs(const ArgParser& parser) {
   options.sift.max_features = parser.getInt("max-features");
   options.sift.contrast_threshold = parser.getDouble("contrast-threshold");
   options.sift.edge_threshold = parser.getDouble("edge-threshold");
-  options.sift.sigma_px = parser.getDouble("sigma");
+  options.sift.sigma_px = parser.getDouble("sigma-px");
   const int max_image_pixels = parser.getInt("max-image-pixels");
   if (max_image_pixels < 1) throw UsageError("--max-image-pixels must be >= 1");
   options.sift.max_image_pixels = static_cast<size_t>(max_image_pixels);
   options.matching.ratio = parser.getDouble("ratio");
-  options.matching.max_descriptor_distance = parser.get("max-distance") == "inf"
+  options.matching.max_descriptor_distance = parser.get("max-descriptor-distance") == "inf"
                                                  ? std::numeric_limits<double>::infinity()
-                                                 : parser.getDouble("max-distance");
+                                                 : parser.getDouble("max-descriptor-distance");
   options.matching.cross_check = parser.flag("cross-check");
-  options.matching.backend = parser.get("matcher");
+  options.matching.backend = parser.get("backend");
   options.filters = filterConfigsFromArgs(parser);
   try {
     validate(options.sift);

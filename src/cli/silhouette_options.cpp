@@ -16,17 +16,19 @@ void addSilhouetteOptions(ArgParser* parser) {
                     "the images)");
   parser->addOption("threshold", "T", "silhouette threshold on grey intensity in [0, 1]",
                     threshold.str());
-  parser->addOption("dilate", "PX", "silhouette dilation radius in pixels",
+  parser->addOption("dilate-px", "PX", "silhouette dilation radius in pixels",
                     std::to_string(defaults.dilate_px));
-  parser->addOption("erode", "PX", "silhouette erosion radius in pixels",
+  parser->addDeprecatedAlias("dilate", {"dilate-px"});
+  parser->addOption("erode-px", "PX", "silhouette erosion radius in pixels",
                     std::to_string(defaults.erode_px));
+  parser->addDeprecatedAlias("erode", {"erode-px"});
 }
 
 SilhouetteConfig silhouetteConfigFromArgs(const ArgParser& parser) {
   SilhouetteConfig config;
   config.threshold = parser.getDouble("threshold");
-  config.dilate_px = parser.getInt("dilate");
-  config.erode_px = parser.getInt("erode");
+  config.dilate_px = parser.getInt("dilate-px");
+  config.erode_px = parser.getInt("erode-px");
   validateOptions(config);
   return config;
 }

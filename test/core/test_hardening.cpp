@@ -257,7 +257,7 @@ class HostileCommandLine : public ::testing::Test {
     std::string out;
     const std::string par = calib.empty() ? *scene_ + "/scene_par.txt" : calib;
     return test::runProgram("hull --calib " + par + " --images " + *scene_ + " --silhouettes " +
-                                *scene_ + "/masks --depth 6 " + extra,
+                                *scene_ + "/masks --max-depth 6 " + extra,
                             &out, err);
   }
 
@@ -291,12 +291,12 @@ TEST_F(HostileCommandLine, HugeCoordinatesEndInAClearError) {
 
 TEST_F(HostileCommandLine, OutOfRangeSettingsAreUsageErrors) {
   std::string err, out;
-  EXPECT_EQ(hull("--depth 12", &err), 2);
+  EXPECT_EQ(hull("--max-depth 12", &err), 2);
   EXPECT_TRUE(contains(err, "max_depth")) << err;
   EXPECT_EQ(hull("--threads 100000", &err), 2);
   EXPECT_EQ(hull("--views ,", &err), 2);
   const std::string left = *scene_ + "/view_0000.png", right = *scene_ + "/view_0001.png";
-  EXPECT_EQ(test::runProgram("match " + left + " " + right + " --filter gms --gms-cells 100000",
+  EXPECT_EQ(test::runProgram("match " + left + " " + right + " --filter gms --grid-cells 100000",
                              &out, &err),
             2);
   EXPECT_EQ(test::runProgram("match " + left + " " + right + " --filter +gsc", &out, &err), 2);
@@ -316,7 +316,7 @@ TEST_F(HostileCommandLine, AViewOfAnotherSizeIsRefused) {
   cv::resize(cv::imread(dir + "/view_0003.png"), big, cv::Size(640, 480));
   cv::imwrite(dir + "/view_0003.png", big);
   EXPECT_EQ(test::runProgram("hull --calib " + dir + "/scene_par.txt --images " + dir +
-                                 " --threshold 0.1 --depth 6",
+                                 " --threshold 0.1 --max-depth 6",
                              &out, &err),
             1);
   EXPECT_TRUE(contains(err, "image size differs")) << err;
