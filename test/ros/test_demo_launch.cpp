@@ -36,7 +36,7 @@ class DemoLaunch : public ::testing::TestWithParam<bool> {
     ASSERT_EQ(
         test::runRosProgram("bag" + views + " --rate 8 --out " + dir_ + "/scene.bag", &out, &err), 0)
         << err;
-    ASSERT_EQ(test::runProgram("hull" + views + " --depth " + std::to_string(kDepth) +
+    ASSERT_EQ(test::runProgram("hull" + views + " --max-depth " + std::to_string(kDepth) +
                                    " --out-mesh " + dir_ + "/offline.ply",
                                &out, &err),
               0)
@@ -47,10 +47,10 @@ class DemoLaunch : public ::testing::TestWithParam<bool> {
   static int runDemoLaunch(const std::string& out_dir, bool nodelets, std::string* log) {
     const int port = freeTcpPort();
     const std::string uri = "http://localhost:" + std::to_string(port);
-    const std::string command = "ROS_MASTER_URI=" + uri + " timeout 150 roslaunch -p " +
-                                std::to_string(port) + " sift_hull demo.launch bag:=" + dir_ +
-                                "/scene.bag out:=" + out_dir + " depth:=" + std::to_string(kDepth) +
-                                " nodelets:=" + (nodelets ? "true" : "false");
+    const std::string command =
+        "ROS_MASTER_URI=" + uri + " timeout 150 roslaunch -p " + std::to_string(port) +
+        " sift_hull demo.launch bag:=" + dir_ + "/scene.bag out:=" + out_dir +
+        " max_depth:=" + std::to_string(kDepth) + " nodelets:=" + (nodelets ? "true" : "false");
     std::string err;
     const int status = test::runCommand(command, log, &err);
     *log += err;

@@ -1,16 +1,21 @@
 // The parameter readers against a real parameter server: the parameter files in config/ restate
-// the config structs' defaults, unset parameters give those defaults, set ones are read, and a
-// parameter of the wrong type or value is an error rather than a silent default.
+// the config structs' defaults and state every parameter the readers read, unset parameters give
+// those defaults, set ones are read, a parameter of the wrong type or value is an error rather
+// than a silent default, and renamed parameters are still read under their old names, with a
+// warning.
 
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 
+#include <algorithm>
 #include <functional>
+#include <set>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "lib/ros_params.h"
-
+#include "sift_hull/MatcherConfig.h"
 #include "sift_hull/filters/filter.h"
 
 namespace sift_hull {
@@ -18,7 +23,27 @@ namespace {
 
 using ros_params::readHullNodeConfig;
 using ros_params::readHullStreamConfig;
+using ros_params::ReadLog;
 using ros_params::readMatcherSettings;
+
+void readHull(const ros::NodeHandle& nh) {
+  readHullNodeConfig(nh);
+  readHullStreamConfig(nh);
+}
+
+void readMatcher(const ros::NodeHandle& nh) { readMatcherSettings(nh); }
+
+/// The names `read` reads on `nh`.
+std::set<std::string> namesRead(const std::function<void(const ros::NodeHandle&)>& read,
+                                const ros::NodeHandle& nh) {
+  ReadLog log;
+  read(nh);
+  return log.names;
+}
+
+bool contains(const std::vector<std::string>& lines, const std::string& line) {
+  return std::find(lines.begin(), lines.end(), line) != lines.end();
+}
 
 void expectDefaultHull(const ros::NodeHandle& nh) {
   const HullNodeConfig node = readHullNodeConfig(nh), node_default;
@@ -26,6 +51,7 @@ void expectDefaultHull(const ros::NodeHandle& nh) {
   EXPECT_EQ(node.queue_size, node_default.queue_size);
   EXPECT_EQ(node.pose_timeout_s, node_default.pose_timeout_s);
   EXPECT_EQ(node.from_image, node_default.from_image);
+  EXPECT_EQ(node.diagnostic_period, node_default.diagnostic_period);
   EXPECT_EQ(node.recipe.threshold, node_default.recipe.threshold);
   EXPECT_EQ(node.recipe.dilate_px, node_default.recipe.dilate_px);
   EXPECT_EQ(node.recipe.erode_px, node_default.recipe.erode_px);
@@ -38,6 +64,8 @@ void expectDefaultHull(const ros::NodeHandle& nh) {
   EXPECT_TRUE(hull.skip_views.empty());
   EXPECT_EQ(hull.min_view_distance_m, hull_default.min_view_distance_m);
   EXPECT_EQ(hull.min_view_angle_deg, hull_default.min_view_angle_deg);
+  EXPECT_EQ(hull.max_waiting_views, hull_default.max_waiting_views);
+  EXPECT_EQ(hull.max_views, hull_default.max_views);
 }
 
 void expectDefaultMatcher(const ros::NodeHandle& nh) {
@@ -50,11 +78,13 @@ void expectDefaultMatcher(const ros::NodeHandle& nh) {
   EXPECT_EQ(read.node.calibrated, standard.node.calibrated);
   EXPECT_EQ(read.node.frame_to_frame, standard.node.frame_to_frame);
   EXPECT_EQ(read.node.image_transport, standard.node.image_transport);
+  EXPECT_EQ(read.node.diagnostic_period, standard.node.diagnostic_period);
   EXPECT_EQ(read.sift.max_features, standard.sift.max_features);
   EXPECT_EQ(read.sift.octave_layers, standard.sift.octave_layers);
   EXPECT_EQ(read.sift.contrast_threshold, standard.sift.contrast_threshold);
   EXPECT_EQ(read.sift.edge_threshold, standard.sift.edge_threshold);
   EXPECT_EQ(read.sift.sigma_px, standard.sift.sigma_px);
+  EXPECT_EQ(read.sift.max_image_pixels, standard.sift.max_image_pixels);
   EXPECT_EQ(read.matching.ratio, standard.matching.ratio);
   EXPECT_EQ(read.matching.max_descriptor_distance, standard.matching.max_descriptor_distance);
   EXPECT_EQ(read.matching.cross_check, standard.matching.cross_check);
@@ -78,7 +108,7 @@ void expectDefaultMatcher(const ros::NodeHandle& nh) {
 TEST(ParameterReaders, TheParameterFilesRestateTheStructDefaults) {
   // param_readers.test loads config/hull.yaml into /hull_yaml and config/matcher.yaml into
   // /matcher_yaml.
-  ASSERT_TRUE(ros::param::has("/hull_yaml/depth"));
+  ASSERT_TRUE(ros::param::has("/hull_yaml/max_depth"));
   ASSERT_TRUE(ros::param::has("/matcher_yaml/filters"));
   expectDefaultHull(ros::NodeHandle("/hull_yaml"));
   expectDefaultMatcher(ros::NodeHandle("/matcher_yaml"));
@@ -104,20 +134,38 @@ bool isRead(const std::string& ns, const std::string& key,
 }
 
 TEST(ParameterReaders, EveryKeyOfTheParameterFilesIsRead) {
-  const auto hull = [](const ros::NodeHandle& nh) {
-    readHullNodeConfig(nh);
-    readHullStreamConfig(nh);
-  };
-  const auto matcher = [](const ros::NodeHandle& nh) { readMatcherSettings(nh); };
   for (const auto& [ns, read] :
-       {std::pair<std::string, std::function<void(const ros::NodeHandle&)>>("/hull_yaml", hull),
-        {"/matcher_yaml", matcher}}) {
+       {std::pair<std::string, std::function<void(const ros::NodeHandle&)>>("/hull_yaml", readHull),
+        {"/matcher_yaml", readMatcher}}) {
     XmlRpc::XmlRpcValue file;
     ASSERT_TRUE(ros::param::get(ns, file));
     ASSERT_EQ(file.getType(), XmlRpc::XmlRpcValue::TypeStruct);
     for (const auto& [key, value] : file) {
       EXPECT_TRUE(isRead(ns, key, read)) << ns << "/" << key << " is not read by any reader";
     }
+  }
+}
+
+TEST(ParameterReaders, TheParameterFilesStateEveryParameterRead) {
+  for (const auto& [ns, read] :
+       {std::pair<std::string, std::function<void(const ros::NodeHandle&)>>("/hull_yaml", readHull),
+        {"/matcher_yaml", readMatcher}}) {
+    XmlRpc::XmlRpcValue file;
+    ASSERT_TRUE(ros::param::get(ns, file));
+    const std::set<std::string> names = namesRead(read, ros::NodeHandle("/nothing_set"));
+    EXPECT_GE(names.size(), 15u) << ns;
+    for (const std::string& name : names) {
+      EXPECT_TRUE(file.hasMember(name)) << name << " is read but not stated in the file of " << ns;
+    }
+    EXPECT_EQ(names.size(), static_cast<size_t>(file.size())) << ns;
+  }
+}
+
+TEST(ParameterReaders, TheReconfigureSettingsAreMatcherParameters) {
+  const std::set<std::string> names = namesRead(readMatcher, ros::NodeHandle("/nothing_set"));
+  for (const auto& description : MatcherConfig::__getParamDescriptions__()) {
+    EXPECT_EQ(names.count(description->name), 1u)
+        << description->name << " (cfg/Matcher.cfg) is not a matcher parameter";
   }
 }
 
@@ -128,7 +176,7 @@ TEST(ParameterReaders, UnsetParametersGiveTheStructDefaults) {
 
 TEST(ParameterReaders, SetParametersAreRead) {
   ros::NodeHandle nh("/set");
-  nh.setParam("depth", 6);
+  nh.setParam("max_depth", 6);
   nh.setParam("box", std::vector<double>{-1, -2, -3, 1, 2, 3});
   nh.setParam("skip_views", std::vector<std::string>{"view_0003"});
   nh.setParam("min_view_distance_m", 0);  // an integer where a number is expected is fine
@@ -157,7 +205,7 @@ TEST(ParameterReaders, WrongTypesAndValuesAreErrors) {
                std::invalid_argument);  // a string, as `_box:=[...]` on a command line gives
   EXPECT_THROW(readHullStreamConfig(hull_with("box", std::vector<double>{1, 2, 3})),
                std::invalid_argument);
-  EXPECT_THROW(readHullStreamConfig(hull_with("depth", 6.5)), std::invalid_argument);
+  EXPECT_THROW(readHullStreamConfig(hull_with("max_depth", 6.5)), std::invalid_argument);
   EXPECT_THROW(readHullStreamConfig(hull_with("min_view_angle_deg", -1.0)), std::invalid_argument);
   EXPECT_THROW(readHullNodeConfig(hull_with("from_image", std::string("yes"))),
                std::invalid_argument);
@@ -167,6 +215,90 @@ TEST(ParameterReaders, WrongTypesAndValuesAreErrors) {
   EXPECT_THROW(readHullNodeConfig(hull_with("queue_size", 0)), std::invalid_argument);
   EXPECT_THROW(readMatcherSettings(hull_with("max_waiting_pairs", -1)), std::invalid_argument);
   EXPECT_THROW(readMatcherSettings(hull_with("workers", 0)), std::invalid_argument);
+  EXPECT_THROW(readHullNodeConfig(hull_with("diagnostic_period", 0.0)), std::invalid_argument);
+  EXPECT_THROW(readMatcherSettings(hull_with("diagnostic_period", std::string("1"))),
+               std::invalid_argument);
+}
+
+TEST(ParameterReaders, OldNamesAreReadWithAWarning) {
+  ros::NodeHandle nh("/old_names");
+  nh.setParam("depth", 6);
+  nh.setParam("slack_px", 2.5);
+  nh.setParam("matcher", "flann");
+  nh.setParam("gsc_max_histogram_distance", 0.3);
+  nh.setParam("gsc_threads", 3);
+  nh.setParam("robust_confidence", 0.95);
+  nh.setParam("robust_max_iterations", 500);
+  nh.setParam("gms_grid_cells", 10);
+  nh.setParam("gms_threshold_factor", 4.0);
+  nh.setParam("gms_with_rotation", true);
+  nh.setParam("gms_with_scale", true);
+  ReadLog log;
+  const HullStreamConfig hull = readHullStreamConfig(nh);
+  EXPECT_EQ(hull.hull.max_depth, 6);
+  EXPECT_EQ(hull.hull.distance_slack_px, 2.5);
+  const MatcherSettings matcher = readMatcherSettings(nh);
+  EXPECT_EQ(matcher.matching.backend, "flann");
+  const FilterConfigs& f = matcher.filters;
+  EXPECT_EQ(f.gsc.max_histogram_distance, 0.3);
+  EXPECT_EQ(f.gsc.threads, 3);
+  for (const RobustFitConfig& robust : {f.ransac, f.magsac}) {
+    EXPECT_EQ(robust.confidence, 0.95);
+    EXPECT_EQ(robust.max_iterations, 500);
+  }
+  EXPECT_EQ(f.gms.grid_cells, 10);
+  EXPECT_EQ(f.gms.threshold_factor, 4.0);
+  EXPECT_TRUE(f.gms.with_rotation);
+  EXPECT_TRUE(f.gms.with_scale);
+  for (const char* warning :
+       {"~depth is deprecated, use ~max_depth", "~slack_px is deprecated, use ~distance_slack_px",
+        "~matcher is deprecated, use ~backend",
+        "~gsc_max_histogram_distance is deprecated, use ~max_histogram_distance",
+        "~gsc_threads is deprecated, use ~threads",
+        "~robust_confidence is deprecated, use ~ransac_confidence",
+        "~robust_confidence is deprecated, use ~magsac_confidence",
+        "~robust_max_iterations is deprecated, use ~ransac_max_iterations",
+        "~robust_max_iterations is deprecated, use ~magsac_max_iterations",
+        "~gms_grid_cells is deprecated, use ~grid_cells",
+        "~gms_threshold_factor is deprecated, use ~threshold_factor",
+        "~gms_with_rotation is deprecated, use ~with_rotation",
+        "~gms_with_scale is deprecated, use ~with_scale"}) {
+    EXPECT_TRUE(contains(log.warnings, warning)) << warning;
+  }
+  EXPECT_EQ(log.warnings.size(), 13u);
+  EXPECT_EQ(log.names.count("depth"), 0u);  // old names are not among the names read
+  ros::NodeHandle wrong_type("/old_name_wrong_type");
+  wrong_type.setParam("depth", 6.5);
+  EXPECT_THROW(readHullStreamConfig(wrong_type), std::invalid_argument);
+}
+
+TEST(ParameterReaders, TheNewNameWinsOverTheOldOne) {
+  ros::NodeHandle nh("/both_names");
+  nh.setParam("depth", 6);
+  nh.setParam("max_depth", 7);
+  nh.setParam("gsc_threads", 3);
+  nh.setParam("threads", 4);
+  nh.setParam("robust_confidence", 0.95);
+  nh.setParam("magsac_confidence", 0.9);
+  ReadLog log;
+  EXPECT_EQ(readHullStreamConfig(nh).hull.max_depth, 7);
+  const FilterConfigs filters = readMatcherSettings(nh).filters;
+  EXPECT_EQ(filters.gsc.threads, 4);
+  EXPECT_EQ(filters.ransac.confidence, 0.95);  // its own name is not set: the old one applies
+  EXPECT_EQ(filters.magsac.confidence, 0.9);
+  EXPECT_TRUE(contains(log.warnings,
+                       "~depth is deprecated, use ~max_depth (both are set: ~depth is ignored)"));
+  EXPECT_TRUE(contains(log.warnings, "~robust_confidence is deprecated, use ~ransac_confidence"));
+  EXPECT_TRUE(contains(log.warnings,
+                       "~robust_confidence is deprecated, use ~magsac_confidence "
+                       "(both are set: ~robust_confidence is ignored)"));
+  // Both set to one value (hull.launch with its deprecated `depth` arg): no conflict to report.
+  ros::NodeHandle same("/same_value");
+  same.setParam("depth", 6);
+  same.setParam("max_depth", 6);
+  ReadLog same_log;
+  EXPECT_EQ(readHullStreamConfig(same).hull.max_depth, 6);
+  EXPECT_EQ(same_log.warnings, std::vector<std::string>{"~depth is deprecated, use ~max_depth"});
 }
 
 }  // namespace

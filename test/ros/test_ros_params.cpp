@@ -18,11 +18,11 @@ TEST(MatcherReconfigure, DefaultsEqualTheConfigStructs) {
   EXPECT_FALSE(std::isfinite(matching.max_descriptor_distance));
   EXPECT_EQ(cfg.max_descriptor_distance, 0.0);  // 0 stands for no limit
   EXPECT_EQ(cfg.cross_check, matching.cross_check);
-  EXPECT_EQ(cfg.gsc_max_histogram_distance, filters.gsc.max_histogram_distance);
+  EXPECT_EQ(cfg.max_histogram_distance, filters.gsc.max_histogram_distance);
   EXPECT_EQ(cfg.ransac_max_epipolar_px, filters.ransac.max_epipolar_px);
   EXPECT_EQ(cfg.magsac_max_epipolar_px, filters.magsac.max_epipolar_px);
   EXPECT_EQ(cfg.max_epipolar_px, filters.epipolar.max_epipolar_px);
-  EXPECT_EQ(cfg.gms_threshold_factor, filters.gms.threshold_factor);
+  EXPECT_EQ(cfg.threshold_factor, filters.gms.threshold_factor);
 }
 
 }  // namespace

@@ -97,7 +97,7 @@ void overload(HullFeed& feed, const DiagnosticsListener& diagnostics, pid_t pid,
 HullRun runHull(RosHarness& harness, const std::string& name, const HullInput& input, int depth) {
   const pid_t pid = harness.startNode(
       "hull_node",
-      nodeArguments("hull", {"_depth:=" + std::to_string(depth), "_world_frame:=world"}));
+      nodeArguments("hull", {"_max_depth:=" + std::to_string(depth), "_world_frame:=world"}));
   ros::NodeHandle nh;
   HullFeed feed(nh, input);
   ArrivalLog<sift_hull::Octomap> octomaps(nh, "octomap_binary");

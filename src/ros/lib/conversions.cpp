@@ -345,17 +345,50 @@ sift_hull::Correspondences correspondencesMessage(const std_msgs::Header& left_h
   return out;
 }
 
+namespace {
+
+// One object per config struct, keyed by its field names (RobustFitConfig's prefixed by the
+// FilterConfigs member, as its ROS parameters are); settingsJson merges them.
+
+nlohmann::json toJson(const MatchConfig& config) {
+  return {{"ratio", config.ratio},
+          {"max_descriptor_distance", std::isfinite(config.max_descriptor_distance)
+                                          ? nlohmann::json(config.max_descriptor_distance)
+                                          : nlohmann::json(nullptr)},
+          {"cross_check", config.cross_check},
+          {"backend", config.backend}};
+}
+
+nlohmann::json toJson(const EpipolarConfig& config) {
+  return {{"max_epipolar_px", config.max_epipolar_px}};
+}
+
+nlohmann::json toJson(const GscConfig& config) {
+  return {{"max_histogram_distance", config.max_histogram_distance}, {"threads", config.threads}};
+}
+
+nlohmann::json toJson(const RobustFitConfig& config, const std::string& prefix) {
+  return {{prefix + "_max_epipolar_px", config.max_epipolar_px},
+          {prefix + "_confidence", config.confidence},
+          {prefix + "_max_iterations", config.max_iterations}};
+}
+
+nlohmann::json toJson(const GmsConfig& config) {
+  return {{"grid_cells", config.grid_cells},
+          {"threshold_factor", config.threshold_factor},
+          {"with_rotation", config.with_rotation},
+          {"with_scale", config.with_scale}};
+}
+
+}  // namespace
+
 std::string settingsJson(const MatchConfig& matching, const FilterConfigs& filters) {
-  const nlohmann::json json = {
-      {"ratio", matching.ratio},
-      {"max_descriptor_distance", std::isfinite(matching.max_descriptor_distance)
-                                      ? nlohmann::json(matching.max_descriptor_distance)
-                                      : nlohmann::json(nullptr)},
-      {"cross_check", matching.cross_check},
-      {"gsc_max_histogram_distance", filters.gsc.max_histogram_distance},
-      {"ransac_max_epipolar_px", filters.ransac.max_epipolar_px},
-      {"magsac_max_epipolar_px", filters.magsac.max_epipolar_px},
-      {"gms_threshold_factor", filters.gms.threshold_factor}};
+  nlohmann::json json = toJson(matching);
+  for (const nlohmann::json& part :
+       {toJson(filters.epipolar), toJson(filters.gsc), toJson(filters.ransac, "ransac"),
+        toJson(filters.magsac, "magsac"), toJson(filters.gms)}) {
+    json.update(part);
+  }
   return json.dump();
 }
 

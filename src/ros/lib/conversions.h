@@ -107,7 +107,8 @@ sift_hull::Correspondences correspondencesMessage(const std_msgs::Header& left_h
                                                   const PutativeMatches& matches,
                                                   const std::vector<FilterResult>& results);
 
-/// The matching and filter settings as the JSON object of Correspondences.filter_settings.
+/// The matching and filter settings as the JSON object of Correspondences.filter_settings, keyed
+/// by the names of their ROS parameters (the config fields; ransac_ / magsac_ for RobustFitConfig).
 std::string settingsJson(const MatchConfig& matching, const FilterConfigs& filters);
 
 }  // namespace ros_conversions

@@ -10,19 +10,18 @@
 
 namespace sift_hull {
 
-/// A node's one /diagnostics task, published every ~diagnostic_period seconds (1 by default) of
-/// wall time: diagnostic_updater waits on ROS time, which stops with a bag's clock.
+/// A node's one /diagnostics task, published every `period_s` seconds of wall time (the node
+/// config's diagnostic_period, read from ~diagnostic_period like diagnostic_updater itself does):
+/// diagnostic_updater waits on ROS time, which stops with a bag's clock.
 class NodeDiagnostics {
  public:
   using Report = std::function<void(diagnostic_updater::DiagnosticStatusWrapper&)>;
 
   NodeDiagnostics(ros::NodeHandle nh, const ros::NodeHandle& private_nh, const std::string& task,
-                  Report report)
+                  double period_s, Report report)
       : updater_(nh, private_nh, private_nh.getNamespace()) {
     updater_.setHardwareID("none");
     updater_.add(task, std::move(report));
-    double period_s = 1.0;  // the updater's own parameter, and default
-    private_nh.param("diagnostic_period", period_s, period_s);
     timer_ = nh.createWallTimer(ros::WallDuration(period_s),
                                 [this](const ros::WallTimerEvent&) { updater_.force_update(); });
   }

@@ -1,7 +1,11 @@
 #include "lib/ros_params.h"
 
+#include <ros/console.h>
+
 #include <cmath>
 #include <limits>
+#include <mutex>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -20,24 +24,75 @@ const char* typeName(const std::string&) { return "string"; }
 const char* typeName(const std::vector<double>&) { return "list of numbers"; }
 const char* typeName(const std::vector<std::string>&) { return "list of strings"; }
 
-/// The parameter's value when it is set; throws std::invalid_argument when it is set with another
-/// type (e.g. a string where a list is expected), rather than quietly keeping the default.
+thread_local ReadLog* active_log = nullptr;
+
+void noteName(const std::string& name) {
+  if (active_log != nullptr) active_log->names.insert(name);
+}
+
+/// Logs `message` once per node namespace and process (readers may run more than once).
+void warnDeprecated(const ros::NodeHandle& private_nh, const std::string& message) {
+  if (active_log != nullptr) active_log->warnings.push_back(message);
+  static std::mutex mutex;
+  static std::set<std::string> given;
+  const std::string text = private_nh.getNamespace() + ": " + message;
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (!given.insert(text).second) return;
+  }
+  ROS_WARN("%s", text.c_str());
+}
+
+/// Whether the parameter is set, and then its value; throws std::invalid_argument when it is set
+/// with another type (e.g. a string where a list is expected), rather than quietly keeping the
+/// default.
 template <typename T>
-void read(const ros::NodeHandle& private_nh, const std::string& name, T* value) {
-  if (!private_nh.hasParam(name)) return;
+bool get(const ros::NodeHandle& private_nh, const std::string& name, T* value) {
+  if (!private_nh.hasParam(name)) return false;
   if (!private_nh.getParam(name, *value)) {
     throw std::invalid_argument("~" + name + " is set, but not as a " + typeName(*value));
   }
+  return true;
 }
 
 /// roscpp would truncate 2.5 to 2 for an integer; here that is a wrong type too.
-void read(const ros::NodeHandle& private_nh, const std::string& name, int* value) {
+bool get(const ros::NodeHandle& private_nh, const std::string& name, int* value) {
   XmlRpc::XmlRpcValue raw;
-  if (!private_nh.getParam(name, raw)) return;
+  if (!private_nh.getParam(name, raw)) return false;
   if (raw.getType() != XmlRpc::XmlRpcValue::TypeInt) {
     throw std::invalid_argument("~" + name + " is set, but not as an integer");
   }
   *value = static_cast<int>(raw);
+  return true;
+}
+
+/// The parameter's value when it is set (see get).
+template <typename T>
+void read(const ros::NodeHandle& private_nh, const std::string& name, T* value) {
+  noteName(name);
+  get(private_nh, name, value);
+}
+
+/// A parameter renamed from `old_name` to `name`: `name` when it is set, else `old_name`, with a
+/// deprecation warning whenever `old_name` is set. Both are type-checked.
+template <typename T>
+void readRenamed(const ros::NodeHandle& private_nh, const std::string& name,
+                 const std::string& old_name, T* value) {
+  noteName(name);
+  const bool has_name = get(private_nh, name, value);
+  if (!private_nh.hasParam(old_name)) return;
+  const std::string warning = "~" + old_name + " is deprecated, use ~" + name;
+  if (has_name) {
+    // Equal values are no conflict (hull.launch sets both from its deprecated `depth` arg).
+    T old_value = *value;
+    get(private_nh, old_name, &old_value);
+    warnDeprecated(private_nh, old_value == *value
+                                   ? warning
+                                   : warning + " (both are set: ~" + old_name + " is ignored)");
+  } else {
+    get(private_nh, old_name, value);
+    warnDeprecated(private_nh, warning);
+  }
 }
 
 }  // namespace
@@ -59,9 +114,9 @@ SilhouetteConfig readSilhouetteConfig(const ros::NodeHandle& private_nh) {
 
 HullConfig readHullConfig(const ros::NodeHandle& private_nh) {
   HullConfig config;
-  read(private_nh, "depth", &config.max_depth);
+  readRenamed(private_nh, "max_depth", "depth", &config.max_depth);
   read(private_nh, "carve_outside_image", &config.carve_outside_image);
-  read(private_nh, "slack_px", &config.distance_slack_px);
+  readRenamed(private_nh, "distance_slack_px", "slack_px", &config.distance_slack_px);
   read(private_nh, "threads", &config.threads);
   validate(config);
   return config;
@@ -113,53 +168,87 @@ MatchConfig readMatchConfig(const ros::NodeHandle& private_nh) {
   read(private_nh, "max_descriptor_distance", &max_distance);
   config.max_descriptor_distance = descriptorDistanceFromParam(max_distance);
   read(private_nh, "cross_check", &config.cross_check);
-  read(private_nh, "matcher", &config.backend);
+  readRenamed(private_nh, "backend", "matcher", &config.backend);
   validate(config);
   return config;
 }
 
-namespace {
-
-void readRobustFit(const ros::NodeHandle& private_nh, const std::string& prefix,
-                   RobustFitConfig* config) {
-  read(private_nh, prefix + "_max_epipolar_px", &config->max_epipolar_px);
-  read(private_nh, "robust_confidence", &config->confidence);
-  read(private_nh, "robust_max_iterations", &config->max_iterations);
+EpipolarConfig readEpipolarConfig(const ros::NodeHandle& private_nh) {
+  EpipolarConfig config;
+  read(private_nh, "max_epipolar_px", &config.max_epipolar_px);
+  return config;
 }
 
-}  // namespace
+GscConfig readGscConfig(const ros::NodeHandle& private_nh) {
+  GscConfig config;
+  readRenamed(private_nh, "max_histogram_distance", "gsc_max_histogram_distance",
+              &config.max_histogram_distance);
+  readRenamed(private_nh, "threads", "gsc_threads", &config.threads);
+  return config;
+}
+
+RobustFitConfig readRobustFitConfig(const ros::NodeHandle& private_nh, const std::string& prefix) {
+  RobustFitConfig config;
+  read(private_nh, prefix + "_max_epipolar_px", &config.max_epipolar_px);
+  readRenamed(private_nh, prefix + "_confidence", "robust_confidence", &config.confidence);
+  readRenamed(private_nh, prefix + "_max_iterations", "robust_max_iterations",
+              &config.max_iterations);
+  return config;
+}
+
+GmsConfig readGmsConfig(const ros::NodeHandle& private_nh) {
+  GmsConfig config;
+  readRenamed(private_nh, "grid_cells", "gms_grid_cells", &config.grid_cells);
+  readRenamed(private_nh, "threshold_factor", "gms_threshold_factor", &config.threshold_factor);
+  readRenamed(private_nh, "with_rotation", "gms_with_rotation", &config.with_rotation);
+  readRenamed(private_nh, "with_scale", "gms_with_scale", &config.with_scale);
+  return config;
+}
 
 FilterConfigs readFilterConfigs(const ros::NodeHandle& private_nh) {
   FilterConfigs configs;
-  read(private_nh, "max_epipolar_px", &configs.epipolar.max_epipolar_px);
-  GscConfig& gsc = configs.gsc;
-  read(private_nh, "gsc_max_histogram_distance", &gsc.max_histogram_distance);
-  read(private_nh, "gsc_threads", &gsc.threads);
-  readRobustFit(private_nh, "ransac", &configs.ransac);
-  readRobustFit(private_nh, "magsac", &configs.magsac);
-  GmsConfig& gms = configs.gms;
-  read(private_nh, "gms_grid_cells", &gms.grid_cells);
-  read(private_nh, "gms_threshold_factor", &gms.threshold_factor);
-  read(private_nh, "gms_with_rotation", &gms.with_rotation);
-  read(private_nh, "gms_with_scale", &gms.with_scale);
+  configs.epipolar = readEpipolarConfig(private_nh);
+  configs.gsc = readGscConfig(private_nh);
+  configs.ransac = readRobustFitConfig(private_nh, "ransac");
+  configs.magsac = readRobustFitConfig(private_nh, "magsac");
+  configs.gms = readGmsConfig(private_nh);
   validate(configs);
   return configs;
 }
 
-MatcherSettings readMatcherSettings(const ros::NodeHandle& private_nh) {
-  MatcherSettings settings;
-  MatcherNodeConfig& node = settings.node;
-  read(private_nh, "filters", &node.filters);
-  read(private_nh, "queue_size", &node.queue_size);
-  read(private_nh, "max_waiting_pairs", &node.max_waiting_pairs);
-  read(private_nh, "workers", &node.workers);
-  read(private_nh, "approximate_sync", &node.approximate_sync);
-  read(private_nh, "calibrated", &node.calibrated);
-  read(private_nh, "frame_to_frame", &node.frame_to_frame);
-  read(private_nh, "image_transport", &node.image_transport);
-  if (node.queue_size < 1 || node.max_waiting_pairs < 1 || node.workers < 1) {
+namespace {
+
+/// ~diagnostic_period, also read by diagnostic_updater itself: seconds between /diagnostics.
+double readDiagnosticPeriod(const ros::NodeHandle& private_nh, double period_s) {
+  read(private_nh, "diagnostic_period", &period_s);
+  if (!(period_s > 0.0) || !std::isfinite(period_s)) {
+    throw std::invalid_argument("~diagnostic_period must be a number > 0 (seconds)");
+  }
+  return period_s;
+}
+
+}  // namespace
+
+MatcherNodeConfig readMatcherNodeConfig(const ros::NodeHandle& private_nh) {
+  MatcherNodeConfig config;
+  read(private_nh, "filters", &config.filters);
+  read(private_nh, "queue_size", &config.queue_size);
+  read(private_nh, "max_waiting_pairs", &config.max_waiting_pairs);
+  read(private_nh, "workers", &config.workers);
+  read(private_nh, "approximate_sync", &config.approximate_sync);
+  read(private_nh, "calibrated", &config.calibrated);
+  read(private_nh, "frame_to_frame", &config.frame_to_frame);
+  read(private_nh, "image_transport", &config.image_transport);
+  config.diagnostic_period = readDiagnosticPeriod(private_nh, config.diagnostic_period);
+  if (config.queue_size < 1 || config.max_waiting_pairs < 1 || config.workers < 1) {
     throw std::invalid_argument("~queue_size, ~max_waiting_pairs and ~workers must be at least 1");
   }
+  return config;
+}
+
+MatcherSettings readMatcherSettings(const ros::NodeHandle& private_nh) {
+  MatcherSettings settings;
+  settings.node = readMatcherNodeConfig(private_nh);
   settings.sift = readSiftConfig(private_nh);
   settings.matching = readMatchConfig(private_nh);
   settings.filters = readFilterConfigs(private_nh);
@@ -172,6 +261,7 @@ HullNodeConfig readHullNodeConfig(const ros::NodeHandle& private_nh) {
   read(private_nh, "queue_size", &config.queue_size);
   read(private_nh, "pose_timeout_s", &config.pose_timeout_s);
   read(private_nh, "from_image", &config.from_image);
+  config.diagnostic_period = readDiagnosticPeriod(private_nh, config.diagnostic_period);
   config.recipe = readSilhouetteConfig(private_nh);
   if (config.queue_size < 1) throw std::invalid_argument("~queue_size must be at least 1");
   if (!std::isfinite(config.pose_timeout_s)) {
@@ -191,6 +281,10 @@ ResultSaverConfig readResultSaverConfig(const ros::NodeHandle& private_nh) {
   }
   return config;
 }
+
+ReadLog::ReadLog() : outer_(active_log) { active_log = this; }
+
+ReadLog::~ReadLog() { active_log = outer_; }
 
 }  // namespace ros_params
 }  // namespace sift_hull

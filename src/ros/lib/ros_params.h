@@ -3,8 +3,17 @@
 // One reader per config struct; every fallback is the struct's own default. A parameter that is
 // set with the wrong type (a string where a list is expected, 2.5 for an integer) is an error
 // (std::invalid_argument), not a silent default.
+//
+// A parameter's name is its config field's name (config/hull.yaml and config/matcher.yaml state
+// every one). The one exception is RobustFitConfig, held twice in FilterConfigs: its fields are
+// ~ransac_<field> and ~magsac_<field>. Renamed parameters are still read under their old names,
+// with a deprecation warning naming the new one; when both are set, the new name wins.
 
 #include <ros/node_handle.h>
+
+#include <set>
+#include <string>
+#include <vector>
 
 #include "nodes/hull_node.h"
 #include "nodes/matcher_node.h"
@@ -26,36 +35,76 @@ double descriptorDistanceParam(double distance);
 /// ~threshold (grey level in [0, 1]), ~dilate_px, ~erode_px: the Middlebury silhouette recipe.
 SilhouetteConfig readSilhouetteConfig(const ros::NodeHandle& private_nh);
 
-/// ~depth, ~carve_outside_image, ~slack_px, ~threads.
+/// ~max_depth, ~carve_outside_image, ~distance_slack_px, ~threads.
+/// Deprecated: ~depth (~max_depth), ~slack_px (~distance_slack_px).
 HullConfig readHullConfig(const ros::NodeHandle& private_nh);
 
 /// The hull config, ~box ([xmin, ymin, zmin, xmax, ymax, zmax] in the world frame, metres; empty
 /// or absent: automatic), ~skip_views (frame ids of silhouettes to leave out),
-/// ~min_view_distance_m and ~min_view_angle_deg. Throws std::invalid_argument for a box that is not
-/// six numbers with max > min, or a negative view separation.
+/// ~min_view_distance_m, ~min_view_angle_deg, ~max_waiting_views and ~max_views. Throws
+/// std::invalid_argument for a box that is not six numbers with max > min, or a negative view
+/// separation.
 HullStreamConfig readHullStreamConfig(const ros::NodeHandle& private_nh);
 
-/// ~max_features, ~octave_layers, ~contrast_threshold, ~edge_threshold, ~sigma_px.
+/// ~max_features, ~octave_layers, ~contrast_threshold, ~edge_threshold, ~sigma_px,
+/// ~max_image_pixels.
 SiftConfig readSiftConfig(const ros::NodeHandle& private_nh);
 
-/// ~ratio, ~max_descriptor_distance (<= 0: none), ~cross_check, ~matcher.
+/// ~ratio, ~max_descriptor_distance (<= 0: none), ~cross_check, ~backend.
+/// Deprecated: ~matcher (~backend).
 MatchConfig readMatchConfig(const ros::NodeHandle& private_nh);
 
-/// ~max_epipolar_px, ~gsc_max_histogram_distance, ~gsc_threads, ~ransac_max_epipolar_px,
-/// ~magsac_max_epipolar_px, ~robust_confidence, ~robust_max_iterations, ~gms_grid_cells,
-/// ~gms_threshold_factor, ~gms_with_rotation, ~gms_with_scale.
+/// ~max_epipolar_px.
+EpipolarConfig readEpipolarConfig(const ros::NodeHandle& private_nh);
+
+/// ~max_histogram_distance, ~threads.
+/// Deprecated: ~gsc_max_histogram_distance, ~gsc_threads.
+GscConfig readGscConfig(const ros::NodeHandle& private_nh);
+
+/// ~<prefix>_max_epipolar_px, ~<prefix>_confidence, ~<prefix>_max_iterations, prefix "ransac" or
+/// "magsac" (the FilterConfigs member). Deprecated: ~robust_confidence and ~robust_max_iterations,
+/// which set both instances unless the instance's own name is set.
+RobustFitConfig readRobustFitConfig(const ros::NodeHandle& private_nh, const std::string& prefix);
+
+/// ~grid_cells, ~threshold_factor, ~with_rotation, ~with_scale.
+/// Deprecated: ~gms_grid_cells, ~gms_threshold_factor, ~gms_with_rotation, ~gms_with_scale.
+GmsConfig readGmsConfig(const ros::NodeHandle& private_nh);
+
+/// The filter readers above: epipolar, gsc, ransac, magsac, gms.
 FilterConfigs readFilterConfigs(const ros::NodeHandle& private_nh);
 
-/// The readers above and ~filters, ~queue_size, ~max_waiting_pairs, ~workers, ~approximate_sync,
-/// ~calibrated, ~frame_to_frame, ~image_transport.
+/// ~filters, ~queue_size, ~max_waiting_pairs, ~workers, ~approximate_sync, ~calibrated,
+/// ~frame_to_frame, ~image_transport, ~diagnostic_period.
+MatcherNodeConfig readMatcherNodeConfig(const ros::NodeHandle& private_nh);
+
+/// readMatcherNodeConfig, readSiftConfig, readMatchConfig and readFilterConfigs.
 MatcherSettings readMatcherSettings(const ros::NodeHandle& private_nh);
 
-/// ~world_frame, ~queue_size, ~pose_timeout_s, ~from_image and the silhouette recipe.
+/// ~world_frame, ~queue_size, ~pose_timeout_s, ~from_image, ~diagnostic_period and the
+/// silhouette recipe.
 HullNodeConfig readHullNodeConfig(const ros::NodeHandle& private_nh);
 
 /// ~bag, ~out_dir (both required: throws std::invalid_argument without them),
 /// ~hull_save_service, ~timeout_s.
 ResultSaverConfig readResultSaverConfig(const ros::NodeHandle& private_nh);
+
+/// While one is alive, records what the readers called on its thread look up: every parameter
+/// name they read (deprecated names aside) and every deprecation warning they give (each time,
+/// though the log shows each warning once per process). For tests: a parameter file must state
+/// every name read.
+class ReadLog {
+ public:
+  ReadLog();
+  ~ReadLog();
+  ReadLog(const ReadLog&) = delete;
+  ReadLog& operator=(const ReadLog&) = delete;
+
+  std::set<std::string> names;
+  std::vector<std::string> warnings;
+
+ private:
+  ReadLog* outer_;
+};
 
 }  // namespace ros_params
 }  // namespace sift_hull

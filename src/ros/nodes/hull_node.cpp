@@ -45,7 +45,7 @@ HullNode::HullNode(ros::NodeHandle nh, ros::NodeHandle private_nh, HullNodeConfi
           "mesh", 1, [this](const ros::SingleSubscriberPublisher&) { publishMeshNow(); },
           ros::SubscriberStatusCallback(), ros::VoidConstPtr(), true)),
       work_(config_.queue_size, 1, [this](View& view) { integrate(view); }),
-      diagnostics_(nh_, private_nh_, "hull",
+      diagnostics_(nh_, private_nh_, "hull", config_.diagnostic_period,
                    [this](diagnostic_updater::DiagnosticStatusWrapper& status) {
                      reportDiagnostics(status);
                    }),

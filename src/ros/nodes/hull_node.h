@@ -43,6 +43,8 @@ struct HullNodeConfig {
   /// silhouette by `recipe` (the Middlebury threshold, dilation and erosion).
   bool from_image = false;
   SilhouetteConfig recipe;
+  /// Seconds of wall time between /diagnostics reports (diagnostic_updater's own parameter).
+  double diagnostic_period = 1.0;
 };
 
 /// The hull node: silhouettes (mono8) with their camera_info, once tf knows the camera's pose in

@@ -45,7 +45,8 @@ MatcherNode::MatcherNode(ros::NodeHandle nh, ros::NodeHandle private_nh, Matcher
       private_nh_(private_nh),
       settings_(std::move(settings)),
       pipeline_(std::make_shared<const Pipeline>(
-          Pipeline{settings_, makeFilters(settings_), ros_conversions::settingsJson(settings_.matching, settings_.filters)})),
+          Pipeline{settings_, makeFilters(settings_),
+                   ros_conversions::settingsJson(settings_.matching, settings_.filters)})),
       transport_(nh_),
       correspondences_pub_(
           nh_.advertise<sift_hull::Correspondences>("correspondences", settings_.node.queue_size)),
@@ -53,7 +54,7 @@ MatcherNode::MatcherNode(ros::NodeHandle nh, ros::NodeHandle private_nh, Matcher
       tf_listener_(tf_buffer_),
       work_(settings_.node.max_waiting_pairs, settings_.node.workers,
             [this](Pair& pair) { matchPair(pair); }),
-      diagnostics_(nh_, private_nh_, "matcher",
+      diagnostics_(nh_, private_nh_, "matcher", settings_.node.diagnostic_period,
                    [this](diagnostic_updater::DiagnosticStatusWrapper& status) {
                      reportDiagnostics(status);
                    }) {
@@ -78,11 +79,11 @@ void MatcherNode::serveReconfigure() {
   config.max_descriptor_distance =
       ros_params::descriptorDistanceParam(settings_.matching.max_descriptor_distance);
   config.cross_check = settings_.matching.cross_check;
-  config.gsc_max_histogram_distance = settings_.filters.gsc.max_histogram_distance;
+  config.max_histogram_distance = settings_.filters.gsc.max_histogram_distance;
   config.ransac_max_epipolar_px = settings_.filters.ransac.max_epipolar_px;
   config.magsac_max_epipolar_px = settings_.filters.magsac.max_epipolar_px;
   config.max_epipolar_px = settings_.filters.epipolar.max_epipolar_px;
-  config.gms_threshold_factor = settings_.filters.gms.threshold_factor;
+  config.threshold_factor = settings_.filters.gms.threshold_factor;
   reconfigure_ = std::make_unique<dynamic_reconfigure::Server<sift_hull::MatcherConfig>>(
       reconfigure_mutex_, private_nh_);
   reconfigure_->updateConfig(config);
@@ -96,11 +97,11 @@ void MatcherNode::onReconfigure(sift_hull::MatcherConfig& config, uint32_t) {
   changed.matching.max_descriptor_distance =
       ros_params::descriptorDistanceFromParam(config.max_descriptor_distance);
   changed.matching.cross_check = config.cross_check;
-  changed.filters.gsc.max_histogram_distance = config.gsc_max_histogram_distance;
+  changed.filters.gsc.max_histogram_distance = config.max_histogram_distance;
   changed.filters.ransac.max_epipolar_px = config.ransac_max_epipolar_px;
   changed.filters.magsac.max_epipolar_px = config.magsac_max_epipolar_px;
   changed.filters.epipolar.max_epipolar_px = config.max_epipolar_px;
-  changed.filters.gms.threshold_factor = config.gms_threshold_factor;
+  changed.filters.gms.threshold_factor = config.threshold_factor;
   std::shared_ptr<const Pipeline> replacement;
   try {
     validate(changed.matching);

@@ -57,6 +57,8 @@ struct MatcherNodeConfig {
   /// How the images arrive: "raw", "compressed" (decoded here when no plugin provides it), or
   /// another installed image_transport plugin.
   std::string image_transport = "raw";
+  /// Seconds of wall time between /diagnostics reports (diagnostic_updater's own parameter).
+  double diagnostic_period = 1.0;
 };
 
 /// Everything the matcher node is configured with.
