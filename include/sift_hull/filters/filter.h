@@ -14,7 +14,11 @@
 
 namespace sift_hull {
 
-/// Every filter's configuration, as a node or the CLI holds them.
+/// Every filter's configuration, as a node or the CLI holds them. Each setting is named as its
+/// field in ROS parameters, dynamic_reconfigure, JSON and (with - for _) command-line flags
+/// (`max_histogram_distance`, `--grid-cells`), with one exception: RobustFitConfig is held twice,
+/// so its fields carry the member's name as a prefix (`ransac_max_epipolar_px`,
+/// `magsac_confidence`, `--magsac-max-epipolar-px`).
 struct FilterConfigs {
   EpipolarConfig epipolar;
   GscConfig gsc;
