@@ -16,11 +16,11 @@
 #include "commands.h"
 #include "match_eval.h"
 #include "pair_data.h"
-#include "sift_hull/synthetic/synthetic_matches.h"
 #include "sift_hull/eval/match_evaluation.h"
 #include "sift_hull/features/labelled_matches.h"
 #include "sift_hull/filters/filter.h"
 #include "sift_hull/filters/filter_result.h"
+#include "sift_hull/synthetic/synthetic_matches.h"
 
 namespace sift_hull {
 namespace cli {

@@ -14,8 +14,8 @@
 #include "hull_options.h"
 #include "pair_data.h"
 #include "sift_hull/eval/hull_evaluation.h"
-#include "sift_hull/hull/hull_pipeline.h"
 #include "sift_hull/hull/hull_config.h"
+#include "sift_hull/hull/hull_pipeline.h"
 #include "sift_hull/hull/octree.h"
 
 namespace sift_hull {

@@ -3,8 +3,8 @@
 
 #include "args.h"
 #include "commands.h"
-#include "sift_hull/io/calibration.h"
 #include "sift_hull/geometry/camera_set.h"
+#include "sift_hull/io/calibration.h"
 #include "sift_hull/io/images.h"
 #include "silhouette_options.h"
 

@@ -8,9 +8,9 @@
 #include "commands.h"
 #include "match_eval.h"
 #include "pair_data.h"
-#include "sift_hull/synthetic/scene.h"
 #include "sift_hull/features/labelled_matches.h"
 #include "sift_hull/filters/filter.h"
+#include "sift_hull/synthetic/scene.h"
 
 namespace sift_hull {
 namespace cli {

@@ -7,9 +7,9 @@
 #include "bench_timing.h"
 #include "commands.h"
 #include "hull_options.h"
-#include "sift_hull/hull/hull_octomap.h"
 #include "sift_hull/eval/mesh_render.h"
 #include "sift_hull/hull/hull_config.h"
+#include "sift_hull/hull/hull_octomap.h"
 #include "sift_hull/hull/hull_pipeline.h"
 #include "sift_hull/io/ply.h"
 

@@ -5,15 +5,15 @@
 #include "commands.h"
 #include "match_eval.h"
 #include "match_options.h"
-#include "sift_hull/geometry/camera.h"
-#include "sift_hull/io/calibration.h"
 #include "sift_hull/eval/match_drawing.h"
-#include "sift_hull/synthetic/scene.h"
 #include "sift_hull/features/labelled_matches.h"
 #include "sift_hull/filters/filter.h"
 #include "sift_hull/filters/filter_result.h"
 #include "sift_hull/filters/gsc.h"
+#include "sift_hull/geometry/camera.h"
+#include "sift_hull/io/calibration.h"
 #include "sift_hull/io/images.h"
+#include "sift_hull/synthetic/scene.h"
 
 namespace sift_hull {
 namespace cli {

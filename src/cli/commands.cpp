@@ -4,8 +4,8 @@
 #include <cstdlib>
 #include <cstring>
 #include <exception>
-#include <new>
 #include <iostream>
+#include <new>
 
 #include "args.h"
 #include "sift_hull/limits.h"
@@ -31,7 +31,6 @@ const Command* findCommand(const Program& program, const std::string& name) {
 }
 
 }  // namespace
-
 
 void printResult(bool as_json, const nlohmann::json& result, const std::string& text) {
   if (as_json) {

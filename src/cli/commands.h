@@ -7,9 +7,9 @@
 namespace sift_hull {
 namespace cli {
 
-/// One subcommand of the sift_hull (offline) or sift_hull_ros (ROS tools) program. `run` gets the arguments after the command's name and
-/// returns the exit code; it throws UsageError for a bad command line and std::exception for bad
-/// input, which main reports on stderr.
+/// One subcommand of the sift_hull (offline) or sift_hull_ros (ROS tools) program. `run` gets the
+/// arguments after the command's name and returns the exit code; it throws UsageError for a bad
+/// command line and std::exception for bad input, which main reports on stderr.
 struct Command {
   const char* name;
   const char* summary;
@@ -24,7 +24,6 @@ struct Program {
   const char* other_name = nullptr;
   std::vector<std::string> other_commands = {};
 };
-
 
 /// Prints a command's result: the JSON object on stdout with --json, else the human text.
 void printResult(bool as_json, const nlohmann::json& result, const std::string& text);

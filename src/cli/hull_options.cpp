@@ -3,12 +3,11 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "silhouette_options.h"
-
 #include "sift_hull/hull/hull_config.h"
 #include "sift_hull/hull/hull_pipeline.h"
 #include "sift_hull/hull/silhouette.h"
 #include "sift_hull/io/view_list.h"
+#include "silhouette_options.h"
 
 namespace sift_hull {
 namespace cli {

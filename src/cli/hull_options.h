@@ -7,8 +7,8 @@
 
 #include "args.h"
 #include "sift_hull/eval/hull_evaluation.h"
-#include "sift_hull/hull/hull_pipeline.h"
 #include "sift_hull/hull/hull_config.h"
+#include "sift_hull/hull/hull_pipeline.h"
 
 namespace sift_hull {
 namespace cli {

@@ -7,20 +7,24 @@ namespace cli {
 namespace {
 
 const Program& offlineProgram() {
-  static const Program program{"sift_hull", {
-      {"dataset-info", "summarise a calibrated view set (Middlebury par or projection list)",
-       runDatasetInfo},
-      {"scene", "render a synthetic scene with exact ground truth", runScene},
-      {"match", "match SIFT features of two images and filter them (epipolar, gsc, ...)", runMatch},
-      {"bench-filters", "time every match filter (the paper's Table 1 and an N sweep)",
-       runBenchFilters},
-      {"evaluate-filters", "precision and recall of every filter on Teddy and graf",
-       runEvaluateFilters},
-      {"hull", "visual hull of calibrated silhouettes: octree, OctoMap and mesh", runHull},
-      {"bench-hull", "time the visual hull against dense carving on dino and temple", runBenchHull},
-  },
-                                 "sift_hull_ros",
-                                 {"bag", "bench-nodes"}};
+  static const Program program{
+      "sift_hull",
+      {
+          {"dataset-info", "summarise a calibrated view set (Middlebury par or projection list)",
+           runDatasetInfo},
+          {"scene", "render a synthetic scene with exact ground truth", runScene},
+          {"match", "match SIFT features of two images and filter them (epipolar, gsc, ...)",
+           runMatch},
+          {"bench-filters", "time every match filter (the paper's Table 1 and an N sweep)",
+           runBenchFilters},
+          {"evaluate-filters", "precision and recall of every filter on Teddy and graf",
+           runEvaluateFilters},
+          {"hull", "visual hull of calibrated silhouettes: octree, OctoMap and mesh", runHull},
+          {"bench-hull", "time the visual hull against dense carving on dino and temple",
+           runBenchHull},
+      },
+      "sift_hull_ros",
+      {"bag", "bench-nodes"}};
   return program;
 }
 

@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "sift_hull/eval/match_evaluation.h"
-#include "sift_hull/filters/filter.h"
 #include "sift_hull/features/labelled_matches.h"
+#include "sift_hull/filters/filter.h"
 #include "sift_hull/filters/filter_result.h"
 
 namespace sift_hull {

@@ -38,9 +38,9 @@ std::optional<EvaluationPair> teddyPair(const std::string& data_root, const Matc
   const std::string dir = dataSet(data_root, "middlebury_stereo2003_teddy", why_not);
   if (dir.empty()) return std::nullopt;
   // Middlebury 2003 quarter size: im2 left, im6 right, disp2.pgm holds disparity * 4.
-  return EvaluationPair{"teddy", matchRectifiedPair(dir + "/im2.png", dir + "/im6.png",
-                                                    dir + "/disp2.pgm", 4.0, options.sift,
-                                                    options.matching)};
+  return EvaluationPair{
+      "teddy", matchRectifiedPair(dir + "/im2.png", dir + "/im6.png", dir + "/disp2.pgm", 4.0,
+                                  options.sift, options.matching)};
 }
 
 std::optional<EvaluationPair> grafPair(const std::string& data_root, int n,
@@ -49,10 +49,10 @@ std::optional<EvaluationPair> grafPair(const std::string& data_root, int n,
   if (dir.empty()) return std::nullopt;
   // Oxford's files: img1 .. img6, H1toNp maps img1 to imgN.
   const std::string index = std::to_string(n);
-  return EvaluationPair{"graf 1-" + index,
-                        matchPlanarPair(dir + "/img1.png", dir + "/img" + index + ".png",
-                                        dir + "/H1to" + index + "p", options.sift,
-                                        options.matching)};
+  return EvaluationPair{
+      "graf 1-" + index,
+      matchPlanarPair(dir + "/img1.png", dir + "/img" + index + ".png", dir + "/H1to" + index + "p",
+                      options.sift, options.matching)};
 }
 
 std::string todayUtc() {

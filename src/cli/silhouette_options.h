@@ -1,8 +1,8 @@
 #pragma once
 
 #include "args.h"
-#include "sift_hull/io/calibration.h"
 #include "sift_hull/hull/silhouette.h"
+#include "sift_hull/io/calibration.h"
 
 namespace sift_hull {
 namespace cli {

@@ -2,6 +2,8 @@
 // Meshes, fields and cameras shared by the mesh tests of every layer (test_mesh, test_ply,
 // test_mesh_render).
 
+#include <gtest/gtest.h>
+
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
@@ -20,11 +22,8 @@
 #include "sift_hull/hull/marching_cubes.h"
 #include "sift_hull/hull/mesh.h"
 
-#include <gtest/gtest.h>
-
 namespace sift_hull {
 namespace test {
-
 
 inline constexpr double kPi = 3.14159265358979323846;
 
@@ -41,7 +40,7 @@ inline FieldSampler samplerOf(const ScalarField& field) {
 /// The cells of the grid over [low, low + count * edge] whose corners straddle zero under the
 /// same rule (value >= 0 outside) and float precision marching cubes uses.
 inline SurfaceCells straddlingCells(const ScalarField& field, const Eigen::Vector3d& low, int count,
-                             double edge) {
+                                    double edge) {
   const int points = count + 1;
   std::vector<bool> outside(static_cast<size_t>(points) * points * points);
   const auto at = [points](int i, int j, int k) {
@@ -100,7 +99,9 @@ inline const Eigen::Vector3d kSphereCentre(0.013, -0.021, 0.007);
 inline constexpr double kSphereRadius = 1.0;
 inline constexpr double kCellEdge = 0.05;
 
-inline double sphereField(const Eigen::Vector3d& p) { return (p - kSphereCentre).norm() - kSphereRadius; }
+inline double sphereField(const Eigen::Vector3d& p) {
+  return (p - kSphereCentre).norm() - kSphereRadius;
+}
 
 inline TriangleMesh sphereMesh() {
   const SurfaceCells cells =

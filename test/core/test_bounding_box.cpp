@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "sift_hull/hull/bounding_box.h"
 #include "sift_hull/geometry/camera.h"
+#include "sift_hull/hull/bounding_box.h"
 
 namespace sift_hull {
 namespace {

@@ -6,11 +6,11 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "sift_hull/io/calibration.h"
+#include "common/test_data.h"
 #include "sift_hull/geometry/camera_set.h"
 #include "sift_hull/hull/silhouette.h"
+#include "sift_hull/io/calibration.h"
 #include "sift_hull/io/images.h"
-#include "common/test_data.h"
 
 namespace sift_hull {
 namespace {

@@ -10,15 +10,15 @@
 #include <utility>
 #include <vector>
 
-#include "sift_hull/io/calibration.h"
+#include "common/test_data.h"
 #include "sift_hull/eval/match_evaluation.h"
-#include "sift_hull/synthetic/scene.h"
 #include "sift_hull/features/labelled_matches.h"
 #include "sift_hull/filters/filter.h"
 #include "sift_hull/filters/filter_result.h"
 #include "sift_hull/filters/ratio.h"
+#include "sift_hull/io/calibration.h"
 #include "sift_hull/io/ground_truth_files.h"
-#include "common/test_data.h"
+#include "sift_hull/synthetic/scene.h"
 
 namespace sift_hull {
 namespace {
@@ -41,7 +41,6 @@ PutativeMatches pointPairs(const std::vector<std::pair<Point, Point>>& pairs,
 constexpr MatchTruth kCorrect = MatchTruth::kCorrect;
 constexpr MatchTruth kWrong = MatchTruth::kWrong;
 constexpr MatchTruth kUnknown = MatchTruth::kUnknown;
-
 
 // ---- judging single matches ---------------------------------------------------------------------
 
@@ -205,8 +204,9 @@ const LabelledMatches& teddy() {
     const std::string dir = test::dataSet("middlebury_stereo2003_teddy");
     MatchConfig matching;
     matching.ratio = 0.8;
-    return dir.empty() ? LabelledMatches() : matchRectifiedPair(dir + "/im2.png", dir + "/im6.png", dir + "/disp2.pgm", 4.0,
-                                                      SiftConfig(), matching);
+    return dir.empty() ? LabelledMatches()
+                       : matchRectifiedPair(dir + "/im2.png", dir + "/im6.png", dir + "/disp2.pgm",
+                                            4.0, SiftConfig(), matching);
   }();
   return matches;
 }
@@ -217,8 +217,9 @@ const LabelledMatches& graf() {
     const std::string dir = test::dataSet("oxford_affine_graf");
     MatchConfig matching;
     matching.ratio = 0.8;
-    return dir.empty() ? LabelledMatches() : matchPlanarPair(dir + "/img1.png", dir + "/img2.png", dir + "/H1to2p",
-                                                   SiftConfig(), matching);
+    return dir.empty() ? LabelledMatches()
+                       : matchPlanarPair(dir + "/img1.png", dir + "/img2.png", dir + "/H1to2p",
+                                         SiftConfig(), matching);
   }();
   return matches;
 }

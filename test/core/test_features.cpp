@@ -9,10 +9,10 @@
 #include <utility>
 #include <vector>
 
-#include "sift_hull/features/sift.h"
-#include "sift_hull/features/matching.h"
-#include "sift_hull/synthetic/scene.h"
 #include "common/test_data.h"
+#include "sift_hull/features/matching.h"
+#include "sift_hull/features/sift.h"
+#include "sift_hull/synthetic/scene.h"
 
 namespace sift_hull {
 namespace {

@@ -3,13 +3,13 @@
 #include <cmath>
 #include <random>
 
-#include "sift_hull/filters/filter.h"
-#include "sift_hull/synthetic/synthetic_matches.h"
 #include "sift_hull/features/labelled_matches.h"
 #include "sift_hull/filters/epipolar.h"
+#include "sift_hull/filters/filter.h"
 #include "sift_hull/filters/filter_result.h"
 #include "sift_hull/filters/gsc.h"
 #include "sift_hull/filters/robust_fit.h"
+#include "sift_hull/synthetic/synthetic_matches.h"
 
 namespace sift_hull {
 namespace {

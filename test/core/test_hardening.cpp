@@ -16,24 +16,24 @@
 #include <stdexcept>
 #include <thread>
 
-#include "hull/distance_kernel.h"
 #include "common/parallel.h"
-#include "sift_hull/hull/bounding_box.h"
-#include "sift_hull/io/calibration.h"
-#include "sift_hull/io/pfm.h"
+#include "common/test_data.h"
+#include "hull/distance_kernel.h"
 #include "sift_hull/eval/match_evaluation.h"
 #include "sift_hull/features/sift.h"
 #include "sift_hull/filters/filter.h"
+#include "sift_hull/hull/bounding_box.h"
+#include "sift_hull/hull/hull_config.h"
 #include "sift_hull/hull/hull_pipeline.h"
 #include "sift_hull/hull/hull_stream.h"
-#include "sift_hull/limits.h"
-#include "sift_hull/synthetic/scene.h"
-#include "sift_hull/hull/hull_config.h"
 #include "sift_hull/hull/hull_view.h"
 #include "sift_hull/hull/octree.h"
 #include "sift_hull/hull/silhouette.h"
+#include "sift_hull/io/calibration.h"
 #include "sift_hull/io/ground_truth_files.h"
-#include "common/test_data.h"
+#include "sift_hull/io/pfm.h"
+#include "sift_hull/limits.h"
+#include "sift_hull/synthetic/scene.h"
 
 namespace sift_hull {
 namespace {
@@ -49,7 +49,6 @@ void writeText(const std::string& path, const std::string& text) {
 bool contains(const std::string& text, const std::string& part) {
   return text.find(part) != std::string::npos;
 }
-
 
 TEST(LookUp, NonFiniteCoordinatesStayInsideTheMap) {
   const float map[] = {1, 2, 3, 4};  // 2x2

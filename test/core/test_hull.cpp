@@ -6,15 +6,15 @@
 
 #include <cmath>
 
+#include "common/test_data.h"
 #include "sift_hull/eval/hull_evaluation.h"
-#include "sift_hull/hull/hull_octomap.h"
-#include "sift_hull/hull/hull_pipeline.h"
-#include "sift_hull/synthetic/scene.h"
 #include "sift_hull/hull/distance_map.h"
 #include "sift_hull/hull/hull_config.h"
+#include "sift_hull/hull/hull_octomap.h"
+#include "sift_hull/hull/hull_pipeline.h"
 #include "sift_hull/hull/hull_view.h"
 #include "sift_hull/hull/octree.h"
-#include "common/test_data.h"
+#include "sift_hull/synthetic/scene.h"
 
 namespace sift_hull {
 namespace {

@@ -5,13 +5,13 @@
 
 #include <nlohmann/json.hpp>
 
+#include "common/test_data.h"
 #include "sift_hull/eval/hull_evaluation.h"
-#include "sift_hull/hull/hull_pipeline.h"
 #include "sift_hull/hull/hull_config.h"
+#include "sift_hull/hull/hull_pipeline.h"
 #include "sift_hull/hull/silhouette.h"
 #include "sift_hull/io/ply.h"
 #include "sift_hull/io/view_list.h"
-#include "common/test_data.h"
 
 namespace sift_hull {
 namespace {

@@ -5,10 +5,10 @@
 
 #include <Eigen/Geometry>
 
+#include "common/test_data.h"
 #include "sift_hull/hull/hull_pipeline.h"
 #include "sift_hull/hull/hull_stream.h"
 #include "sift_hull/synthetic/scene.h"
-#include "common/test_data.h"
 
 namespace sift_hull {
 namespace {

@@ -100,8 +100,8 @@ TEST(LayoutTest, EachStageIncludesOnlyTheStagesBelowIt) {
       const std::string other = match[1];
       if (other == stage || other == "common" || !allowedIncludes().count(other)) continue;
       EXPECT_TRUE(allowedIncludes().at(stage).count(other))
-          << fs::relative(file, kRoot) << " (" << stage << ") includes " << include << " ("
-          << other << ")";
+          << fs::relative(file, kRoot) << " (" << stage << ") includes " << include << " (" << other
+          << ")";
     }
   }
   EXPECT_EQ(stages.size(), allowedIncludes().size()) << "a stage folder has gone missing";

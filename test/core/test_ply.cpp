@@ -16,8 +16,8 @@
 #include <utility>
 
 #include "common/mesh_fixtures.h"
-#include "sift_hull/io/ply.h"
 #include "sift_hull/hull/mesh.h"
+#include "sift_hull/io/ply.h"
 
 namespace sift_hull {
 namespace {

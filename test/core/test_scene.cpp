@@ -7,13 +7,13 @@
 #include <opencv2/imgproc.hpp>
 #include <random>
 
+#include "common/test_data.h"
 #include "sift_hull/geometry/correspondence.h"
-#include "sift_hull/io/pfm.h"
-#include "sift_hull/synthetic/scene.h"
 #include "sift_hull/hull/silhouette.h"
 #include "sift_hull/io/calibration.h"
 #include "sift_hull/io/images.h"
-#include "common/test_data.h"
+#include "sift_hull/io/pfm.h"
+#include "sift_hull/synthetic/scene.h"
 
 namespace sift_hull {
 namespace {

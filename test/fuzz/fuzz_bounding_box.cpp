@@ -16,15 +16,15 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
-#include <cstdint>
 #include <cstring>
 #include <exception>
 #include <vector>
 
-#include "sift_hull/hull/bounding_box.h"
 #include "sift_hull/geometry/camera.h"
+#include "sift_hull/hull/bounding_box.h"
 
 namespace {
 

@@ -1,5 +1,6 @@
-// libFuzzer harness: sift_hull::readHomography (io/ground_truth_files.h) on arbitrary file contents. Any std::exception
-// is accepted; a crash, abort, sanitizer report, leak or time-out is a finding.
+// libFuzzer harness: sift_hull::readHomography (io/ground_truth_files.h) on arbitrary file
+// contents. Any std::exception is accepted; a crash, abort, sanitizer report, leak or time-out is a
+// finding.
 #include "fuzz_input_file.h"
 #include "sift_hull/eval/match_evaluation.h"
 #include "sift_hull/io/ground_truth_files.h"

@@ -1,5 +1,5 @@
-// libFuzzer harness: sift_hull::readProjectionList (io/calibration.h) on arbitrary file contents. Any std::exception
-// is accepted; a crash, abort, sanitizer report, leak or time-out is a finding.
+// libFuzzer harness: sift_hull::readProjectionList (io/calibration.h) on arbitrary file contents.
+// Any std::exception is accepted; a crash, abort, sanitizer report, leak or time-out is a finding.
 #include "fuzz_input_file.h"
 #include "sift_hull/io/calibration.h"
 

@@ -27,15 +27,15 @@
 #include <string>
 #include <vector>
 
-#include "lib/conversions.h"
 #include "common/octomap_volume.h"
+#include "lib/conversions.h"
 #include "ros_wait.h"
 #include "sift_hull/Correspondences.h"
 #include "sift_hull/Octomap.h"
-#include "sift_hull/synthetic/scene.h"
-#include "sift_hull/synthetic/shape.h"
 #include "sift_hull/hull/hull_pipeline.h"
 #include "sift_hull/io/calibration.h"
+#include "sift_hull/synthetic/scene.h"
+#include "sift_hull/synthetic/shape.h"
 
 namespace sift_hull {
 namespace bad_inputs {
@@ -116,7 +116,8 @@ inline std::string joined(const std::vector<std::string>& needles) {
 
 /// Waits for an error of `node` holding every one of `needles`, logged after `since`.
 inline ::testing::AssertionResult loggedError(const std::string& node,
-                                       const std::vector<std::string>& needles, size_t since) {
+                                              const std::vector<std::string>& needles,
+                                              size_t since) {
   if (waitFor([&] { return rosout().hasError(node, needles, since); })) {
     return ::testing::AssertionSuccess();
   }
@@ -182,7 +183,7 @@ inline ros::Time freshStamp() {
 }
 
 inline sensor_msgs::Image imageMessage(const cv::Mat& image, const ros::Time& stamp,
-                                const std::string& frame) {
+                                       const std::string& frame) {
   std_msgs::Header header;
   header.stamp = stamp;
   header.frame_id = frame;

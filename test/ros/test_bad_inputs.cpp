@@ -22,7 +22,8 @@ int main(int argc, char** argv) {
   // fixtures then wait for each node's topics).
   if (!sift_hull::test::waitFor(
           [] { return sift_hull::bad_inputs::rosout().subscriber().getNumPublishers() >= 3; })) {
-    std::cerr << "warning: /rosout has " << sift_hull::bad_inputs::rosout().subscriber().getNumPublishers()
+    std::cerr << "warning: /rosout has "
+              << sift_hull::bad_inputs::rosout().subscriber().getNumPublishers()
               << " publishers connected, expected 3 (this test, hull, matcher)\n";
   }
   return RUN_ALL_TESTS();

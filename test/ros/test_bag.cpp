@@ -10,8 +10,8 @@
 
 #include <map>
 
-#include "sift_hull/io/calibration.h"
 #include "common/test_data.h"
+#include "sift_hull/io/calibration.h"
 
 namespace sift_hull {
 namespace {
@@ -21,11 +21,11 @@ TEST(BagCommand, WritesEveryViewOfASceneWithItsCamera) {
   std::string out, err;
   ASSERT_EQ(test::runProgram("scene --out " + dir + " --views 4 --size 160x120", &out, &err), 0)
       << err;
-  ASSERT_EQ(
-      test::runRosProgram("bag --calib " + dir + "/scene_par.txt --images " + dir + " --silhouettes " +
-                           dir + "/masks --rate 4 --out " + dir + "/scene.bag",
-                       &out, &err),
-      0)
+  ASSERT_EQ(test::runRosProgram("bag --calib " + dir + "/scene_par.txt --images " + dir +
+                                    " --silhouettes " + dir + "/masks --rate 4 --out " + dir +
+                                    "/scene.bag",
+                                &out, &err),
+            0)
       << err;
   const std::vector<CalibratedView> views = readCalibration(dir + "/scene_par.txt");
   rosbag::Bag bag(dir + "/scene.bag", rosbag::bagmode::Read);

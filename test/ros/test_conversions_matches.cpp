@@ -16,8 +16,8 @@ namespace {
 PutativeMatches threeMatches() {
   PutativeMatches matches;
   for (int i = 0; i < 3; ++i) {
-    matches.left_keypoints.emplace_back(cv::Point2f(10.0f * i, 5.0f), 2.0f + i, 30.0f * i,
-                                        0.5f * i, i);
+    matches.left_keypoints.emplace_back(cv::Point2f(10.0f * i, 5.0f), 2.0f + i, 30.0f * i, 0.5f * i,
+                                        i);
     matches.right_keypoints.emplace_back(cv::Point2f(100.0f + i, 7.0f), 3.0f, 45.0f);
   }
   for (int i = 0; i < 3; ++i) matches.matches.emplace_back(i, 2 - i, 0.25f * (i + 1));
@@ -50,9 +50,9 @@ TEST(CorrespondencesMessage, EachMatchCarriesItsKeypointsAndABitPerFilterThatKep
   const PutativeMatches matches = threeMatches();
   const std::vector<FilterResult> results = {result({1, 0, 1}, {0.1, 0.9, 0.2}),
                                              result({1, 1, 0}, {0.05, 0.15, 0.6})};
-  const sift_hull::Correspondences out = ros_conversions::correspondencesMessage(
-      header("left", 2.0), header("right", 2.5), {"epipolar", "gsc"}, "{\"x\":1}", matches,
-      results);
+  const sift_hull::Correspondences out =
+      ros_conversions::correspondencesMessage(header("left", 2.0), header("right", 2.5),
+                                              {"epipolar", "gsc"}, "{\"x\":1}", matches, results);
   EXPECT_EQ(out.header.frame_id, "left");
   EXPECT_EQ(out.header.stamp, ros::Time(2.0));
   EXPECT_EQ(out.right_header.frame_id, "right");
@@ -74,9 +74,9 @@ TEST(CorrespondencesMessage, EachMatchCarriesItsKeypointsAndABitPerFilterThatKep
 }
 
 TEST(CorrespondencesMessage, WithoutAGscFilterTheScoreIsNan) {
-  const sift_hull::Correspondences out = ros_conversions::correspondencesMessage(
-      header("l", 1.0), header("r", 1.0), {"ransac"}, "{}", threeMatches(),
-      {result({0, 0, 1}, {1.0, 2.0, 3.0})});
+  const sift_hull::Correspondences out =
+      ros_conversions::correspondencesMessage(header("l", 1.0), header("r", 1.0), {"ransac"}, "{}",
+                                              threeMatches(), {result({0, 0, 1}, {1.0, 2.0, 3.0})});
   ASSERT_EQ(out.matches.size(), 3u);
   for (const sift_hull::Correspondence& c : out.matches) EXPECT_TRUE(std::isnan(c.gsc_score));
   EXPECT_EQ(out.matches[2].kept_by, 1u);
@@ -93,10 +93,10 @@ TEST(CorrespondencesMessage, RefusesResultsThatDoNotFitTheMatchesOrTheNames) {
                                                        matches, {result({1, 1}, {0.0, 0.0})}),
                std::invalid_argument);
   const std::vector<std::string> names(33, "ratio");
-  EXPECT_THROW(ros_conversions::correspondencesMessage(header("l", 1), header("r", 1), names, "{}",
-                                                       matches,
-                                                       std::vector<FilterResult>(33, good)),
-               std::invalid_argument);
+  EXPECT_THROW(
+      ros_conversions::correspondencesMessage(header("l", 1), header("r", 1), names, "{}", matches,
+                                              std::vector<FilterResult>(33, good)),
+      std::invalid_argument);
   EXPECT_NO_THROW(ros_conversions::correspondencesMessage(header("l", 1), header("r", 1), {"a"},
                                                           "{}", matches, {good}));
 }

@@ -10,10 +10,10 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include "common/test_data.h"
+#include "lib/free_port.h"
 #include "sift_hull/hull/mesh.h"
 #include "sift_hull/io/ply.h"
-#include "lib/free_port.h"
-#include "common/test_data.h"
 
 namespace sift_hull {
 namespace {
@@ -34,7 +34,8 @@ class DemoLaunch : public ::testing::TestWithParam<bool> {
     const std::string views = " --calib " + dir_ + "/scene_par.txt --images " + dir_ +
                               " --silhouettes " + dir_ + "/masks";
     ASSERT_EQ(
-        test::runRosProgram("bag" + views + " --rate 8 --out " + dir_ + "/scene.bag", &out, &err), 0)
+        test::runRosProgram("bag" + views + " --rate 8 --out " + dir_ + "/scene.bag", &out, &err),
+        0)
         << err;
     ASSERT_EQ(test::runProgram("hull" + views + " --max-depth " + std::to_string(kDepth) +
                                    " --out-mesh " + dir_ + "/offline.ply",

@@ -20,15 +20,15 @@
 #include <mutex>
 #include <sstream>
 
-#include "lib/conversions.h"
 #include "common/octomap_volume.h"
+#include "lib/conversions.h"
 #include "ros_wait.h"
 #include "sift_hull/Octomap.h"
+#include "sift_hull/hull/hull_config.h"
 #include "sift_hull/hull/hull_octomap.h"
 #include "sift_hull/hull/hull_pipeline.h"
-#include "sift_hull/synthetic/scene.h"
-#include "sift_hull/hull/hull_config.h"
 #include "sift_hull/hull/hull_view.h"
+#include "sift_hull/synthetic/scene.h"
 
 namespace sift_hull {
 namespace {

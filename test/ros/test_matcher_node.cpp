@@ -19,8 +19,8 @@
 #include "ros_wait.h"
 #include "sift_hull/Correspondences.h"
 #include "sift_hull/eval/match_evaluation.h"
-#include "sift_hull/synthetic/scene.h"
 #include "sift_hull/features/labelled_matches.h"
+#include "sift_hull/synthetic/scene.h"
 
 namespace sift_hull {
 namespace {

@@ -4,8 +4,8 @@
 #include <gtest/gtest.h>
 
 #include "sift_hull/MatcherConfig.h"
-#include "sift_hull/filters/filter.h"
 #include "sift_hull/features/matching.h"
+#include "sift_hull/filters/filter.h"
 
 namespace sift_hull {
 namespace {

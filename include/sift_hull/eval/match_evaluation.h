@@ -6,8 +6,8 @@
 #include <vector>
 
 #include "sift_hull/features/labelled_matches.h"
-#include "sift_hull/geometry/correspondence.h"
 #include "sift_hull/filters/filter.h"
+#include "sift_hull/geometry/correspondence.h"
 
 namespace sift_hull {
 
@@ -48,7 +48,6 @@ LabelledMatches matchRectifiedPair(const std::string& left_path, const std::stri
 LabelledMatches matchPlanarPair(const std::string& left_path, const std::string& right_path,
                                 const std::string& homography_path, const SiftConfig& sift,
                                 const MatchConfig& matching);
-
 
 /// A filter's result measured against the ground truth.
 struct FilterScores {

@@ -19,7 +19,7 @@ FilterResult filterEpipolar(const PutativeMatches& input, const EpipolarConfig& 
 /// Keeps each match with finite positions whose symmetric epipolar distance under F_right_left is
 /// at most max_px; score: the larger of the two point-to-line distances. Shared by the filters that
 /// estimate F.
-FilterResult keepNearEpipolarLines(const PutativeMatches& input, const Eigen::Matrix3d& F_right_left,
-                                   double max_px);
+FilterResult keepNearEpipolarLines(const PutativeMatches& input,
+                                   const Eigen::Matrix3d& F_right_left, double max_px);
 
 }  // namespace sift_hull

@@ -4,10 +4,10 @@
 #include <string>
 #include <vector>
 
-#include "sift_hull/hull/mesh.h"
 #include "sift_hull/geometry/camera.h"
 #include "sift_hull/hull/bounding_box.h"
 #include "sift_hull/hull/hull_view.h"
+#include "sift_hull/hull/mesh.h"
 #include "sift_hull/hull/octree.h"
 
 namespace sift_hull {

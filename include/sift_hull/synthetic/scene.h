@@ -4,8 +4,8 @@
 #include <string>
 #include <vector>
 
-#include "sift_hull/io/calibration.h"
 #include "sift_hull/hull/hull_pipeline.h"
+#include "sift_hull/io/calibration.h"
 #include "sift_hull/synthetic/shape.h"
 
 namespace sift_hull {

@@ -18,13 +18,13 @@
 #include <sstream>
 #include <thread>
 
-#include "lib/conversions.h"
-#include "nodes/matcher_node.h"
-#include "lib/wall_wait.h"
 #include "args.h"
 #include "bench_timing.h"
 #include "commands.h"
 #include "hull_options.h"
+#include "lib/conversions.h"
+#include "lib/wall_wait.h"
+#include "nodes/matcher_node.h"
 #include "pair_data.h"
 #include "ros_harness.h"
 #include "sift_hull/Correspondences.h"
@@ -105,7 +105,7 @@ class ArrivalLog {
 };
 
 inline std::vector<std::string> nodeArguments(const std::string& name,
-                                       std::vector<std::string> parameters) {
+                                              std::vector<std::string> parameters) {
   parameters.insert(parameters.begin(), {"__name:=" + name, "_diagnostic_period:=0.2"});
   return parameters;
 }

@@ -113,7 +113,6 @@ HullRun runHull(RosHarness& harness, const std::string& name, const HullInput& i
   return run;
 }
 
-
 std::vector<HullRun> benchHulls(RosHarness& harness, const std::string& data_root) {
   std::vector<HullRun> runs;
   runs.push_back(runHull(harness, "synthetic", hullInputOf(renderScene(SceneConfig())), 8));

@@ -6,11 +6,11 @@
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
-#include "lib/bag_topics.h"
-#include "lib/conversions.h"
 #include "args.h"
 #include "commands.h"
 #include "hull_options.h"
+#include "lib/bag_topics.h"
+#include "lib/conversions.h"
 #include "sift_hull/hull/hull_pipeline.h"
 #include "sift_hull/io/images.h"
 

@@ -60,8 +60,9 @@ nlohmann::json targetsJson(const std::vector<MatcherRun>& matcher,
 std::string markdownReport(const std::vector<MatcherRun>& matcher,
                            const std::vector<HullRun>& hulls, const nlohmann::json& targets) {
   std::ostringstream out;
-  out << "Written by `sift_hull_ros bench-nodes --write docs/BENCHMARKS.md` on " << todayUtc() << ", "
-      << std::thread::hardware_concurrency() << " hardware threads. The nodes run as processes "
+  out << "Written by `sift_hull_ros bench-nodes --write docs/BENCHMARKS.md` on " << todayUtc()
+      << ", " << std::thread::hardware_concurrency()
+      << " hardware threads. The nodes run as processes "
       << "of their own against a ROS master of their own; this program publishes their input and "
       << "subscribes their output over TCP, as `rosbag play` and rviz would.\n\n"
       << "Matcher node, 640x480 synthetic stereo pairs (the scene's views k and k+1), filter gsc, "

@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
        {"bench-nodes", "time the matcher and hull nodes as processes on topic streams",
         runBenchNodes}},
       "sift_hull",
-      {"dataset-info", "scene", "match", "bench-filters", "evaluate-filters", "hull", "bench-hull"}};
+      {"dataset-info", "scene", "match", "bench-filters", "evaluate-filters", "hull",
+       "bench-hull"}};
   return runMain(program, argc, argv);
 }

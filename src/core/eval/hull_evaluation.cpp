@@ -1,5 +1,4 @@
 #include "sift_hull/eval/hull_evaluation.h"
-#include "sift_hull/eval/mesh_render.h"
 
 #include <algorithm>
 #include <atomic>
@@ -9,6 +8,7 @@
 #include <thread>
 
 #include "common/parallel.h"
+#include "sift_hull/eval/mesh_render.h"
 
 namespace sift_hull {
 namespace {

@@ -19,9 +19,8 @@ std::vector<Eigen::Vector3d> triangulateMatches(const PinholeCamera& left,
     if (!keep[m]) continue;
     const cv::Point2f& x_left = matches.left(m).pt;
     const cv::Point2f& x_right = matches.right(m).pt;
-    const std::optional<Eigen::Vector3d> point =
-        triangulate(left, right, Eigen::Vector2d(x_left.x, x_left.y),
-                    Eigen::Vector2d(x_right.x, x_right.y));
+    const std::optional<Eigen::Vector3d> point = triangulate(
+        left, right, Eigen::Vector2d(x_left.x, x_left.y), Eigen::Vector2d(x_right.x, x_right.y));
     if (point) points_W.push_back(*point);
   }
   return points_W;

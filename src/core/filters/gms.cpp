@@ -17,6 +17,8 @@
 // Points outside their image ([0, width) x [0, height)) are dropped: they count in no cell, are
 // never kept and score 0.
 
+#include "sift_hull/filters/gms.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -27,7 +29,6 @@
 #include <unordered_map>
 #include <vector>
 
-#include "sift_hull/filters/gms.h"
 #include "sift_hull/limits.h"
 
 namespace sift_hull {

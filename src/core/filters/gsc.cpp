@@ -12,13 +12,14 @@
 // counts in the upper half (b = 0) or in the sector farther from the polar axis direction (other
 // borders). Points coincident with the keypoint have no polar angle and are left out.
 
+#include "sift_hull/filters/gsc.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <thread>
 
 #include "common/parallel.h"
-#include "sift_hull/filters/gsc.h"
 
 namespace sift_hull {
 namespace {

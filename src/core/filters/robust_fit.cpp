@@ -37,7 +37,7 @@ FilterResult fitFundamentalMatrix(const PutativeMatches& input, int method,
 void validate(const RobustFitConfig& config, const std::string& name) {
   requireFit(config.max_epipolar_px > 0.0, name + ".max_epipolar_px must be > 0");
   requireFit(config.confidence > 0.0 && config.confidence < 1.0,
-          name + ".confidence must be in (0, 1)");
+             name + ".confidence must be in (0, 1)");
   requireFit(config.max_iterations >= 1, name + ".max_iterations must be >= 1");
 }
 

@@ -17,7 +17,8 @@ CommonPoint opticalAxesMeetingPoint(const std::vector<PinholeCamera>& cameras) {
   }
   CommonPoint result;
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(A);
-  result.well_defined = cameras.size() >= 2 && eigen.eigenvalues().minCoeff() > 1e-6 * cameras.size();
+  result.well_defined =
+      cameras.size() >= 2 && eigen.eigenvalues().minCoeff() > 1e-6 * cameras.size();
   if (!result.well_defined) return result;
   result.point_W = A.ldlt().solve(b);
   result.in_front_of_all = true;

@@ -1,10 +1,10 @@
 #include "sift_hull/hull/distance_map.h"
 
-#include "hull/distance_kernel.h"
-
 #include <algorithm>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
+
+#include "hull/distance_kernel.h"
 
 namespace sift_hull {
 namespace {

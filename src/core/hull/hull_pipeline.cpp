@@ -17,7 +17,6 @@ double millisecondsSince(Clock::time_point start) {
 
 }  // namespace
 
-
 Box3d boundingBoxOf(const std::vector<HullView>& views) {
   std::vector<PinholeCamera> cameras;
   std::vector<SilhouetteBounds> bounds;

@@ -1,3 +1,5 @@
+#include "sift_hull/hull/hull_view.h"
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -8,10 +10,9 @@
 #include <stdexcept>
 #include <thread>
 
-#include "hull/distance_kernel.h"
 #include "common/parallel.h"
+#include "hull/distance_kernel.h"
 #include "sift_hull/limits.h"
-#include "sift_hull/hull/hull_view.h"
 
 namespace sift_hull {
 namespace {

@@ -1,3 +1,5 @@
+#include "sift_hull/hull/marching_cubes.h"
+
 #include <vtkMarchingCubesTriangleCases.h>
 
 #include <algorithm>
@@ -8,8 +10,6 @@
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
-
-#include "sift_hull/hull/marching_cubes.h"
 
 namespace sift_hull {
 namespace {

@@ -13,7 +13,6 @@
 #include <stdexcept>
 #include <string>
 
-
 namespace sift_hull {
 namespace {
 

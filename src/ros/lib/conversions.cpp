@@ -16,8 +16,8 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "sift_hull/limits.h"
 #include "sift_hull/hull/mesh.h"
+#include "sift_hull/limits.h"
 
 namespace sift_hull {
 namespace ros_conversions {
@@ -319,8 +319,9 @@ sift_hull::Correspondences correspondencesMessage(const std_msgs::Header& left_h
   for (const FilterResult& result : results) {
     if (result.keep.size() != matches.matches.size() ||
         result.score.size() != matches.matches.size()) {
-      throw std::invalid_argument("correspondencesMessage: a filter result has not one entry "
-                                  "per match");
+      throw std::invalid_argument(
+          "correspondencesMessage: a filter result has not one entry "
+          "per match");
     }
   }
   sift_hull::Correspondences out;

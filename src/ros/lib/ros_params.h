@@ -15,14 +15,14 @@
 #include <string>
 #include <vector>
 
+#include "lib/result_saver.h"
 #include "nodes/hull_node.h"
 #include "nodes/matcher_node.h"
-#include "lib/result_saver.h"
-#include "sift_hull/io/calibration.h"
-#include "sift_hull/hull/hull_stream.h"
 #include "sift_hull/filters/filter.h"
 #include "sift_hull/hull/hull_config.h"
+#include "sift_hull/hull/hull_stream.h"
 #include "sift_hull/hull/silhouette.h"
+#include "sift_hull/io/calibration.h"
 
 namespace sift_hull {
 namespace ros_params {

@@ -19,13 +19,13 @@
 #include "lib/node_diagnostics.h"
 #include "lib/pose_gate.h"
 #include "lib/pose_waits.h"
+#include "lib/throttled_log.h"
+#include "lib/work_queue.h"
 #include "sift_hull/Save.h"
-#include "sift_hull/io/calibration.h"
 #include "sift_hull/hull/hull_stream.h"
 #include "sift_hull/hull/mesh.h"
 #include "sift_hull/hull/silhouette.h"
-#include "lib/throttled_log.h"
-#include "lib/work_queue.h"
+#include "sift_hull/io/calibration.h"
 
 namespace sift_hull {
 

@@ -9,11 +9,11 @@
 #include "lib/conversions.h"
 #include "lib/node_diagnostics.h"
 #include "lib/ros_params.h"
+#include "lib/wall_wait.h"
 #include "sift_hull/eval/match_drawing.h"
 #include "sift_hull/features/triangulation.h"
 #include "sift_hull/filters/filter.h"
 #include "sift_hull/filters/filter_result.h"
-#include "lib/wall_wait.h"
 
 namespace sift_hull {
 namespace {

@@ -22,15 +22,15 @@
 
 #include "lib/image_input.h"
 #include "lib/node_diagnostics.h"
-#include "sift_hull/Correspondences.h"
-#include "sift_hull/MatcherConfig.h"
-#include "sift_hull/geometry/camera.h"
-#include "sift_hull/features/sift.h"
-#include "sift_hull/filters/filter.h"
-#include "sift_hull/features/matching.h"
-#include "sift_hull/filters/filter_result.h"
 #include "lib/throttled_log.h"
 #include "lib/work_queue.h"
+#include "sift_hull/Correspondences.h"
+#include "sift_hull/MatcherConfig.h"
+#include "sift_hull/features/matching.h"
+#include "sift_hull/features/sift.h"
+#include "sift_hull/filters/filter.h"
+#include "sift_hull/filters/filter_result.h"
+#include "sift_hull/geometry/camera.h"
 
 namespace sift_hull {
 
