@@ -3,6 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -99,6 +103,47 @@ TEST(CorrespondencesMessage, RefusesResultsThatDoNotFitTheMatchesOrTheNames) {
       std::invalid_argument);
   EXPECT_NO_THROW(ros_conversions::correspondencesMessage(header("l", 1), header("r", 1), {"a"},
                                                           "{}", matches, {good}));
+}
+
+TEST(SettingsJson, HoldsEverySettingUnderItsParameterName) {
+  MatchConfig matching;
+  matching.ratio = 0.7;
+  matching.max_descriptor_distance = 250.0;
+  FilterConfigs filters;
+  filters.epipolar.max_epipolar_px = 1.5;
+  filters.gsc.max_histogram_distance = 0.25;
+  filters.ransac.max_epipolar_px = 0.75;
+  filters.magsac.max_iterations = 500;
+  filters.gms.grid_cells = 12;
+  const nlohmann::json json =
+      nlohmann::json::parse(ros_conversions::settingsJson(matching, filters));
+  EXPECT_DOUBLE_EQ(json.at("ratio").get<double>(), 0.7);
+  EXPECT_DOUBLE_EQ(json.at("max_descriptor_distance").get<double>(), 250.0);
+  EXPECT_DOUBLE_EQ(json.at("max_epipolar_px").get<double>(), 1.5);
+  EXPECT_DOUBLE_EQ(json.at("max_histogram_distance").get<double>(), 0.25);
+  EXPECT_DOUBLE_EQ(json.at("ransac_max_epipolar_px").get<double>(), 0.75);
+  EXPECT_DOUBLE_EQ(json.at("magsac_max_epipolar_px").get<double>(), filters.magsac.max_epipolar_px);
+  EXPECT_EQ(json.at("magsac_max_iterations").get<int>(), 500);
+  EXPECT_EQ(json.at("grid_cells").get<int>(), 12);
+  // Each key is the name of a parameter that config/matcher.yaml states (one name per setting).
+  std::ifstream yaml(std::string(SIFT_HULL_SOURCE_DIR) + "/config/matcher.yaml");
+  ASSERT_TRUE(yaml.good());
+  std::set<std::string> parameters;
+  for (std::string line; std::getline(yaml, line);) {
+    const size_t colon = line.find(':');
+    if (line.empty() || line[0] == '#' || line[0] == ' ' || colon == std::string::npos) continue;
+    parameters.insert(line.substr(0, colon));
+  }
+  ASSERT_GT(parameters.size(), 20u);
+  for (const auto& [key, value] : json.items()) {
+    EXPECT_TRUE(parameters.count(key)) << key << " is no parameter of config/matcher.yaml";
+  }
+  EXPECT_GE(json.size(), 16u);
+  // No limit on the descriptor distance is null, not infinity (which JSON cannot hold).
+  matching.max_descriptor_distance = INFINITY;
+  EXPECT_TRUE(nlohmann::json::parse(ros_conversions::settingsJson(matching, filters))
+                  .at("max_descriptor_distance")
+                  .is_null());
 }
 
 }  // namespace
