@@ -16,6 +16,7 @@ set(SIFT_HULL_CORE_GTESTS
   test_filters eval
   test_evaluation eval
   test_scene eval
+  test_scene_backgrounds eval
   test_mesh_render eval
   test_hull eval
   test_hull_data eval

@@ -46,6 +46,7 @@ SceneConfig configFromArgs(const ArgParser& parser) {
   config.layout = parser.get("layout");
   config.seed = static_cast<unsigned>(parser.getInt("seed"));
   config.camera_distance_m = parser.getDouble("camera-distance-m");
+  config.background = parser.get("background");
   validateOptions(config);
   return config;
 }
@@ -68,6 +69,10 @@ int runScene(const std::vector<std::string>& args) {
   parser.addOption("camera-distance-m", "M", "camera distance from the object's centre in metres",
                    formatNumber(defaults.camera_distance_m));
   parser.addDeprecatedAlias("distance", {"camera-distance-m"});
+  parser.addOption("background", "NAME",
+                   "what the rays missing the object see: " + joined(sceneBackgrounds()) +
+                       " (blue: uniform dark blue; textured: coloured blobs)",
+                   defaults.background);
   parser.addFlag("json", "print the result as one JSON object");
   if (!parser.parse(args)) return 0;
   const SceneConfig config = configFromArgs(parser);
@@ -84,6 +89,7 @@ int runScene(const std::vector<std::string>& args) {
       {"views", config.views},
       {"size", {config.width_px, config.height_px}},
       {"shape", config.shape},
+      {"background", config.background},
       {"time_ms", {{"render", render_ms}, {"write", total_ms - render_ms}, {"total", total_ms}}}};
   std::ostringstream text;
   text << "wrote " << config.views << " views of '" << config.shape << "' (" << config.width_px

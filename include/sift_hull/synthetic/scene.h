@@ -21,7 +21,14 @@ struct SceneConfig {
   double camera_distance_m = 4.0;    ///< from the shape's bounding centre
   double ring_elevation_deg = 25.0;  ///< above the horizontal plane, for the ring layout
   double fill_fraction = 0.8;        ///< share of the smaller image side the bounding sphere spans
+  /// What the rays that miss the object see (sceneBackgrounds()): "black"; "blue", a uniform dark
+  /// blue (grey level 0.196, just above the Middlebury recipe's threshold); "textured", coloured
+  /// blobs on a sphere at infinity (a colour per ray direction, so the views see one world).
+  std::string background = "black";
 };
+
+/// The background names SceneConfig::background takes.
+const std::vector<std::string>& sceneBackgrounds();
 
 /// Throws std::invalid_argument naming the first bad field.
 void validate(const SceneConfig& config);
@@ -29,7 +36,7 @@ void validate(const SceneConfig& config);
 /// One rendered view. Pixel (u, v) is the colour seen along the ray through its centre.
 struct RenderedView {
   CalibratedView view;
-  cv::Mat image;  ///< CV_8UC3, BGR, black background
+  cv::Mat image;  ///< CV_8UC3, BGR, on the scene's background
   cv::Mat mask;   ///< CV_8UC1, 255 where the ray hits the object
   cv::Mat depth;  ///< CV_32FC1, depth along the optical axis in metres, +inf on the background
 };
@@ -38,8 +45,9 @@ struct RenderedView {
 std::vector<CalibratedView> sceneCameras(const SceneConfig& config, const Shape& shape);
 
 /// Ray-casts one view: solid procedural texture, Lambertian shading under a fixed world light.
+/// `background` as SceneConfig::background.
 RenderedView renderView(const Shape& shape, const CalibratedView& view, cv::Size size,
-                        unsigned seed);
+                        unsigned seed, const std::string& background = "black");
 
 std::vector<RenderedView> renderScene(const SceneConfig& config);
 

@@ -1,5 +1,6 @@
 #include "sift_hull/synthetic/scene.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -62,14 +63,30 @@ Eigen::Matrix3d intrinsics(const SceneConfig& config, const Shape& shape) {
   return K;
 }
 
+/// The colour of a ray that misses the object (SceneConfig::background, checked by validate).
+cv::Vec3b backgroundColour(const std::string& background, const Eigen::Vector3d& direction_W,
+                           unsigned seed) {
+  if (background == "blue") return cv::Vec3b(120, 50, 25);  // BGR, grey 0.196
+  if (background == "textured") {
+    // Blobs of the solid texture on a sphere far away, in saturated mid-bright colours; another
+    // seed than the object's, so the two do not share a pattern.
+    const cv::Vec3f albedo = solidTexture(8.0 * direction_W, seed + 7919);
+    cv::Vec3b colour;
+    for (int c = 0; c < 3; ++c) colour[c] = cv::saturate_cast<uint8_t>(40.0 + 180.0 * albedo[c]);
+    return colour;
+  }
+  return cv::Vec3b(0, 0, 0);
+}
+
 void shadePixel(const Shape& shape, const PinholeCamera& camera, const Eigen::Vector2d& pixel,
-                unsigned seed, cv::Vec3b* colour, uint8_t* inside, float* depth) {
+                unsigned seed, const std::string& background, cv::Vec3b* colour, uint8_t* inside,
+                float* depth) {
   static const Eigen::Vector3d light_W = Eigen::Vector3d(0.4, 0.3, 0.85).normalized();
   const Eigen::Vector3d origin = camera.centre();
   const Eigen::Vector3d direction = camera.rayDirection(pixel);
   RayHit hit;
   if (!shape.firstHit(origin, direction, &hit)) {
-    *colour = cv::Vec3b(0, 0, 0);
+    *colour = backgroundColour(background, direction, seed);
     *inside = 0;
     *depth = std::numeric_limits<float>::infinity();
     return;
@@ -102,7 +119,8 @@ nlohmann::json toJson(const SceneConfig& c) {
           {"seed", c.seed},
           {"camera_distance_m", c.camera_distance_m},
           {"ring_elevation_deg", c.ring_elevation_deg},
-          {"fill_fraction", c.fill_fraction}};
+          {"fill_fraction", c.fill_fraction},
+          {"background", c.background}};
 }
 
 SceneConfig configFromJson(const nlohmann::json& j) {
@@ -116,6 +134,7 @@ SceneConfig configFromJson(const nlohmann::json& j) {
   c.camera_distance_m = j.at("camera_distance_m").get<double>();
   c.ring_elevation_deg = j.at("ring_elevation_deg").get<double>();
   c.fill_fraction = j.at("fill_fraction").get<double>();
+  c.background = j.value("background", "black");  // scenes written before it existed: black
   return c;
 }
 
@@ -141,6 +160,9 @@ void validate(const SceneConfig& config) {
   require(std::abs(config.ring_elevation_deg) < 85.0, "ring elevation must lie in (-85, 85) deg");
   require(config.fill_fraction > 0.0 && config.fill_fraction <= 1.0,
           "fill fraction must lie in (0, 1]");
+  const std::vector<std::string>& backgrounds = sceneBackgrounds();
+  require(std::find(backgrounds.begin(), backgrounds.end(), config.background) != backgrounds.end(),
+          "background must be black, blue or textured, not '" + config.background + "'");
 }
 
 std::vector<CalibratedView> sceneCameras(const SceneConfig& config, const Shape& shape) {
@@ -158,14 +180,20 @@ std::vector<CalibratedView> sceneCameras(const SceneConfig& config, const Shape&
   return views;
 }
 
+const std::vector<std::string>& sceneBackgrounds() {
+  static const std::vector<std::string> names = {"black", "blue", "textured"};
+  return names;
+}
+
 RenderedView renderView(const Shape& shape, const CalibratedView& view, cv::Size size,
-                        unsigned seed) {
+                        unsigned seed, const std::string& background) {
   RenderedView out{view, cv::Mat(size, CV_8UC3), cv::Mat(size, CV_8UC1), cv::Mat(size, CV_32FC1)};
   cv::parallel_for_(cv::Range(0, size.height), [&](const cv::Range& rows) {
     for (int v = rows.start; v < rows.end; ++v) {
       for (int u = 0; u < size.width; ++u) {
-        shadePixel(shape, view.camera, Eigen::Vector2d(u, v), seed, &out.image.at<cv::Vec3b>(v, u),
-                   &out.mask.at<uint8_t>(v, u), &out.depth.at<float>(v, u));
+        shadePixel(shape, view.camera, Eigen::Vector2d(u, v), seed, background,
+                   &out.image.at<cv::Vec3b>(v, u), &out.mask.at<uint8_t>(v, u),
+                   &out.depth.at<float>(v, u));
       }
     }
   });
@@ -176,8 +204,8 @@ std::vector<RenderedView> renderScene(const SceneConfig& config) {
   const Shape shape = Shape::byName(config.shape);
   std::vector<RenderedView> rendered;
   for (const CalibratedView& view : sceneCameras(config, shape)) {
-    rendered.push_back(
-        renderView(shape, view, cv::Size(config.width_px, config.height_px), config.seed));
+    rendered.push_back(renderView(shape, view, cv::Size(config.width_px, config.height_px),
+                                  config.seed, config.background));
   }
   return rendered;
 }
@@ -186,8 +214,8 @@ RenderedView renderSceneView(const SceneConfig& config, size_t index) {
   const Shape shape = Shape::byName(config.shape);
   const std::vector<CalibratedView> cameras = sceneCameras(config, shape);
   if (index >= cameras.size()) throw std::out_of_range("renderSceneView: no such view");
-  return renderView(shape, cameras[index], cv::Size(config.width_px, config.height_px),
-                    config.seed);
+  return renderView(shape, cameras[index], cv::Size(config.width_px, config.height_px), config.seed,
+                    config.background);
 }
 
 void writeScene(const std::string& directory, const SceneConfig& config,
