@@ -17,6 +17,7 @@ set(SIFT_HULL_CORE_GTESTS
   test_evaluation eval
   test_scene eval
   test_scene_backgrounds eval
+  test_silhouettes eval
   test_mesh_render eval
   test_hull eval
   test_hull_data eval

@@ -14,6 +14,10 @@ void addSilhouetteOptions(ArgParser* parser) {
   parser->addOption("silhouettes", "DIR",
                     "directory of mask files named like the images (default: extract them from "
                     "the images)");
+  parser->addOption("silhouette-method", "NAME",
+                    "how silhouettes come from images: threshold (grey above --threshold) or "
+                    "background (a colour model of the image border, no threshold needed)",
+                    defaults.silhouette_method);
   parser->addOption("threshold", "T", "silhouette threshold on grey intensity in [0, 1]",
                     threshold.str());
   parser->addOption("dilate-px", "PX", "silhouette dilation radius in pixels",
@@ -26,6 +30,7 @@ void addSilhouetteOptions(ArgParser* parser) {
 
 SilhouetteConfig silhouetteConfigFromArgs(const ArgParser& parser) {
   SilhouetteConfig config;
+  config.silhouette_method = parser.get("silhouette-method");
   config.threshold = parser.getDouble("threshold");
   config.dilate_px = parser.getInt("dilate-px");
   config.erode_px = parser.getInt("erode-px");

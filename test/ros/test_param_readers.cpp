@@ -52,6 +52,7 @@ void expectDefaultHull(const ros::NodeHandle& nh) {
   EXPECT_EQ(node.pose_timeout_s, node_default.pose_timeout_s);
   EXPECT_EQ(node.from_image, node_default.from_image);
   EXPECT_EQ(node.diagnostic_period, node_default.diagnostic_period);
+  EXPECT_EQ(node.recipe.silhouette_method, node_default.recipe.silhouette_method);
   EXPECT_EQ(node.recipe.threshold, node_default.recipe.threshold);
   EXPECT_EQ(node.recipe.dilate_px, node_default.recipe.dilate_px);
   EXPECT_EQ(node.recipe.erode_px, node_default.recipe.erode_px);

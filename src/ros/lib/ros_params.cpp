@@ -105,6 +105,7 @@ double descriptorDistanceParam(double distance) { return std::isfinite(distance)
 
 SilhouetteConfig readSilhouetteConfig(const ros::NodeHandle& private_nh) {
   SilhouetteConfig config;
+  read(private_nh, "silhouette_method", &config.silhouette_method);
   read(private_nh, "threshold", &config.threshold);
   read(private_nh, "dilate_px", &config.dilate_px);
   read(private_nh, "erode_px", &config.erode_px);
