@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <iostream>
+#include <opencv2/imgproc.hpp>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -84,6 +85,44 @@ TEST(BackgroundSilhouettes, GiveTheMiddleburyRingsTheirHullWithoutAThreshold) {
   if (!std::isnan(temple)) {
     EXPECT_GE(temple, 0.985);
   }
+}
+
+TEST(SilhouetteWarnings, NameEmptyFullAndBorderTouchingSilhouettes) {
+  const cv::Size size(40, 30);
+  cv::Mat good(size, CV_8UC1, cv::Scalar(0)), empty = good.clone(), full(size, CV_8UC1, 255);
+  cv::rectangle(good, cv::Rect(10, 5, 20, 20), 255, cv::FILLED);
+  cv::Mat frame = good.clone();  // touches every border, covers under 90 %
+  cv::rectangle(frame, cv::Rect(0, 0, 40, 30), 255, 1);
+  const std::vector<std::string> warnings =
+      silhouetteWarnings({"good", "empty", "full", "frame"}, {good, empty, full, frame});
+  ASSERT_EQ(warnings.size(), 3u);
+  EXPECT_EQ(warnings[0].rfind("empty: the silhouette is empty", 0), 0u) << warnings[0];
+  EXPECT_EQ(warnings[1].rfind("full: the silhouette covers 100 %", 0), 0u) << warnings[1];
+  EXPECT_EQ(warnings[2].rfind("frame: the silhouette touches all four", 0), 0u) << warnings[2];
+  EXPECT_THROW(silhouetteWarnings({"a"}, {}), std::invalid_argument);
+}
+
+TEST(SilhouetteWarnings, NameTheViewFarBelowTheOthers) {
+  const std::vector<std::string> names = {"a", "b", "c", "d"};
+  EXPECT_TRUE(disagreeingViewWarnings(names, {0.99, 0.98, 0.985, 0.95}).empty());
+  const std::vector<std::string> warnings =
+      disagreeingViewWarnings(names, {0.99, 0.62, 0.985, 0.97});
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_EQ(warnings[0].rfind("b: the hull reprojects onto its silhouette with IoU 0.62", 0), 0u)
+      << warnings[0];
+  // On the blue background the grey threshold's silhouettes are all suspect.
+  SceneConfig config;
+  config.views = 3;
+  config.width_px = 160;
+  config.height_px = 120;
+  config.background = "blue";
+  std::vector<std::string> scene_names;
+  std::vector<cv::Mat> masks;
+  for (const RenderedView& view : renderScene(config)) {
+    scene_names.push_back(view.view.name);
+    masks.push_back(silhouetteFromImage(view.image, SilhouetteConfig()));
+  }
+  EXPECT_EQ(silhouetteWarnings(scene_names, masks).size(), 3u);
 }
 
 TEST(BackgroundSilhouettes, UnknownMethodsAndBadImagesAreRefused) {

@@ -2,6 +2,7 @@
 
 #include <opencv2/core.hpp>
 #include <string>
+#include <vector>
 
 namespace sift_hull {
 
@@ -31,5 +32,17 @@ cv::Mat silhouetteFromImage(const cv::Mat& image, const SilhouetteConfig& config
 /// the image's border band (`border_fraction` of the smaller side, at least 2 pixels wide): the
 /// "background" method's evidence, before its threshold.
 cv::Mat backgroundDistance(const cv::Mat& image, double border_fraction = 0.03);
+
+/// What makes a silhouette suspect, named for the user: empty, covering more than 90 % of its
+/// image, or touching all four image borders (a background taken for the object). One message per
+/// suspect view, "NAME: reason; leave the view out or give its mask"; none for a good one.
+std::vector<std::string> silhouetteWarnings(const std::vector<std::string>& names,
+                                            const std::vector<cv::Mat>& masks);
+
+/// The views whose reprojection IoU (one per view, e.g. ReprojectionIoU::per_view) lies far below
+/// the others': more than 0.1 under the median and under 0.9. One message per such view, naming
+/// it and its IoU and suggesting to leave it out.
+std::vector<std::string> disagreeingViewWarnings(const std::vector<std::string>& names,
+                                                 const std::vector<double>& reprojection_iou);
 
 }  // namespace sift_hull

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <limits>
 #include <opencv2/imgproc.hpp>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -143,6 +144,60 @@ cv::Mat silhouetteFromImage(const cv::Mat& image, const SilhouetteConfig& config
   }
   return config.silhouette_method == "background" ? backgroundSilhouette(image, config)
                                                   : thresholdSilhouette(image, config);
+}
+
+std::vector<std::string> silhouetteWarnings(const std::vector<std::string>& names,
+                                            const std::vector<cv::Mat>& masks) {
+  if (names.size() != masks.size()) {
+    throw std::invalid_argument("silhouetteWarnings: one name per mask");
+  }
+  std::vector<std::string> warnings;
+  for (size_t i = 0; i < masks.size(); ++i) {
+    const cv::Mat& mask = masks[i];
+    if (mask.empty() || mask.type() != CV_8UC1) {
+      throw std::invalid_argument("silhouetteWarnings: '" + names[i] + "' is not a CV_8UC1 mask");
+    }
+    const double share = static_cast<double>(cv::countNonZero(mask)) / mask.total();
+    std::string reason;
+    if (share == 0.0) {
+      reason = "the silhouette is empty";
+    } else if (share > 0.9) {
+      reason = "the silhouette covers " + std::to_string(static_cast<int>(100 * share)) +
+               " % of the image (the background taken for the object?)";
+    } else if (cv::countNonZero(mask.row(0)) > 0 && cv::countNonZero(mask.row(mask.rows - 1)) > 0 &&
+               cv::countNonZero(mask.col(0)) > 0 && cv::countNonZero(mask.col(mask.cols - 1)) > 0) {
+      reason =
+          "the silhouette touches all four image borders (the background taken for the "
+          "object?)";
+    }
+    if (!reason.empty()) {
+      warnings.push_back(names[i] + ": " + reason + "; leave the view out or give its mask");
+    }
+  }
+  return warnings;
+}
+
+std::vector<std::string> disagreeingViewWarnings(const std::vector<std::string>& names,
+                                                 const std::vector<double>& reprojection_iou) {
+  if (names.size() != reprojection_iou.size()) {
+    throw std::invalid_argument("disagreeingViewWarnings: one name per IoU");
+  }
+  std::vector<double> sorted = reprojection_iou;
+  if (sorted.size() < 3) return {};
+  std::sort(sorted.begin(), sorted.end());
+  const double median = sorted[sorted.size() / 2];
+  std::vector<std::string> warnings;
+  for (size_t i = 0; i < names.size(); ++i) {
+    const double iou = reprojection_iou[i];
+    if (iou < 0.9 && iou < median - 0.1) {
+      std::ostringstream message;
+      message << names[i] << ": the hull reprojects onto its silhouette with IoU " << iou
+              << ", the median view's " << median
+              << ": its silhouette or camera disagrees with the others; leave the view out";
+      warnings.push_back(message.str());
+    }
+  }
+  return warnings;
 }
 
 }  // namespace sift_hull
