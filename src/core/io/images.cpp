@@ -1,6 +1,8 @@
 #include "sift_hull/io/images.h"
 
+#include <exception>
 #include <fstream>
+#include <opencv2/core/utility.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
 
@@ -45,26 +47,47 @@ std::vector<cv::Mat> loadSilhouettes(const std::vector<CalibratedView>& views,
                                      const std::string& image_directory,
                                      const std::string& mask_directory,
                                      const SilhouetteConfig& recipe) {
+  // Each view read and its silhouette made on OpenCV's threads, one image in memory per thread;
+  // then the checks in view order, so the first error is the one a sequential read would meet.
+  struct Loaded {
+    cv::Size image_size;
+    cv::Mat silhouette;
+    std::exception_ptr error;
+  };
+  std::vector<Loaded> loaded(views.size());
+  cv::parallel_for_(cv::Range(0, static_cast<int>(views.size())), [&](const cv::Range& range) {
+    for (int i = range.start; i < range.end; ++i) {
+      try {
+        const cv::Mat image = loadViewImage(image_directory, views[i]);
+        loaded[i].image_size = image.size();
+        loaded[i].silhouette = mask_directory.empty()
+                                   ? silhouetteFromImage(image, recipe)
+                                   : loadMask(mask_directory + "/" + views[i].name);
+      } catch (...) {
+        loaded[i].error = std::current_exception();
+      }
+    }
+  });
   std::vector<cv::Mat> silhouettes;
-  for (const CalibratedView& view : views) {
-    const cv::Mat image = loadViewImage(image_directory, view);
-    if (!silhouettes.empty() && image.size() != silhouettes.front().size()) {
+  for (size_t i = 0; i < views.size(); ++i) {
+    const CalibratedView& view = views[i];
+    // A sequential read meets a bad image, then a size other than the first's, then a bad mask.
+    if (loaded[i].error && loaded[i].image_size.empty()) std::rethrow_exception(loaded[i].error);
+    const cv::Size size = loaded[i].image_size;
+    if (i > 0 && size != loaded[0].image_size) {
       throw std::runtime_error(image_directory + "/" + view.name + ": image size differs from " +
-                               views.front().name + "'s (" + std::to_string(image.cols) + "x" +
-                               std::to_string(image.rows) + ", not " +
-                               std::to_string(silhouettes.front().cols) + "x" +
-                               std::to_string(silhouettes.front().rows) +
+                               views.front().name + "'s (" + std::to_string(size.width) + "x" +
+                               std::to_string(size.height) + ", not " +
+                               std::to_string(loaded[0].image_size.width) + "x" +
+                               std::to_string(loaded[0].image_size.height) +
                                "): one calibration set is for one image size");
     }
-    if (mask_directory.empty()) {
-      silhouettes.push_back(silhouetteFromImage(image, recipe));
-      continue;
+    if (loaded[i].error) std::rethrow_exception(loaded[i].error);
+    if (loaded[i].silhouette.size() != size) {
+      throw std::runtime_error(mask_directory + "/" + view.name +
+                               ": mask size differs from the image's");
     }
-    const std::string path = mask_directory + "/" + view.name;
-    silhouettes.push_back(loadMask(path));
-    if (silhouettes.back().size() != image.size()) {
-      throw std::runtime_error(path + ": mask size differs from the image's");
-    }
+    silhouettes.push_back(std::move(loaded[i].silhouette));
   }
   return silhouettes;
 }
