@@ -247,6 +247,18 @@ bool Box3d::contains(const Eigen::Vector3d& X_W, double tolerance_m) const {
          (X_W.array() <= max_W.array() + tolerance_m).all();
 }
 
+std::vector<std::string> viewsSeeingBoxBehind(const Box3d& box,
+                                              const std::vector<PinholeCamera>& cameras,
+                                              const std::vector<std::string>& names) {
+  const std::vector<std::string> given = names.size() == cameras.size() ? names
+                                                                          : std::vector<std::string>{};
+  std::vector<std::string> behind;
+  for (size_t i = 0; i < cameras.size(); ++i) {
+    if (!(cameras[i].depth(box.centre()) > 0.0)) behind.push_back(viewName(given, i));
+  }
+  return behind;
+}
+
 SilhouetteBounds silhouetteBounds(const cv::Mat& mask, bool border_bounds_object) {
   if (mask.empty()) throw std::invalid_argument("silhouetteBounds: the mask is empty");
   if (mask.type() != CV_8UC1) throw std::invalid_argument("silhouetteBounds: mask is not CV_8UC1");
