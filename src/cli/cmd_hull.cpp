@@ -63,8 +63,7 @@ std::string joined(const std::vector<std::string>& names) {
 void checkBox(const Box3d& box, const HullInput& input, PoorResults* poor) {
   const std::vector<std::string> behind = viewsSeeingBoxBehind(box, input.cameras, input.names);
   if (!input.cameras.empty() && behind.size() == input.cameras.size()) {
-    poor->report("no camera sees the --box in front of it: its centre is behind " +
-                 joined(behind));
+    poor->report("no camera sees the --box in front of it: its centre is behind " + joined(behind));
   }
   const double distance = camerasMutualDistance(input.cameras);
   const double edge = box.size().maxCoeff();

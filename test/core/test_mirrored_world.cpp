@@ -97,10 +97,9 @@ TEST(MirroredWorld, EachViewsSignIsChosenSoThatTheSceneIsInFront) {
     }
   }
   // The mirrored world with one view's P negated: that view is oriented too.
-  const std::vector<PinholeCamera> cameras =
-      throughProjections(normal.cameras, [](size_t i, const Matrix34d& P) {
-        return i == 3 ? Matrix34d(-mirrored(P)) : mirrored(P);
-      });
+  const std::vector<PinholeCamera> cameras = throughProjections(
+      normal.cameras,
+      [](size_t i, const Matrix34d& P) { return i == 3 ? Matrix34d(-mirrored(P)) : mirrored(P); });
   for (const PinholeCamera& camera : cameras) {
     EXPECT_TRUE(camera.improper());
     EXPECT_GT(camera.depth(Eigen::Vector3d::Zero()), 0.0);
@@ -133,8 +132,8 @@ TEST(MirroredWorld, TheStreamRefusesAViewThatSeesTheGivenBoxBehindIt) {
   HullStream stream(config);
   const PinholeCamera& camera = input.cameras[0];
   const Eigen::Matrix3d turn = Eigen::Vector3d(-1.0, 1.0, -1.0).asDiagonal();  // half a turn
-  const PinholeCamera away = PinholeCamera::fromCentre(camera.K(), turn * camera.R(),
-                                                       camera.centre());
+  const PinholeCamera away =
+      PinholeCamera::fromCentre(camera.K(), turn * camera.R(), camera.centre());
   EXPECT_EQ(stream.add("away", away, input.masks[0]), HullStream::Outcome::kRefused);
   const std::vector<std::string> refusals = stream.takeRefusals();
   ASSERT_EQ(refusals.size(), 1u);
@@ -177,10 +176,10 @@ class MirroredCommandLine : public ::testing::Test {
            const std::string& calib = "") {
     std::string out;
     const std::string par = calib.empty() ? *scene_ + "/scene_par.txt" : calib;
-    const int code = test::runProgram("hull --json --calib " + par + " --images " + *scene_ +
-                                          " --silhouettes " + *scene_ + "/masks --max-depth 6 " +
-                                          extra,
-                                      &out, err);
+    const int code =
+        test::runProgram("hull --json --calib " + par + " --images " + *scene_ + " --silhouettes " +
+                             *scene_ + "/masks --max-depth 6 " + extra,
+                         &out, err);
     if (code == 0) *json = nlohmann::json::parse(out);
     return code;
   }
@@ -197,8 +196,7 @@ TEST_F(MirroredCommandLine, MirroredAndNegatedListsGiveTheSameHull) {
                  projectionList([](size_t, const Matrix34d& P) { return mirrored(P); })),
             0)
       << err;
-  ASSERT_EQ(hull("", &negated, &err,
-                 projectionList([](size_t i, const Matrix34d& P) {
+  ASSERT_EQ(hull("", &negated, &err, projectionList([](size_t i, const Matrix34d& P) {
                    return i % 3 == 0 ? Matrix34d(-P) : P;
                  })),
             0)
@@ -219,8 +217,7 @@ TEST_F(MirroredCommandLine, MirroredAndNegatedListsGiveTheSameHull) {
 TEST_F(MirroredCommandLine, AMixedHandednessListIsRefusedNamingTheCamera) {
   nlohmann::json json;
   std::string err;
-  EXPECT_EQ(hull("", &json, &err,
-                 projectionList([](size_t i, const Matrix34d& P) {
+  EXPECT_EQ(hull("", &json, &err, projectionList([](size_t i, const Matrix34d& P) {
                    return i == 5 ? mirrored(P) : P;
                  })),
             1);
@@ -238,9 +235,9 @@ TEST_F(MirroredCommandLine, PoorResultsAreErrorsUnlessAllowed) {
   ASSERT_LT(a.depth(behind), 0.0);
   ASSERT_LT(b.depth(behind), 0.0);
   std::ostringstream behind_box;
-  behind_box << "--views " << views[0].name << "," << views[1].name << " --box "
-             << behind.x() - 0.5 << ',' << behind.y() - 0.5 << ',' << behind.z() - 0.5 << ','
-             << behind.x() + 0.5 << ',' << behind.y() + 0.5 << ',' << behind.z() + 0.5;
+  behind_box << "--views " << views[0].name << "," << views[1].name << " --box " << behind.x() - 0.5
+             << ',' << behind.y() - 0.5 << ',' << behind.z() - 0.5 << ',' << behind.x() + 0.5 << ','
+             << behind.y() + 0.5 << ',' << behind.z() + 0.5;
   const struct {
     std::string arguments, reason;
   } cases[] = {

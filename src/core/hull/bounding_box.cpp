@@ -250,8 +250,8 @@ bool Box3d::contains(const Eigen::Vector3d& X_W, double tolerance_m) const {
 std::vector<std::string> viewsSeeingBoxBehind(const Box3d& box,
                                               const std::vector<PinholeCamera>& cameras,
                                               const std::vector<std::string>& names) {
-  const std::vector<std::string> given = names.size() == cameras.size() ? names
-                                                                          : std::vector<std::string>{};
+  const std::vector<std::string> given =
+      names.size() == cameras.size() ? names : std::vector<std::string>{};
   std::vector<std::string> behind;
   for (size_t i = 0; i < cameras.size(); ++i) {
     if (!(cameras[i].depth(box.centre()) > 0.0)) behind.push_back(viewName(given, i));
