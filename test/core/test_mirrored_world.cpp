@@ -14,6 +14,7 @@
 #include "common/test_data.h"
 #include "sift_hull/eval/hull_evaluation.h"
 #include "sift_hull/geometry/camera_set.h"
+#include "sift_hull/hull/bounding_box.h"
 #include "sift_hull/hull/hull_pipeline.h"
 #include "sift_hull/hull/hull_stream.h"
 #include "sift_hull/hull/mesh.h"
@@ -119,6 +120,21 @@ TEST(MirroredWorld, OneMirroredCameraAmongRightHandedOnesIsNamed) {
   } catch (const std::invalid_argument& e) {
     EXPECT_TRUE(contains(e.what(), "'" + normal.names[4] + "'")) << e.what();
     EXPECT_FALSE(contains(e.what(), normal.names[3])) << e.what();
+  }
+}
+
+TEST(MirroredWorld, AnEmptyBoxNamesTheCamerasThatSeeTheSceneBehindThem) {
+  const HullInput input = test::ring(6);
+  std::vector<PinholeCamera> cameras = input.cameras;
+  cameras[2] = cameras[2].negated();  // its P's sign kept wrong: the object behind it
+  std::vector<SilhouetteBounds> bounds;
+  for (const cv::Mat& mask : input.masks) bounds.push_back(silhouetteBounds(mask, false));
+  try {
+    hullBoundingBox(cameras, bounds, input.names);
+    FAIL() << "a box was found";
+  } catch (const HullBoxError& e) {
+    EXPECT_EQ(e.reason(), HullBoxError::Reason::kEmpty);
+    EXPECT_TRUE(contains(e.what(), "behind '" + input.names[2] + "'")) << e.what();
   }
 }
 
