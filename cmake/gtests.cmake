@@ -24,6 +24,7 @@ set(SIFT_HULL_CORE_GTESTS
   test_hull_stream eval
   test_hull_stream_refusals eval
   test_hardening eval
+  test_mirrored_world eval
 )
 # The harnesses of test/fuzz whose corpus test_fuzz_corpus replays: CamelCase entry point names,
 # file test/fuzz/fuzz_<snake_case>.cpp.

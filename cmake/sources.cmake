@@ -36,6 +36,7 @@ set(SIFT_HULL_IO_SOURCES
   src/core/io/pfm.cpp
   src/core/io/ply.cpp
   src/core/io/view_list.cpp
+  src/core/io/view_orientation.cpp
 )
 set(SIFT_HULL_EVAL_SOURCES
   src/core/synthetic/scene.cpp

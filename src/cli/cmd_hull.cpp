@@ -1,5 +1,6 @@
 #include <octomap/OcTree.h>
 
+#include <iostream>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
@@ -8,6 +9,7 @@
 #include "commands.h"
 #include "hull_options.h"
 #include "sift_hull/eval/mesh_render.h"
+#include "sift_hull/geometry/camera_set.h"
 #include "sift_hull/hull/hull_config.h"
 #include "sift_hull/hull/hull_octomap.h"
 #include "sift_hull/hull/hull_pipeline.h"
@@ -26,6 +28,64 @@ void writeOutputs(const ArgParser& parser, const HullResult& result,
     if (!cv::imwrite(path, renderTurntable(result.mesh, 4, cv::Size(480, 480)))) {
       throw std::runtime_error(path + ": cannot write the image");
     }
+  }
+}
+
+/// A result that cannot be right: an error, or with --allow-poor a warning on stderr and in the
+/// JSON's `warnings`.
+class PoorResults {
+ public:
+  explicit PoorResults(bool allow) : allow_(allow) {}
+  void report(const std::string& reason) {
+    if (!allow_) throw std::runtime_error(reason + " (--allow-poor accepts it)");
+    std::cerr << "sift_hull hull: warning: " << reason << '\n';
+    warnings_.push_back(reason);
+  }
+  const std::vector<std::string>& warnings() const { return warnings_; }
+
+ private:
+  bool allow_;
+  std::vector<std::string> warnings_;
+};
+
+/// Largest box edge over the cameras' mutual distance (largest distance between two centres).
+constexpr double kMaxBoxEdgeOverCameraDistance = 100.0;
+/// Below this mean reprojection IoU the hull does not explain the silhouettes.
+constexpr double kMinMeanIoU = 0.5;
+
+std::string joined(const std::vector<std::string>& names) {
+  std::string list;
+  for (const std::string& name : names) list += (list.empty() ? "'" : ", '") + name + "'";
+  return list;
+}
+
+/// A --box no camera sees in front of it, or far larger than the camera set.
+void checkBox(const Box3d& box, const HullInput& input, PoorResults* poor) {
+  const std::vector<std::string> behind = viewsSeeingBoxBehind(box, input.cameras, input.names);
+  if (!input.cameras.empty() && behind.size() == input.cameras.size()) {
+    poor->report("no camera sees the --box in front of it: its centre is behind " + joined(behind));
+  }
+  const double distance = camerasMutualDistance(input.cameras);
+  const double edge = box.size().maxCoeff();
+  if (distance > 0.0 && edge > kMaxBoxEdgeOverCameraDistance * distance) {
+    std::ostringstream text;
+    text << "the --box's longest edge, " << edge << ", exceeds " << kMaxBoxEdgeOverCameraDistance
+         << " times the cameras' mutual distance (largest distance between two camera centres), "
+         << distance;
+    poor->report(text.str());
+  }
+}
+
+/// A mesh with no faces or a mean reprojection IoU below kMinMeanIoU.
+void checkResult(const HullResult& result, const ReprojectionIoU& iou, PoorResults* poor) {
+  if (result.mesh.faces.empty()) {
+    poor->report("the mesh has no faces: nothing is seen inside every silhouette");
+  }
+  if (!(iou.mean >= kMinMeanIoU)) {
+    std::ostringstream text;
+    text << "the mean reprojection IoU is " << iou.mean << ", below " << kMinMeanIoU
+         << ": the hull does not explain the silhouettes";
+    poor->report(text.str());
   }
 }
 
@@ -53,15 +113,24 @@ int runHull(const std::vector<std::string>& args) {
   parser.addOption("out-octree", "BT", "write the OctoMap (.bt)");
   parser.addOption("out-render", "PNG", "write shaded renderings of the mesh");
   parser.addFlag("json", "print the result as one JSON object");
+  parser.addFlag("allow-poor",
+                 "warn instead of failing on a result that cannot be right (no faces, mean IoU "
+                 "below 0.5, a --box behind every camera or over 100x the cameras' distance)");
   if (!parser.parse(args)) return 0;
 
   const HullConfig config = hullConfigFromArgs(parser);
-  const HullResult result = buildHull(viewSetFromArgs(parser), config, boxFromArgs(parser));
+  PoorResults poor(parser.flag("allow-poor"));
+  const HullInput input = viewSetFromArgs(parser);
+  const std::optional<Box3d> box = boxFromArgs(parser);
+  if (box) checkBox(*box, input, &poor);
+  const HullResult result = buildHull(input, config, box);
   const double hull_peak_mib = peakMemoryMiB();
   const std::unique_ptr<octomap::OcTree> octree = toOctomap(result.hull);
   const ReprojectionIoU iou = reprojectionIoU(result.mesh, result.hull.views());
+  checkResult(result, iou, &poor);
   writeOutputs(parser, result, *octree);
   nlohmann::json json = hullJson(result, octree->getNumLeafNodes(), iou);
+  json["warnings"] = poor.warnings();
   json["peak_memory_mib"] = {{"through_hull", hull_peak_mib}, {"total", peakMemoryMiB()}};
   printResult(parser.flag("json"), json, hullText(json));
   return 0;

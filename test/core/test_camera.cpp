@@ -108,6 +108,21 @@ TEST(Camera, ProjectionMatrixDecompositionRecoversKRt) {
   }
 }
 
+TEST(Camera, TheNegatedCameraProjectsAlikeWithOppositeDepths) {
+  std::mt19937 rng(4);
+  const PinholeCamera camera = randomCamera(&rng);
+  const PinholeCamera negated = camera.negated();
+  EXPECT_FALSE(camera.improper());
+  EXPECT_TRUE(negated.improper());
+  EXPECT_LT((negated.projectionMatrix() + camera.projectionMatrix()).norm(), 1e-9);
+  EXPECT_LT((negated.centre() - camera.centre()).norm(), 1e-9);
+  const Eigen::Vector3d X =
+      camera.centre() + 2.0 * camera.opticalAxis() + Eigen::Vector3d(0.1, 0, 0);
+  EXPECT_NEAR(negated.depth(X), -camera.depth(X), 1e-9);
+  EXPECT_LT((negated.project(X) - camera.project(X)).norm(), 1e-9);
+  EXPECT_FALSE(negated.negated().improper());
+}
+
 TEST(Camera, RejectsBadParameters) {
   const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
   Eigen::Matrix3d singular = exampleK();

@@ -284,6 +284,8 @@ TEST_F(HostileCommandLine, HugeCoordinatesEndInAClearError) {
   EXPECT_TRUE(contains(err, "half cube edges")) << err;
   EXPECT_EQ(hull("", &err, parWithCameraAt(1e307, true)), 1) << err;
   EXPECT_EQ(hull("--box -1e39,-1e39,-1e39,1e39,1e39,1e39", &err), 1);
+  EXPECT_TRUE(contains(err, "mutual distance")) << err;
+  EXPECT_EQ(hull("--box -1e39,-1e39,-1e39,1e39,1e39,1e39 --allow-poor", &err), 1);
   EXPECT_TRUE(contains(err, "too large")) << err;
   EXPECT_EQ(hull("--box 0,0,0,1e-300,1e-300,1e-300", &err), 1);
 }

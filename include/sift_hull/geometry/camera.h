@@ -11,6 +11,19 @@ using Matrix34d = Eigen::Matrix<double, 3, 4>;
 /// A pinhole camera in the Middlebury convention x ~ K [R | t] X: R and t take world points into
 /// the camera frame (z forward, x right, y down), K maps the camera frame to pixels. Pixel (u, v)
 /// is the centre of the pixel in column u and row v, origin at the top-left pixel's centre.
+///
+/// Mirrored worlds. A 3x4 projection matrix is defined up to scale, sign included, and a world
+/// frame may be left-handed (one axis of a right-handed frame negated): then the left 3x3 block of
+/// the P that sees the scene in front has det < 0, and no rotation with det +1 gives the same
+/// projection. Such a camera is kept as it is, "improper", with an orthogonal R of det -1
+/// (negated()): projection, depth, centre, optical axis and back-projection hold for any
+/// orthogonal R, and the hull is carved on the world points as given, so the LP box, the octree,
+/// the OctoMap and the mesh (its winding and volume come from the occupancy in world coordinates,
+/// not from the cameras) are those of the mirrored scene, correct as they are. Mirroring the world
+/// back on reading instead would have to mirror every output, and flip the mesh's winding, again.
+/// Which sign of P is the right one is a property of a set of views, not of one matrix: see
+/// orientCameras (geometry/camera_set.h). An improper R has no quaternion: a TF pose of such a
+/// camera is not a rigid motion. The constructor takes rotations only (det +1).
 class PinholeCamera {
  public:
   PinholeCamera() = default;
@@ -22,9 +35,16 @@ class PinholeCamera {
   static PinholeCamera fromCentre(const Eigen::Matrix3d& K, const Eigen::Matrix3d& R,
                                   const Eigen::Vector3d& centre);
   /// Decomposes P = K [R | t] (any non-zero scale) by RQ decomposition into a K with positive focal
-  /// lengths and K(2,2) = 1, and a rotation with det R = +1. Throws std::invalid_argument when the
-  /// left 3x3 block of P is singular.
+  /// lengths and K(2,2) = 1, and a rotation with det R = +1 (P's sign chosen for that; the camera
+  /// set's orientation, orientCameras, may negate it afterwards). Throws std::invalid_argument when
+  /// the left 3x3 block of P is singular.
   static PinholeCamera fromProjection(const Matrix34d& P);
+
+  /// The same projection with P's sign flipped: R and t negated, K kept. Every depth changes sign;
+  /// pixels and the centre stay. A proper camera (det R = +1) becomes improper and back.
+  PinholeCamera negated() const;
+  /// True when det R = -1: the camera lives in a mirrored (left-handed) world frame.
+  bool improper() const { return R_.determinant() < 0.0; }
 
   const Eigen::Matrix3d& K() const { return K_; }
   const Eigen::Matrix3d& R() const { return R_; }

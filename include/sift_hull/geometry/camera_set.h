@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <string>
 #include <vector>
 
 #include "sift_hull/geometry/camera.h"
@@ -17,5 +18,28 @@ struct CommonPoint {
 };
 
 CommonPoint opticalAxesMeetingPoint(const std::vector<PinholeCamera>& cameras);
+
+/// What orientCameras did.
+struct CameraOrientation {
+  std::vector<size_t> negated;  ///< views whose P's sign was flipped
+  bool mirrored_world = false;  ///< every camera is improper: the world frame is left-handed
+  bool by_scene_point = false;  ///< a scene point decided (false: too few views, signs kept)
+};
+
+/// Chooses the sign of each view's projection matrix from the data (cheirality): the scene point is
+/// where the optical axes meet (opticalAxesMeetingPoint: the axes are lines, the same for P and
+/// -P), and each view whose P puts that point behind the camera is negated (negated()), so that
+/// the scene has positive depth in every view. With fewer than two views or parallel axes there is
+/// no such point and the signs are kept (det R = +1, a right-handed world). Afterwards every camera
+/// must have the same handedness, all proper or all improper (a mirrored world): one world frame
+/// cannot be both. Throws std::invalid_argument naming the views of the smaller group (`names`,
+/// optional, name the views) otherwise: no choice of signs puts the scene in front of them in the
+/// world frame of the others.
+CameraOrientation orientCameras(std::vector<PinholeCamera>* cameras,
+                                const std::vector<std::string>& names = {});
+
+/// The cameras' mutual distance: the largest distance between two camera centres, in world units;
+/// 0 for fewer than two cameras.
+double camerasMutualDistance(const std::vector<PinholeCamera>& cameras);
 
 }  // namespace sift_hull

@@ -32,6 +32,13 @@ struct SilhouetteBounds {
   int boundedSides() const { return has_u_min + has_u_max + has_v_min + has_v_max; }
 };
 
+/// The views that see the box behind them: the box's centre has depth <= 0 (cheirality), by name
+/// (`names`, optional, same length; else "view <i>"). A box that every view sees behind it holds
+/// nothing a silhouette shows.
+std::vector<std::string> viewsSeeingBoxBehind(const Box3d& box,
+                                              const std::vector<PinholeCamera>& cameras,
+                                              const std::vector<std::string>& names = {});
+
 /// Bounds of a CV_8UC1 mask (non-zero inside). `border_bounds_object`: a silhouette side on the
 /// image border still bounds the object (true when views that see a point outside the image carve
 /// it). Throws std::invalid_argument for an empty Mat or another type.

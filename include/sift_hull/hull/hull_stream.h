@@ -14,6 +14,7 @@ namespace sift_hull {
 struct HullStreamConfig {
   HullConfig hull;
   /// The box to carve, world frame; empty: the LP box (eq. 8) of the first views that bound one.
+  /// A view whose camera sees the given box behind it (the centre at depth <= 0) is refused.
   std::optional<Box3d> box;
   std::vector<std::string> skip_views;  ///< view names left out (bad silhouettes)
   /// A view whose camera centre lies within min_view_distance_m of a view already taken and

@@ -83,6 +83,13 @@ PinholeCamera PinholeCamera::fromProjection(const Matrix34d& P) {
   return PinholeCamera(K, R, t);
 }
 
+PinholeCamera PinholeCamera::negated() const {
+  PinholeCamera camera = *this;
+  camera.R_ = -R_;
+  camera.t_ = -t_;
+  return camera;
+}
+
 Matrix34d PinholeCamera::projectionMatrix() const {
   Matrix34d Rt;
   Rt << R_, t_;

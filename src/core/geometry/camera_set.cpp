@@ -2,6 +2,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <stdexcept>
 
 namespace sift_hull {
 
@@ -30,6 +31,47 @@ CommonPoint opticalAxesMeetingPoint(const std::vector<PinholeCamera>& cameras) {
     result.in_front_of_all &= camera.depth(result.point_W) > 0.0;
   }
   return result;
+}
+
+CameraOrientation orientCameras(std::vector<PinholeCamera>* cameras,
+                                const std::vector<std::string>& names) {
+  CameraOrientation result;
+  const CommonPoint scene = opticalAxesMeetingPoint(*cameras);
+  if (!scene.well_defined) return result;
+  result.by_scene_point = true;
+  std::vector<size_t> proper, improper;
+  for (size_t i = 0; i < cameras->size(); ++i) {
+    PinholeCamera& camera = (*cameras)[i];
+    if (camera.depth(scene.point_W) < 0.0) {
+      camera = camera.negated();
+      result.negated.push_back(i);
+    }
+    (camera.improper() ? improper : proper).push_back(i);
+  }
+  result.mirrored_world = proper.empty();
+  if (proper.empty() || improper.empty()) return result;
+  const bool few_improper = improper.size() <= proper.size();
+  const std::vector<size_t>& odd = few_improper ? improper : proper;
+  std::string list;
+  for (size_t i : odd) {
+    if (!list.empty()) list += ", ";
+    list += names.size() == cameras->size() ? "'" + names[i] + "'" : "view " + std::to_string(i);
+  }
+  throw std::invalid_argument(
+      "the cameras cannot be oriented consistently: " + list +
+      " see the scene (where the optical axes meet) behind them unless their world frame is " +
+      (few_improper ? "mirrored" : "right-handed") + " while the other cameras' is " +
+      (few_improper ? "right-handed" : "mirrored") + "; check their projection matrices");
+}
+
+double camerasMutualDistance(const std::vector<PinholeCamera>& cameras) {
+  double distance = 0.0;
+  for (size_t i = 0; i < cameras.size(); ++i) {
+    for (size_t j = i + 1; j < cameras.size(); ++j) {
+      distance = std::max(distance, (cameras[i].centre() - cameras[j].centre()).norm());
+    }
+  }
+  return distance;
 }
 
 }  // namespace sift_hull

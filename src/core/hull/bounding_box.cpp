@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "sift_hull/geometry/camera_set.h"
+
 namespace sift_hull {
 namespace {
 
@@ -247,6 +249,18 @@ bool Box3d::contains(const Eigen::Vector3d& X_W, double tolerance_m) const {
          (X_W.array() <= max_W.array() + tolerance_m).all();
 }
 
+std::vector<std::string> viewsSeeingBoxBehind(const Box3d& box,
+                                              const std::vector<PinholeCamera>& cameras,
+                                              const std::vector<std::string>& names) {
+  const std::vector<std::string> given =
+      names.size() == cameras.size() ? names : std::vector<std::string>{};
+  std::vector<std::string> behind;
+  for (size_t i = 0; i < cameras.size(); ++i) {
+    if (!(cameras[i].depth(box.centre()) > 0.0)) behind.push_back(viewName(given, i));
+  }
+  return behind;
+}
+
 SilhouetteBounds silhouetteBounds(const cv::Mat& mask, bool border_bounds_object) {
   if (mask.empty()) throw std::invalid_argument("silhouetteBounds: the mask is empty");
   if (mask.type() != CV_8UC1) throw std::invalid_argument("silhouetteBounds: mask is not CV_8UC1");
@@ -264,6 +278,24 @@ SilhouetteBounds silhouetteBounds(const cv::Mat& mask, bool border_bounds_object
   bounds.has_v_max = border_bounds_object || inside.y + inside.height < mask.rows;
   return bounds;
 }
+
+namespace {
+
+/// For an empty box: the views that see where the optical axes meet behind them, if any.
+std::string behindNote(const std::vector<PinholeCamera>& cameras,
+                       const std::vector<std::string>& names) {
+  const CommonPoint scene = opticalAxesMeetingPoint(cameras);
+  if (!scene.well_defined || scene.in_front_of_all) return "";
+  std::string list;
+  for (size_t i = 0; i < cameras.size(); ++i) {
+    if (cameras[i].depth(scene.point_W) > 0.0) continue;
+    list += (list.empty() ? "'" : ", '") + viewName(names, i) + "'";
+  }
+  return "; the point where the optical axes meet is behind " + list +
+         " (the sign or handedness of their projection?)";
+}
+
+}  // namespace
 
 Box3d hullBoundingBox(const std::vector<PinholeCamera>& cameras,
                       const std::vector<SilhouetteBounds>& bounds,
@@ -291,10 +323,15 @@ Box3d hullBoundingBox(const std::vector<PinholeCamera>& cameras,
   }
   const double far_limit = farCoordinateLimit(cameras, frame);
   Box3d box;
-  for (int axis = 0; axis < 3; ++axis) {
-    box.min_W(axis) = frame.origin(axis) + frame.scale * extremeOf(solution, 2 * axis, far_limit);
-    box.max_W(axis) =
-        frame.origin(axis) + frame.scale * extremeOf(solution, 2 * axis + 1, far_limit);
+  try {
+    for (int axis = 0; axis < 3; ++axis) {
+      box.min_W(axis) = frame.origin(axis) + frame.scale * extremeOf(solution, 2 * axis, far_limit);
+      box.max_W(axis) =
+          frame.origin(axis) + frame.scale * extremeOf(solution, 2 * axis + 1, far_limit);
+    }
+  } catch (const HullBoxError& e) {
+    if (e.reason() != HullBoxError::Reason::kEmpty) throw;
+    throw HullBoxError(e.reason(), e.what() + behindNote(cameras, names));
   }
   // The LP frame's optimum, scaled back, can overflow where the cameras lie near 1e300.
   if (!box.min_W.allFinite() || !box.max_W.allFinite()) {

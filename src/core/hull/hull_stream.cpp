@@ -81,6 +81,9 @@ HullStream::Outcome HullStream::add(const std::string& name, const PinholeCamera
   newest_refused_ = false;
   std::string coverage = coverageProblem(mask);
   if (coverage.empty()) coverage = cameraProblem(camera);
+  if (coverage.empty() && config_.box && !(camera.depth(config_.box->centre()) > 0.0)) {
+    coverage = "its camera sees the given box behind it (the box's centre has depth <= 0)";
+  }
   const size_t views = waiting_.size() + (hull_ ? hull_->views().size() : 0);
   if (!coverage.empty()) {
     refuse(name, serial, coverage);

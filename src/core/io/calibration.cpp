@@ -11,6 +11,7 @@
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
+#include "sift_hull/io/view_orientation.h"
 #include "sift_hull/limits.h"
 
 namespace sift_hull {
@@ -167,6 +168,7 @@ std::vector<CalibratedView> readProjectionList(const std::string& path) {
   if (lines.empty()) throw ParseError(path, 0, "empty file, expected 3x4 projection matrices");
   std::vector<CalibratedView> views;
   for (const Line& line : lines) views.push_back(parseProjectionLine(line, path));
+  orientViews(&views, path);
   return views;
 }
 
@@ -186,6 +188,11 @@ void writeMiddleburyPar(const std::string& path, const std::vector<CalibratedVie
   out << views.size() << '\n' << std::setprecision(17);
   for (const CalibratedView& view : views) {
     const PinholeCamera& c = view.camera;
+    if (c.improper()) {
+      throw std::runtime_error(path + ": view '" + view.name +
+                               "' has a mirrored world frame (det R = -1), which a par file cannot "
+                               "hold; write a projection list");
+    }
     out << view.name;
     for (int r = 0; r < 3; ++r) {
       for (int col = 0; col < 3; ++col) out << ' ' << c.K()(r, col);
