@@ -103,12 +103,18 @@ int runDatasetInfo(const std::vector<std::string>& args) {
   parser.addOption("calib", "FILE|DIR",
                    "Middlebury *_par.txt, a list of 3x4 projection matrices, a COLMAP sparse model "
                    "directory or an LLFF poses_bounds.npy");
-  parser.addOption("images", "DIR", "directory of the images (default: the calibration's)");
+  parser.addOption(
+      "images", "DIR",
+      "directory of the images (default: the calibration file's, or the COLMAP model directory)");
   addSilhouetteOptions(&parser);
   parser.addFlag("json", "print the result as one JSON object");
   if (!parser.parse(args)) return 0;
   const std::string calib = parser.get("calib");
-  const std::string images = parser.has("images") ? parser.get("images") : parentDirectory(calib);
+  const std::string format = calibrationFormat(calib);
+  // A COLMAP model is a directory: its images default to that directory, a file's to its own.
+  const std::string images = parser.has("images")             ? parser.get("images")
+                             : format.rfind("COLMAP", 0) == 0 ? calib
+                                                              : parentDirectory(calib);
 
   const std::vector<CalibratedView> views = readCalibrationWithImages(calib, images);
   const std::vector<cv::Mat> silhouettes =
@@ -125,7 +131,7 @@ int runDatasetInfo(const std::vector<std::string>& args) {
                        {"distortion", distortionJson(views[i].distortion)}});
   }
   const nlohmann::json info = {{"calib", calib},
-                               {"format", calibrationFormat(calib)},
+                               {"format", format},
                                {"camera_models", describeModels(views)},
                                {"views", views.size()},
                                {"image_size", {size.width, size.height}},

@@ -5,6 +5,8 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
 #include "common/test_data.h"
@@ -245,6 +247,32 @@ TEST_F(CalibrationFormats, ParAndProjectionViewsNameTheirModel) {
   d.k1 = -0.25;
   d.p2 = 0.5;
   EXPECT_EQ(describeDistortion(d), "k1=-0.25 p2=0.5");
+}
+
+TEST_F(CalibrationFormats, DatasetInfoNamesTheFormatAndWhyThereIsNoCommonPoint) {
+  for (const char* name : {"a.png", "b.png"}) {
+    cv::imwrite(dir_ + "/" + name, cv::Mat(48, 64, CV_8UC3, cv::Scalar::all(200)));
+  }
+  write("cameras.txt", "1 OPENCV 64 48 50 50 32 24 -0.1 0 0 0\n");
+  write("images.txt", "1 1 0 0 0 0 0 2 1 a.png\n\n2 1 0 0 0 0.5 0 2 1 b.png\n\n");
+  std::string out, err;
+  ASSERT_EQ(test::runProgram("dataset-info --calib " + dir_, &out, &err), 0) << err;
+  EXPECT_NE(out.find("format: COLMAP text (cameras.txt, images.txt), camera model OPENCV, k1=-0.1"),
+            std::string::npos)
+      << out;
+  EXPECT_NE(out.find("cameras look at a common point: no: the optical axes are (nearly) parallel"),
+            std::string::npos)
+      << out;
+  // b.png looks away from where the axes meet.
+  const std::string par = write("par.txt",
+                                "2\na.png 50 0 32 0 50 24 0 0 1  1 0 0 0 1 0 0 0 1  0 0 2\n"
+                                "b.png 50 0 32 0 50 24 0 0 1  0 0 1 0 1 0 -1 0 0  0 0 -2\n");
+  ASSERT_EQ(test::runProgram("dataset-info --calib " + par, &out, &err), 0) << err;
+  EXPECT_NE(out.find("format: Middlebury par, camera model par, no distortion"), std::string::npos)
+      << out;
+  EXPECT_NE(out.find(": the point is behind camera b.png"), std::string::npos) << out;
+  ASSERT_EQ(test::runProgram("dataset-info --json --calib " + par, &out, &err), 0) << err;
+  EXPECT_NE(out.find("\"reason\": \"the point is behind camera b.png\""), std::string::npos) << out;
 }
 
 }  // namespace
