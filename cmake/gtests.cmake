@@ -10,6 +10,8 @@ set(SIFT_HULL_CORE_GTESTS
   test_layout core
   test_mesh core
   test_dataset io
+  test_colmap io
+  test_calibration_formats io
   test_ply io
   test_ground_truth_files io
   test_features eval
@@ -28,4 +30,5 @@ set(SIFT_HULL_CORE_GTESTS
 )
 # The harnesses of test/fuzz whose corpus test_fuzz_corpus replays: CamelCase entry point names,
 # file test/fuzz/fuzz_<snake_case>.cpp.
-set(SIFT_HULL_FUZZ_HARNESSES MiddleburyPar ProjectionList Homography Pfm Ply BoundingBox)
+set(SIFT_HULL_FUZZ_HARNESSES MiddleburyPar ProjectionList Homography Pfm Ply BoundingBox
+  ColmapBinary Npy)

@@ -31,8 +31,10 @@ set(SIFT_HULL_CORE_SOURCES
 )
 set(SIFT_HULL_IO_SOURCES
   src/core/io/calibration.cpp
+  src/core/io/colmap.cpp
   src/core/io/ground_truth_files.cpp
   src/core/io/images.cpp
+  src/core/io/llff.cpp
   src/core/io/pfm.cpp
   src/core/io/ply.cpp
   src/core/io/view_list.cpp

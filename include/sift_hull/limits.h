@@ -34,6 +34,13 @@ constexpr size_t kMaxDecodedImagePixels = 100000000;
 /// Width or height of an image or map read from a file or a message, pixels.
 constexpr size_t kMaxImageSidePx = 1 << 16;
 
+/// Views (or cameras) of one calibration file: par count lines, COLMAP models, LLFF poses.
+constexpr size_t kMaxCalibrationViews = 1000000;
+/// Characters of an image name in a binary calibration file (COLMAP images.bin).
+constexpr size_t kMaxImageNameChars = 4096;
+/// Bytes of a .npy header (LLFF poses_bounds.npy); numpy writes well under 200.
+constexpr size_t kMaxNpyHeaderBytes = 65536;
+
 /// Throws std::invalid_argument "`name` must be in [low, high], got value" when out of range.
 inline void requireInRange(const std::string& name, long long value, long long low,
                            long long high) {

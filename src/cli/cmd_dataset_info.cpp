@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <opencv2/core.hpp>
 #include <sstream>
 
@@ -14,31 +15,65 @@ namespace {
 
 nlohmann::json vectorJson(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 
-bool projectsInside(const std::vector<CalibratedView>& views, const Eigen::Vector3d& X_W,
-                    cv::Size size) {
-  for (const CalibratedView& view : views) {
-    const Eigen::Vector2d pixel = view.camera.project(X_W);
-    if (pixel.x() < -0.5 || pixel.y() < -0.5 || pixel.x() > size.width - 0.5 ||
-        pixel.y() > size.height - 0.5) {
-      return false;
+/// Index of the first view the point projects outside of (or -1).
+int firstOutside(const std::vector<CalibratedView>& views, const Eigen::Vector3d& X_W,
+                 cv::Size size) {
+  for (size_t i = 0; i < views.size(); ++i) {
+    const Eigen::Vector2d pixel = views[i].camera.project(X_W);
+    if (!(pixel.x() >= -0.5 && pixel.y() >= -0.5 && pixel.x() <= size.width - 0.5 &&
+          pixel.y() <= size.height - 0.5)) {
+      return static_cast<int>(i);
     }
   }
-  return true;
+  return -1;
 }
 
 nlohmann::json commonPointJson(const std::vector<CalibratedView>& views, cv::Size size) {
   const CommonPoint common = opticalAxesMeetingPoint(camerasOf(views));
-  if (!common.well_defined) return {{"looks_at_common_point", false}, {"point", nullptr}};
-  const bool inside = projectsInside(views, common.point_W, size);
-  return {{"point", vectorJson(common.point_W)},
-          {"max_axis_distance_m", common.max_axis_distance_m},
-          {"in_front_of_all", common.in_front_of_all},
-          {"projects_inside_all", inside},
-          {"looks_at_common_point", common.in_front_of_all && inside}};
+  if (!common.well_defined) {
+    const std::string reason =
+        views.size() < 2 ? "fewer than two views" : "the optical axes are (nearly) parallel";
+    return {{"looks_at_common_point", false}, {"point", nullptr}, {"reason", reason}};
+  }
+  const int outside = firstOutside(views, common.point_W, size);
+  std::string reason;
+  if (common.first_behind >= 0) {
+    reason = "the point is behind camera " + views[common.first_behind].name;
+  } else if (outside >= 0) {
+    reason = "the point projects outside the image of " + views[outside].name;
+  }
+  nlohmann::json result = {{"point", vectorJson(common.point_W)},
+                           {"max_axis_distance_m", common.max_axis_distance_m},
+                           {"in_front_of_all", common.in_front_of_all},
+                           {"projects_inside_all", outside < 0},
+                           {"looks_at_common_point", common.in_front_of_all && outside < 0}};
+  result["reason"] = reason.empty() ? nlohmann::json(nullptr) : nlohmann::json(reason);
+  return result;
+}
+
+nlohmann::json distortionJson(const LensDistortion& d) {
+  return {{"k1", d.k1}, {"k2", d.k2}, {"p1", d.p1}, {"p2", d.p2}, {"k3", d.k3}};
+}
+
+/// "PINHOLE, no distortion" for each distinct model and distortion, joined by "; ".
+std::string describeModels(const std::vector<CalibratedView>& views) {
+  std::vector<std::string> seen;
+  for (const CalibratedView& view : views) {
+    const std::string text = "camera model " +
+                             (view.camera_model.empty() ? "unknown" : view.camera_model) + ", " +
+                             describeDistortion(view.distortion);
+    if (std::find(seen.begin(), seen.end(), text) == seen.end()) seen.push_back(text);
+  }
+  std::string joined;
+  for (size_t i = 0; i < seen.size() && i < 4; ++i) joined += (i ? "; " : "") + seen[i];
+  if (seen.size() > 4) joined += "; ... (" + std::to_string(seen.size()) + " different)";
+  return joined;
 }
 
 std::string describe(const nlohmann::json& info) {
   std::ostringstream text;
+  text << "format: " << info["format"].get<std::string>() << ", "
+       << info["camera_models"].get<std::string>() << "\n";
   text << info["views"].get<int>() << " views, images " << info["image_size"][0] << "x"
        << info["image_size"][1] << "\n";
   for (const auto& view : info["cameras"]) {
@@ -52,6 +87,7 @@ std::string describe(const nlohmann::json& info) {
     text << " (" << common["point"].dump() << ", farthest optical axis "
          << common["max_axis_distance_m"].get<double>() << " away)";
   }
+  if (!common["reason"].is_null()) text << ": " << common["reason"].get<std::string>();
   text << "\n";
   return text.str();
 }
@@ -64,15 +100,23 @@ int runDatasetInfo(const std::vector<std::string>& args) {
                    "views, the image size, the camera centres and whether the cameras look at a\n"
                    "common point (where their optical axes come closest, in front of every camera\n"
                    "and inside every image), and the share of each image its silhouette covers.");
-  parser.addOption("calib", "FILE", "Middlebury *_par.txt or a list of 3x4 projection matrices");
-  parser.addOption("images", "DIR", "directory of the images (default: the calibration's)");
+  parser.addOption("calib", "FILE|DIR",
+                   "Middlebury *_par.txt, a list of 3x4 projection matrices, a COLMAP sparse model "
+                   "directory or an LLFF poses_bounds.npy");
+  parser.addOption(
+      "images", "DIR",
+      "directory of the images (default: the calibration file's, or the COLMAP model directory)");
   addSilhouetteOptions(&parser);
   parser.addFlag("json", "print the result as one JSON object");
   if (!parser.parse(args)) return 0;
   const std::string calib = parser.get("calib");
-  const std::string images = parser.has("images") ? parser.get("images") : parentDirectory(calib);
+  const std::string format = calibrationFormat(calib);
+  // A COLMAP model is a directory: its images default to that directory, a file's to its own.
+  const std::string images = parser.has("images")             ? parser.get("images")
+                             : format.rfind("COLMAP", 0) == 0 ? calib
+                                                              : parentDirectory(calib);
 
-  const std::vector<CalibratedView> views = readCalibration(calib);
+  const std::vector<CalibratedView> views = readCalibrationWithImages(calib, images);
   const std::vector<cv::Mat> silhouettes =
       loadSilhouettes(views, images, parser.has("silhouettes") ? parser.get("silhouettes") : "",
                       silhouetteConfigFromArgs(parser));
@@ -82,9 +126,13 @@ int runDatasetInfo(const std::vector<std::string>& args) {
     const double fraction = cv::countNonZero(silhouettes[i]) / static_cast<double>(size.area());
     cameras.push_back({{"name", views[i].name},
                        {"centre", vectorJson(views[i].camera.centre())},
-                       {"silhouette_fraction", fraction}});
+                       {"silhouette_fraction", fraction},
+                       {"camera_model", views[i].camera_model},
+                       {"distortion", distortionJson(views[i].distortion)}});
   }
   const nlohmann::json info = {{"calib", calib},
+                               {"format", format},
+                               {"camera_models", describeModels(views)},
                                {"views", views.size()},
                                {"image_size", {size.width, size.height}},
                                {"cameras", cameras},

@@ -37,7 +37,9 @@ size_t viewIndex(const std::vector<CalibratedView>& views, const std::string& na
 }
 
 void addPairOptions(ArgParser* parser) {
-  parser->addOption("calib", "FILE", "calibration of the pair (Middlebury par or projections)");
+  parser->addOption("calib", "FILE",
+                    "calibration of the pair (Middlebury par, projections, COLMAP model directory "
+                    "or LLFF poses_bounds.npy, whose views are the images beside the left one)");
   parser->addOption("left-view", "NAME", "LEFT's name in --calib (default: its file name)");
   parser->addOption("right-view", "NAME", "RIGHT's name in --calib (default: its file name)");
   parser->addFlag("rectified", "the pair is rectified: epipolar lines are image rows");
@@ -59,7 +61,7 @@ std::optional<Eigen::Matrix3d> pairCalibration(const ArgParser& parser, const st
   } else {
     return std::nullopt;
   }
-  const std::vector<CalibratedView> views = readCalibration(calib);
+  const std::vector<CalibratedView> views = readCalibrationWithImages(calib, parentDirectory(left));
   const std::string left_name = parser.has("left-view") ? parser.get("left-view") : baseName(left);
   const std::string right_name =
       parser.has("right-view") ? parser.get("right-view") : baseName(right);

@@ -43,7 +43,9 @@ std::vector<std::string> viewNamesFromArgs(const ArgParser& parser) {
 }  // namespace
 
 void addViewSetOptions(ArgParser* parser) {
-  parser->addOption("calib", "FILE", "Middlebury par file or projection list");
+  parser->addOption("calib", "FILE|DIR",
+                    "Middlebury par file, projection list, COLMAP sparse model directory or LLFF "
+                    "poses_bounds.npy");
   parser->addOption("images", "DIR", "directory of the images the calibration names");
   addSilhouetteOptions(parser);
   parser->addOption("views", "LIST", "comma-separated image names to use (default: all)");

@@ -107,7 +107,9 @@ TEST_F(MalformedFile, ProjectionListErrorsNameFileAndLine) {
   const std::string path = dir_ + "/calib.txt";
   EXPECT_EQ(
       errorOf("# comment\n500 0 320 0  0 500 240 0  0 0 1\n", readProjectionList),
-      path + ":2: expected 12 numbers of a 3x4 matrix, optionally after a name; found 11 fields");
+      path +
+          ":2: expected 12 numbers of a 3x4 matrix (or a row of 4), optionally after a name; "
+          "found 11 fields");
   EXPECT_EQ(errorOf("7 500 0 320 0  0 500 240 0  0 0 1 2\n", readProjectionList),
             path + ":1: expected an image name before the 12 numbers, found '7'");
   EXPECT_EQ(errorOf("a.png 1 0 0 0  1 0 0 0  0 0 0 1\n", readProjectionList),

@@ -20,6 +20,8 @@ extern "C" int fuzzHomography(const uint8_t* data, size_t size);
 extern "C" int fuzzPfm(const uint8_t* data, size_t size);
 extern "C" int fuzzPly(const uint8_t* data, size_t size);
 extern "C" int fuzzBoundingBox(const uint8_t* data, size_t size);
+extern "C" int fuzzColmapBinary(const uint8_t* data, size_t size);
+extern "C" int fuzzNpy(const uint8_t* data, size_t size);
 
 namespace sift_hull {
 namespace {
@@ -57,6 +59,8 @@ TEST(FuzzCorpus, Homography) { replay("fuzz_homography", fuzzHomography); }
 TEST(FuzzCorpus, Pfm) { replay("fuzz_pfm", fuzzPfm); }
 TEST(FuzzCorpus, Ply) { replay("fuzz_ply", fuzzPly); }
 TEST(FuzzCorpus, BoundingBox) { replay("fuzz_bounding_box", fuzzBoundingBox); }
+TEST(FuzzCorpus, ColmapBinary) { replay("fuzz_colmap_binary", fuzzColmapBinary); }
+TEST(FuzzCorpus, Npy) { replay("fuzz_npy", fuzzNpy); }
 
 }  // namespace
 }  // namespace sift_hull

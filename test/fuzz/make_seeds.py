@@ -197,3 +197,60 @@ write("fuzz_bounding_box", "ring4_c_1e39", box_input(far))
 # Tiny focal length and subnormal bounds.
 tiny = [([[1e-300, 0, 0], [0, 1e-300, 0], [0, 0, 1]], R, t) for K, R, t in ring4]
 write("fuzz_bounding_box", "ring4_tiny", box_input(tiny, bounds=[-5e-324, 5e-324, -1e-310, 1e-310]))
+
+
+# ---- COLMAP binary models: first byte 0 for cameras.bin, 1 for images.bin -----------------------
+def colmap_cameras(models):
+    data = struct.pack("<Q", len(models))
+    for camera_id, (model_id, params) in enumerate(models, start=1):
+        data += struct.pack("<iiQQ", camera_id, model_id, 640, 480)
+        data += struct.pack(f"<{len(params)}d", *params)
+    return b"\x00" + data
+
+
+def colmap_images(views, points=2):
+    data = struct.pack("<Q", len(views))
+    for image_id, (K, R, t) in enumerate(views, start=1):
+        data += struct.pack("<I", image_id) + struct.pack("<4d", *quaternion(R))
+        data += struct.pack("<3d", *t) + struct.pack("<I", 1)
+        data += f"view_{image_id:04d}.png".encode() + b"\x00" + struct.pack("<Q", points)
+        data += b"".join(struct.pack("<ddQ", 10.0 * p, 20.0, p) for p in range(points))
+    return b"\x01" + data
+
+
+write("fuzz_colmap_binary", "pinhole_opencv", colmap_cameras(
+    [(1, [500, 500, 320, 240]), (4, [500, 500, 320, 240, -0.1, 0.01, 0.001, 0.002])]))
+write("fuzz_colmap_binary", "every_model", colmap_cameras(
+    [(0, [500, 320, 240]), (2, [500, 320, 240, 0.1]), (3, [500, 320, 240, 0.1, 0.2]),
+     (6, [500, 500, 320, 240, 0.1, 0.2, 0.0, 0.0, 0.3, 0.0, 0.0, 0.0])]))
+write("fuzz_colmap_binary", "images_ring4", colmap_images([ring_camera(i, 4) for i in range(4)]))
+write("fuzz_colmap_binary", "images_no_points", colmap_images([ring_camera(0, 2)], points=0))
+
+
+# ---- LLFF poses_bounds.npy ----------------------------------------------------------------------
+def npy(rows, fortran=False, version=1):
+    header = "{'descr': '<f8', 'fortran_order': %s, 'shape': (%d, 17), }" % (
+        "True" if fortran else "False", len(rows))
+    fixed = 10 if version == 1 else 12
+    header += " " * ((64 - (fixed + len(header) + 1) % 64) % 64) + "\n"
+    length = struct.pack("<H", len(header)) if version == 1 else struct.pack("<I", len(header))
+    values = [x for row in rows for x in row]
+    if fortran:
+        values = [rows[r][c] for c in range(17) for r in range(len(rows))]
+    return b"\x93NUMPY" + bytes([version, 0]) + length + header.encode() + struct.pack(
+        f"<{len(values)}d", *values)
+
+
+def llff_row(K, R, t):
+    # camera-to-world axes in LLFF's [down, right, backwards] order, centre, [height, width, focal]
+    Rt = [[R[c][r] for c in range(3)] for r in range(3)]  # R^T: columns are the camera axes
+    centre = [-x for x in mat_vec(Rt, t)]
+    columns = [[Rt[r][1] for r in range(3)], [Rt[r][0] for r in range(3)],
+               [-Rt[r][2] for r in range(3)], centre, [240.0, 320.0, K[0][0]]]
+    return [columns[c][r] for r in range(3) for c in range(5)] + [0.5, 4.0]
+
+
+ring3_rows = [llff_row(*ring_camera(i, 3)) for i in range(3)]
+write("fuzz_npy", "ring3", npy(ring3_rows))
+write("fuzz_npy", "ring3_fortran", npy(ring3_rows, fortran=True))
+write("fuzz_npy", "ring2_v2", npy(ring3_rows[:2], version=2))

@@ -15,8 +15,12 @@ struct CommonPoint {
   double max_axis_distance_m = 0.0;
   bool in_front_of_all = false;  ///< the point has positive depth in every view
   bool well_defined = false;     ///< the axes are not all parallel (needs two views or more)
+  int first_behind = -1;         ///< index of the first camera the point is behind, -1 if none
 };
 
+/// The point nearest to all the cameras' optical axes (least squares), with how far it is from the
+/// farthest axis and whether it lies in front of every camera; not well defined when the axes are
+/// all parallel or there are fewer than two cameras.
 CommonPoint opticalAxesMeetingPoint(const std::vector<PinholeCamera>& cameras);
 
 /// What orientCameras did.

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "sift_hull/geometry/camera.h"
+#include "sift_hull/geometry/distortion.h"
 
 namespace sift_hull {
 
@@ -24,7 +25,11 @@ class ParseError : public std::runtime_error {
 struct CalibratedView {
   std::string name;  ///< image file name as written in the calibration file (may be empty)
   PinholeCamera camera;
-  std::string source;  ///< "FILE:LINE" the view was read from; empty when made in code
+  std::string source;         ///< "FILE:LINE" the view was read from; empty when made in code
+  LensDistortion distortion;  ///< zero unless the calibration gives lens distortion
+  /// Camera model of the calibration: a COLMAP model name ("PINHOLE", "OPENCV", ...), "LLFF",
+  /// "par" or "projection"; empty when made in code.
+  std::string camera_model;
 };
 
 /// Reads a Middlebury `*_par.txt`: a count line, then one line per view
@@ -34,14 +39,31 @@ struct CalibratedView {
 /// rotation, or a count line that disagrees with the lines.
 std::vector<CalibratedView> readMiddleburyPar(const std::string& path);
 
-/// Reads a list of 3x4 projection matrices, one per line as 12 row-major numbers, each optionally
-/// preceded by an image name (which must not be a number). Blank lines and lines starting with '#'
-/// are skipped. Throws ParseError naming the file and line.
+/// Reads a list of 3x4 projection matrices, each either on one line as 12 row-major numbers or on
+/// three lines of 4 numbers (a row each), optionally preceded by an image name (which must not be
+/// a number) on the first row or alone on the line before. Numbers may be separated by white space
+/// or commas. Blank lines and lines starting with '#' are skipped. Throws ParseError naming the
+/// file and line.
 std::vector<CalibratedView> readProjectionList(const std::string& path);
 
-/// Reads either format: a first line holding a single integer means a Middlebury par file. A first
-/// line shaped like a par line (a name and 21 numbers) is reported as a missing count line.
+/// Reads any calibration format: a directory is a COLMAP sparse model (readColmapModel), a file
+/// ending in ".npy" LLFF poses (readLlffPoses, the views being the sorted images of
+/// `image_directory`), else a text file: a first line holding a single integer means a Middlebury
+/// par file, otherwise a projection list. A first line shaped like a par line (a name and 21
+/// numbers) is reported as a missing count line.
+std::vector<CalibratedView> readCalibrationWithImages(const std::string& path,
+                                                      const std::string& image_directory);
+
+/// readCalibrationWithImages(path, parentDirectory(path)).
 std::vector<CalibratedView> readCalibration(const std::string& path);
+
+/// Human-readable name of the format readCalibration() reads at `path`, such as
+/// "COLMAP text (cameras.txt, images.txt)", "COLMAP binary (cameras.bin, images.bin)",
+/// "LLFF poses_bounds.npy", "Middlebury par" or "projection list". Does not validate the file.
+std::string calibrationFormat(const std::string& path);
+
+/// "no distortion" or "k1=... k2=... p1=... p2=... k3=..." (the non-zero coefficients).
+std::string describeDistortion(const LensDistortion& distortion);
 
 /// Writes views as a Middlebury par file (17 significant digits, so reading it back is exact).
 void writeMiddleburyPar(const std::string& path, const std::vector<CalibratedView>& views);

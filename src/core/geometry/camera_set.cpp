@@ -28,7 +28,10 @@ CommonPoint opticalAxesMeetingPoint(const std::vector<PinholeCamera>& cameras) {
     const Eigen::Vector3d offset = result.point_W - camera.centre();
     const double distance = (offset - axis * axis.dot(offset)).norm();
     result.max_axis_distance_m = std::max(result.max_axis_distance_m, distance);
-    result.in_front_of_all &= camera.depth(result.point_W) > 0.0;
+    if (!(camera.depth(result.point_W) > 0.0) && result.in_front_of_all) {
+      result.in_front_of_all = false;
+      result.first_behind = static_cast<int>(&camera - cameras.data());
+    }
   }
   return result;
 }

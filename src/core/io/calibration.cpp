@@ -1,7 +1,10 @@
 #include "sift_hull/io/calibration.h"
 
+#include <sys/stat.h>
+
 #include <Eigen/Dense>
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -11,6 +14,8 @@
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
+#include "sift_hull/io/colmap.h"
+#include "sift_hull/io/llff.h"
 #include "sift_hull/io/view_orientation.h"
 #include "sift_hull/limits.h"
 
@@ -26,7 +31,7 @@ struct Line {
   std::vector<std::string> fields;
 };
 
-/// Non-blank, non-comment lines of a text file, split at white space.
+/// Non-blank, non-comment lines of a text file, split at white space and commas.
 std::vector<Line> readFields(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw ParseError(path, 0, "cannot open file");
@@ -36,6 +41,7 @@ std::vector<Line> readFields(const std::string& path) {
     if (text.find('\0') != std::string::npos) {
       throw ParseError(path, number, "the line holds a NUL byte: not a text file");
     }
+    std::replace(text.begin(), text.end(), ',', ' ');
     std::istringstream words(text);
     Line line{number, {}};
     for (std::string word; words >> word;) line.fields.push_back(word);
@@ -80,7 +86,7 @@ template <typename MakeCamera>
 CalibratedView makeView(const std::string& name, const Line& line, const std::string& path,
                         MakeCamera make_camera) {
   try {
-    return CalibratedView{name, make_camera(), location(path, line.number)};
+    return CalibratedView{name, make_camera(), location(path, line.number), {}, {}};
   } catch (const std::invalid_argument& e) {
     throw ParseError(path, line.number, e.what());
   }
@@ -96,25 +102,83 @@ CalibratedView parseParLine(const Line& line, const std::string& path) {
   const Eigen::Matrix3d K = parseMatrix<3, 3>(line, 1, path);
   const Eigen::Matrix3d R = parseMatrix<3, 3>(line, 10, path);
   const Eigen::Vector3d t = parseMatrix<3, 1>(line, 19, path);
-  return makeView(line.fields[0], line, path, [&] { return PinholeCamera(K, R, t); });
+  CalibratedView view =
+      makeView(line.fields[0], line, path, [&] { return PinholeCamera(K, R, t); });
+  view.camera_model = "par";
+  return view;
 }
 
-CalibratedView parseProjectionLine(const Line& line, const std::string& path) {
+CalibratedView projectionView(const std::string& name, const Matrix34d& P, const Line& line,
+                              const std::string& path) {
+  CalibratedView view =
+      makeView(name, line, path, [&] { return PinholeCamera::fromProjection(P); });
+  view.camera_model = "projection";
+  return view;
+}
+
+/// Parses the matrix starting at lines[*i] (one line of 12 numbers, or three rows of 4, each form
+/// optionally named on its first line or alone on the line before) and moves *i past it.
+CalibratedView parseProjection(const std::vector<Line>& lines, size_t* i, const std::string& path) {
+  const Line& line = lines[*i];
   const size_t n = line.fields.size();
-  if (n != 12 && n != 13) {
+  std::string name;
+  size_t first = 0;
+  if (n == 1 && !isNumber(line.fields[0])) {  // a name alone: the matrix follows
+    name = line.fields[0];
+    if (*i + 1 >= lines.size()) {
+      throw ParseError(path, line.number, "the name '" + name + "' is not followed by a matrix");
+    }
+    ++*i;
+    const Line& next = lines[*i];
+    if (next.fields.size() != 12 && next.fields.size() != 4) {
+      throw ParseError(path, next.number,
+                       "expected 12 numbers of a 3x4 matrix or a row of 4 after the name '" + name +
+                           "'; found " + std::to_string(next.fields.size()) + " fields");
+    }
+    if (next.fields.size() == 12) {
+      ++*i;
+      return projectionView(name, parseMatrix<3, 4>(next, 0, path), next, path);
+    }
+  } else if (n == 5 && !isNumber(line.fields[0])) {
+    name = line.fields[0];
+    first = 1;
+  } else if (n == 12 || n == 13) {
+    first = n - 12;
+    if (first == 1 && isNumber(line.fields[0])) {
+      throw ParseError(
+          path, line.number,
+          "expected an image name before the 12 numbers, found '" + line.fields[0] + "'");
+    }
+    ++*i;
+    return projectionView(first == 1 ? line.fields[0] : std::string(),
+                          parseMatrix<3, 4>(line, first, path), line, path);
+  } else if (n != 4) {
     throw ParseError(path, line.number,
-                     "expected 12 numbers of a 3x4 matrix, optionally after a name; found " +
+                     "expected 12 numbers of a 3x4 matrix (or a row of 4), optionally after a "
+                     "name; found " +
                          std::to_string(n) + " fields");
   }
-  const size_t first = n - 12;
-  if (first == 1 && isNumber(line.fields[0])) {
-    throw ParseError(
-        path, line.number,
-        "expected an image name before the 12 numbers, found '" + line.fields[0] + "'");
+  // Three rows of 4 numbers, the first at lines[*i] after `first` fields.
+  const Line& top = lines[*i];
+  Matrix34d P;
+  for (int r = 0; r < 3; ++r) {
+    if (*i >= lines.size()) {
+      throw ParseError(path, lines.back().number,
+                       "the file ends inside a matrix: expected 3 rows of 4 numbers");
+    }
+    const Line& row = lines[*i];
+    const size_t skip = r == 0 ? first : 0;
+    if (row.fields.size() != 4 + skip) {
+      throw ParseError(path, row.number,
+                       "expected row " + std::to_string(r + 1) +
+                           " of a 3x4 matrix (4 numbers), "
+                           "found " +
+                           std::to_string(row.fields.size()) + " fields");
+    }
+    P.row(r) = parseMatrix<1, 4>(row, skip, path);
+    ++*i;
   }
-  const Matrix34d P = parseMatrix<3, 4>(line, first, path);
-  const std::string name = first == 1 ? line.fields[0] : std::string();
-  return makeView(name, line, path, [&] { return PinholeCamera::fromProjection(P); });
+  return projectionView(name, P, top, path);
 }
 
 int parseCount(const Line& line, const std::string& path) {
@@ -167,12 +231,70 @@ std::vector<CalibratedView> readProjectionList(const std::string& path) {
   const std::vector<Line> lines = readFields(path);
   if (lines.empty()) throw ParseError(path, 0, "empty file, expected 3x4 projection matrices");
   std::vector<CalibratedView> views;
-  for (const Line& line : lines) views.push_back(parseProjectionLine(line, path));
+  for (size_t i = 0; i < lines.size();) views.push_back(parseProjection(lines, &i, path));
   orientViews(&views, path);
   return views;
 }
 
+namespace {
+
+bool isDirectory(const std::string& path) {
+  struct stat info;
+  return ::stat(path.c_str(), &info) == 0 && S_ISDIR(info.st_mode);
+}
+
+bool isNpy(const std::string& path) {
+  if (path.size() < 4) return false;
+  std::string suffix = path.substr(path.size() - 4);
+  std::transform(suffix.begin(), suffix.end(), suffix.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return suffix == ".npy";
+}
+
+}  // namespace
+
 std::vector<CalibratedView> readCalibration(const std::string& path) {
+  return readCalibrationWithImages(path, parentDirectory(path));
+}
+
+std::string calibrationFormat(const std::string& path) {
+  if (isDirectory(path)) return colmapModelFormat(path);
+  if (isNpy(path)) return "LLFF poses_bounds.npy";
+  try {
+    const std::vector<Line> lines = readFields(path);
+    if (!lines.empty() && looksLikeCountLine(lines.front())) return "Middlebury par";
+  } catch (const ParseError&) {
+  }
+  return "projection list";
+}
+
+std::string describeDistortion(const LensDistortion& d) {
+  if (d.isZero()) return "no distortion";
+  std::ostringstream text;
+  text << std::setprecision(9);
+  const std::pair<const char*, double> coefficients[] = {
+      {"k1", d.k1}, {"k2", d.k2}, {"p1", d.p1}, {"p2", d.p2}, {"k3", d.k3}};
+  const char* separator = "";
+  for (const auto& [name, value] : coefficients) {
+    if (value == 0.0) continue;
+    text << separator << name << "=" << value;
+    separator = " ";
+  }
+  return text.str();
+}
+
+std::vector<CalibratedView> readCalibrationWithImages(const std::string& path,
+                                                      const std::string& image_directory) {
+  if (isDirectory(path)) return readColmapModel(path);
+  if (isNpy(path)) {
+    std::vector<std::string> names;
+    try {
+      names = listImageFiles(image_directory);
+    } catch (const std::runtime_error& e) {
+      throw ParseError(path, 0, std::string("the views are the images of ") + e.what());
+    }
+    return readLlffPoses(path, names);
+  }
   const std::vector<Line> lines = readFields(path);
   if (!lines.empty() && looksLikeCountLine(lines.front())) return readMiddleburyPar(path);
   if (!lines.empty() && looksLikeParLine(lines.front())) {

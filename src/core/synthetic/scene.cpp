@@ -175,7 +175,7 @@ std::vector<CalibratedView> sceneCameras(const SceneConfig& config, const Shape&
     const Eigen::Vector3d centre =
         target + config.camera_distance_m * viewDirection(config, i, &rng);
     views.push_back({numbered("view", i, "png"),
-                     PinholeCamera::fromCentre(K, lookAt(centre, target), centre), ""});
+                     PinholeCamera::fromCentre(K, lookAt(centre, target), centre), "", {}, ""});
   }
   return views;
 }
