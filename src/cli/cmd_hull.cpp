@@ -13,6 +13,7 @@
 #include "sift_hull/hull/hull_config.h"
 #include "sift_hull/hull/hull_octomap.h"
 #include "sift_hull/hull/hull_pipeline.h"
+#include "sift_hull/hull/silhouette.h"
 #include "sift_hull/io/ply.h"
 
 namespace sift_hull {
@@ -38,6 +39,11 @@ class PoorResults {
   explicit PoorResults(bool allow) : allow_(allow) {}
   void report(const std::string& reason) {
     if (!allow_) throw std::runtime_error(reason + " (--allow-poor accepts it)");
+    std::cerr << "sift_hull hull: warning: " << reason << '\n';
+    warnings_.push_back(reason);
+  }
+  /// A warning whatever --allow-poor says (a suspect view, for instance).
+  void warn(const std::string& reason) {
     std::cerr << "sift_hull hull: warning: " << reason << '\n';
     warnings_.push_back(reason);
   }
@@ -121,12 +127,17 @@ int runHull(const std::vector<std::string>& args) {
   const HullConfig config = hullConfigFromArgs(parser);
   PoorResults poor(parser.flag("allow-poor"));
   const HullInput input = viewSetFromArgs(parser);
+  for (const std::string& warning : silhouetteWarnings(input.names, input.masks))
+    poor.warn(warning);
   const std::optional<Box3d> box = boxFromArgs(parser);
   if (box) checkBox(*box, input, &poor);
   const HullResult result = buildHull(input, config, box);
   const double hull_peak_mib = peakMemoryMiB();
   const std::unique_ptr<octomap::OcTree> octree = toOctomap(result.hull);
   const ReprojectionIoU iou = reprojectionIoU(result.mesh, result.hull.views());
+  for (const std::string& warning : disagreeingViewWarnings(input.names, iou.per_view)) {
+    poor.warn(warning);
+  }
   checkResult(result, iou, &poor);
   writeOutputs(parser, result, *octree);
   nlohmann::json json = hullJson(result, octree->getNumLeafNodes(), iou);

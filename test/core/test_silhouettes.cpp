@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <iostream>
+#include <nlohmann/json.hpp>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 #include <string>
@@ -123,6 +124,30 @@ TEST(SilhouetteWarnings, NameTheViewFarBelowTheOthers) {
     masks.push_back(silhouetteFromImage(view.image, SilhouetteConfig()));
   }
   EXPECT_EQ(silhouetteWarnings(scene_names, masks).size(), 3u);
+}
+
+TEST(SilhouetteWarnings, TheHullCommandNamesTheSuspectViews) {
+  const std::string dir = test::temporaryDirectory();
+  std::string out, err;
+  ASSERT_EQ(test::runProgram("scene --out " + dir + " --views 6 --size 160x120 --background blue",
+                             &out, &err),
+            0)
+      << err;
+  // The grey threshold takes every whole image for the object: each view is named, then no box
+  // can be bounded.
+  EXPECT_EQ(test::runProgram("hull --calib " + dir + "/scene_par.txt --images " + dir +
+                                 " --max-depth 6 --allow-poor --json",
+                             &out, &err),
+            1);
+  EXPECT_NE(err.find("view_0003.png: the silhouette covers 100 %"), std::string::npos) << err;
+  EXPECT_NE(err.find("bounded silhouette side"), std::string::npos) << err;
+  // The background model needs no threshold there, and warns of nothing.
+  ASSERT_EQ(test::runProgram("hull --calib " + dir + "/scene_par.txt --images " + dir +
+                                 " --max-depth 6 --silhouette-method background --json",
+                             &out, &err),
+            0)
+      << err;
+  EXPECT_TRUE(nlohmann::json::parse(out).at("warnings").empty()) << out;
 }
 
 TEST(BackgroundSilhouettes, UnknownMethodsAndBadImagesAreRefused) {
