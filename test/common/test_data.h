@@ -97,6 +97,24 @@ inline int runCommand(const std::string& command_line, std::string* out, std::st
 inline int runProgram(const std::string& arguments, std::string* out, std::string* err) {
   return runCommand(std::string(SIFT_HULL_EXECUTABLE) + " " + arguments, out, err);
 }
+
+/// A test suite sharing one scene written by `sift_hull scene` (8 views, 320x240) in the
+/// directory `scene_`, for the command-line tests.
+class WrittenSceneSuite : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    scene_ = new std::string(temporaryDirectory());
+    std::string out, err;
+    ASSERT_EQ(runProgram("scene --out " + *scene_ + " --views 8 --size 320x240", &out, &err), 0)
+        << err;
+  }
+  static void TearDownTestSuite() {
+    delete scene_;
+    scene_ = nullptr;
+  }
+
+  inline static std::string* scene_ = nullptr;
+};
 #endif
 
 #ifdef SIFT_HULL_ROS_EXECUTABLE

@@ -123,7 +123,7 @@ TEST(Readers, NumbersWithTrailingBytesAreRefused) {
       {"a.png",
        PinholeCamera(Eigen::Matrix3d::Identity(), Eigen::Matrix3d::Identity(),
                      Eigen::Vector3d(0, 0, 1)),
-       ""}};
+       "", LensDistortion(), ""}};
   writeMiddleburyPar(dir + "/good.txt", views);
   std::ifstream in(dir + "/good.txt");
   std::string text((std::istreambuf_iterator<char>(in)), {});
@@ -240,17 +240,8 @@ TEST(VisualHull, AWorldFrameFarFromItsOriginGivesTheSameHull) {
 
 // ---- the command-line program --------------------------------------------------------------
 
-class HostileCommandLine : public ::testing::Test {
+class HostileCommandLine : public test::WrittenSceneSuite {
  protected:
-  static void SetUpTestSuite() {
-    scene_ = new std::string(test::temporaryDirectory());
-    std::string out, err;
-    ASSERT_EQ(test::runProgram("scene --out " + *scene_ + " --views 8 --size 320x240", &out, &err),
-              0)
-        << err;
-  }
-  static void TearDownTestSuite() { delete scene_; }
-
   /// Runs `hull` on the scene with `calib` (the scene's own by default) and extra arguments.
   int hull(const std::string& extra, std::string* err, const std::string& calib = "") {
     std::string out;
@@ -273,10 +264,7 @@ class HostileCommandLine : public ::testing::Test {
     writeMiddleburyPar(path, views);
     return path;
   }
-
-  static std::string* scene_;
 };
-std::string* HostileCommandLine::scene_ = nullptr;
 
 TEST_F(HostileCommandLine, HugeCoordinatesEndInAClearError) {
   std::string err;

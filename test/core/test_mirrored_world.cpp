@@ -158,17 +158,8 @@ TEST(MirroredWorld, TheStreamRefusesAViewThatSeesTheGivenBoxBehindIt) {
 }
 
 /// The command line on a rendered scene: its par file, and projection lists made from it.
-class MirroredCommandLine : public ::testing::Test {
+class MirroredCommandLine : public test::WrittenSceneSuite {
  protected:
-  static void SetUpTestSuite() {
-    scene_ = new std::string(test::temporaryDirectory());
-    std::string out, err;
-    ASSERT_EQ(test::runProgram("scene --out " + *scene_ + " --views 8 --size 320x240", &out, &err),
-              0)
-        << err;
-  }
-  static void TearDownTestSuite() { delete scene_; }
-
   /// A projection list of the scene's views, each P transformed by `change`.
   template <typename Change>
   std::string projectionList(Change change) {
@@ -199,10 +190,7 @@ class MirroredCommandLine : public ::testing::Test {
     if (code == 0) *json = nlohmann::json::parse(out);
     return code;
   }
-
-  static std::string* scene_;
 };
-std::string* MirroredCommandLine::scene_ = nullptr;
 
 TEST_F(MirroredCommandLine, MirroredAndNegatedListsGiveTheSameHull) {
   nlohmann::json normal, mirror, negated;
