@@ -4,6 +4,7 @@
 # the sanitizer build (test/sanitize), so that both build the same tests.
 set(SIFT_HULL_CORE_GTESTS
   test_camera core
+  test_distortion core
   test_bounding_box core
   test_gms core
   test_triangulation core
@@ -27,6 +28,7 @@ set(SIFT_HULL_CORE_GTESTS
   test_hull_stream_refusals eval
   test_hardening eval
   test_mirrored_world eval
+  test_distorted_scene eval
 )
 # The harnesses of test/fuzz whose corpus test_fuzz_corpus replays: CamelCase entry point names,
 # file test/fuzz/fuzz_<snake_case>.cpp.

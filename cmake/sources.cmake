@@ -8,6 +8,7 @@ set(SIFT_HULL_CORE_SOURCES
   src/core/geometry/camera.cpp
   src/core/geometry/camera_set.cpp
   src/core/geometry/correspondence.cpp
+  src/core/geometry/distortion.cpp
   src/core/features/matching.cpp
   src/core/features/sift.cpp
   src/core/features/triangulation.cpp
@@ -32,6 +33,7 @@ set(SIFT_HULL_CORE_SOURCES
 set(SIFT_HULL_IO_SOURCES
   src/core/io/calibration.cpp
   src/core/io/colmap.cpp
+  src/core/io/colmap_writer.cpp
   src/core/io/ground_truth_files.cpp
   src/core/io/images.cpp
   src/core/io/llff.cpp

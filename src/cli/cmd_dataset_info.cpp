@@ -61,7 +61,7 @@ std::string describeModels(const std::vector<CalibratedView>& views) {
   for (const CalibratedView& view : views) {
     const std::string text = "camera model " +
                              (view.camera_model.empty() ? "unknown" : view.camera_model) + ", " +
-                             describeDistortion(view.distortion);
+                             describeDistortion(view.camera.distortion());
     if (std::find(seen.begin(), seen.end(), text) == seen.end()) seen.push_back(text);
   }
   std::string joined;
@@ -128,7 +128,7 @@ int runDatasetInfo(const std::vector<std::string>& args) {
                        {"centre", vectorJson(views[i].camera.centre())},
                        {"silhouette_fraction", fraction},
                        {"camera_model", views[i].camera_model},
-                       {"distortion", distortionJson(views[i].distortion)}});
+                       {"distortion", distortionJson(views[i].camera.distortion())}});
   }
   const nlohmann::json info = {{"calib", calib},
                                {"format", format},

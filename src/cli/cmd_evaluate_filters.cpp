@@ -24,7 +24,7 @@ EvaluationPair scenePair(const MatchOptions& options) {
   pair.name = "synthetic scene, views 0-1";
   PutativeMatches& input = pair.matches.putative;
   input = matchImages(left.image, right.image, options.sift, options.matching);
-  input.F_right_left = fundamentalMatrix(left.view.camera, right.view.camera);
+  calibratePair(&input, left.view.camera, right.view.camera);
   pair.matches.truth =
       judgeBySceneDepth(input, {left.view.camera, left.depth}, {right.view.camera, right.depth});
   return pair;

@@ -49,24 +49,27 @@ void addPairOptions(ArgParser* parser) {
   parser->addOption("gt-scene", "DIR", "ground truth: a scene directory (sift_hull scene)");
 }
 
-/// The fundamental matrix from --calib, --rectified or the scene's cameras, when any is given.
-std::optional<Eigen::Matrix3d> pairCalibration(const ArgParser& parser, const std::string& left,
-                                               const std::string& right) {
-  if (parser.flag("rectified")) return rectifiedFundamentalMatrix();
+/// Calibrates the pair from --rectified, --calib or the scene's cameras, when any is given.
+void calibrate(const ArgParser& parser, const std::string& left, const std::string& right,
+               PutativeMatches* input) {
+  if (parser.flag("rectified")) {
+    input->F_right_left = rectifiedFundamentalMatrix();
+    return;
+  }
   std::string calib;
   if (parser.has("calib")) {
     calib = parser.get("calib");
   } else if (parser.has("gt-scene")) {
-    calib = parser.get("gt-scene") + "/scene_par.txt";
+    calib = sceneCalibration(parser.get("gt-scene"));
   } else {
-    return std::nullopt;
+    return;
   }
   const std::vector<CalibratedView> views = readCalibrationWithImages(calib, parentDirectory(left));
   const std::string left_name = parser.has("left-view") ? parser.get("left-view") : baseName(left);
   const std::string right_name =
       parser.has("right-view") ? parser.get("right-view") : baseName(right);
-  return fundamentalMatrix(views[viewIndex(views, left_name, calib)].camera,
-                           views[viewIndex(views, right_name, calib)].camera);
+  calibratePair(input, views[viewIndex(views, left_name, calib)].camera,
+                views[viewIndex(views, right_name, calib)].camera);
 }
 
 std::optional<PairTruth> pairTruth(const ArgParser& parser, const std::string& left,
@@ -193,7 +196,7 @@ int runMatch(const std::vector<std::string>& args) {
   const cv::Mat left = readImage(left_path), right = readImage(right_path);
 
   PutativeMatches input = matchImages(left, right, options.sift, options.matching);
-  input.F_right_left = pairCalibration(parser, left_path, right_path);
+  calibrate(parser, left_path, right_path, &input);
   const std::optional<PairTruth> truth = pairTruth(parser, left_path, right_path);
   const std::vector<MatchTruth> judged = truth ? truth->judge(input) : std::vector<MatchTruth>();
   const std::vector<MatchTruth>* truth_or_null = truth ? &judged : nullptr;

@@ -1,5 +1,7 @@
 #include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <sstream>
 
 #include "args.h"
@@ -22,6 +24,26 @@ cv::Size parseSize(const std::string& text) {
     throw UsageError("--size expects WIDTHxHEIGHT, got '" + text + "'");
   }
   return {width, height};
+}
+
+/// "K1,K2,P1,P2" or "K1,K2,P1,P2,K3", OpenCV's order.
+LensDistortion parseDistortion(const std::string& text) {
+  std::vector<double> values;
+  std::stringstream in(text);
+  std::string field;
+  while (std::getline(in, field, ',')) {
+    char* end = nullptr;
+    const double value = std::strtod(field.c_str(), &end);
+    if (field.empty() || end != field.c_str() + field.size() || !std::isfinite(value)) {
+      throw UsageError("--distortion expects finite numbers K1,K2,P1,P2[,K3], got '" + text + "'");
+    }
+    values.push_back(value);
+  }
+  if (values.size() != 4 && values.size() != 5) {
+    throw UsageError("--distortion expects 4 or 5 numbers K1,K2,P1,P2[,K3], got '" + text + "'");
+  }
+  values.resize(5, 0.0);
+  return {values[0], values[1], values[2], values[3], values[4]};
 }
 
 std::string formatNumber(double value) {
@@ -47,6 +69,7 @@ SceneConfig configFromArgs(const ArgParser& parser) {
   config.seed = static_cast<unsigned>(parser.getInt("seed"));
   config.camera_distance_m = parser.getDouble("camera-distance-m");
   config.background = parser.get("background");
+  config.distortion = parseDistortion(parser.get("distortion"));
   validateOptions(config);
   return config;
 }
@@ -58,7 +81,8 @@ int runScene(const std::vector<std::string>& args) {
   ArgParser parser(
       "scene",
       "Ray-casts a textured object made of analytic primitives, seen by N cameras, and\n"
-      "writes images, silhouettes, depth maps (PFM) and a Middlebury par file.");
+      "writes images, silhouettes, depth maps (PFM) and the calibration (a Middlebury par\n"
+      "file, or a COLMAP model in DIR/sparse for a distorted lens).");
   parser.addOption("out", "DIR", "output directory (created when missing)");
   parser.addOption("views", "N", "number of cameras", std::to_string(defaults.views));
   parser.addOption("size", "WxH", "image size in pixels",
@@ -73,6 +97,10 @@ int runScene(const std::vector<std::string>& args) {
                    "what the rays missing the object see: " + joined(sceneBackgrounds()) +
                        " (blue: uniform dark blue; textured: coloured blobs)",
                    defaults.background);
+  parser.addOption("distortion", "K1,K2,P1,P2[,K3]",
+                   "lens distortion of every camera (OpenCV's radial-tangential model); not zero: "
+                   "the calibration is written as a COLMAP model in DIR/sparse",
+                   "0,0,0,0");
   parser.addFlag("json", "print the result as one JSON object");
   if (!parser.parse(args)) return 0;
   const SceneConfig config = configFromArgs(parser);

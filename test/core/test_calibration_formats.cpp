@@ -112,7 +112,7 @@ void expectKnownViews(const std::vector<CalibratedView>& views,
     EXPECT_TRUE(views[i].camera.K().isApprox(K, 1e-12));
     EXPECT_TRUE(views[i].camera.R().isApprox(known[i].R_c2w_cv.transpose(), 1e-12));
     EXPECT_TRUE(views[i].camera.centre().isApprox(known[i].centre, 1e-12));
-    EXPECT_TRUE(views[i].distortion.isZero());
+    EXPECT_TRUE(views[i].camera.distortion().isZero());
   }
 }
 

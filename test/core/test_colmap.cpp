@@ -136,12 +136,12 @@ void expectKnownCameras(const std::vector<CalibratedView>& views) {
   EXPECT_TRUE(views[2].camera.t().isApprox(kImages[2].t, 1e-12));
   EXPECT_EQ(views[1].camera_model, "PINHOLE");
   EXPECT_EQ(views[0].camera_model, "OPENCV");
-  EXPECT_TRUE(views[1].distortion.isZero());
-  EXPECT_DOUBLE_EQ(views[0].distortion.k1, -0.1);
-  EXPECT_DOUBLE_EQ(views[0].distortion.k2, 0.01);
-  EXPECT_DOUBLE_EQ(views[0].distortion.p1, 0.001);
-  EXPECT_DOUBLE_EQ(views[0].distortion.p2, -0.002);
-  EXPECT_DOUBLE_EQ(views[0].distortion.k3, 0.0);
+  EXPECT_TRUE(views[1].camera.distortion().isZero());
+  EXPECT_DOUBLE_EQ(views[0].camera.distortion().k1, -0.1);
+  EXPECT_DOUBLE_EQ(views[0].camera.distortion().k2, 0.01);
+  EXPECT_DOUBLE_EQ(views[0].camera.distortion().p1, 0.001);
+  EXPECT_DOUBLE_EQ(views[0].camera.distortion().p2, -0.002);
+  EXPECT_DOUBLE_EQ(views[0].camera.distortion().k3, 0.0);
 }
 
 TEST_F(ColmapModel, TextModelGivesTheKnownCameras) {
@@ -169,9 +169,9 @@ TEST_F(ColmapModel, EmptyPointLinesAndEveryModelRead) {
   const auto views = readColmapModel(dir_);
   ASSERT_EQ(views.size(), 4u);
   EXPECT_DOUBLE_EQ(views[0].camera.K()(1, 1), 500.0);
-  EXPECT_DOUBLE_EQ(views[1].distortion.k1, 0.1);
-  EXPECT_DOUBLE_EQ(views[2].distortion.k2, 0.2);
-  EXPECT_DOUBLE_EQ(views[3].distortion.k3, 0.5);
+  EXPECT_DOUBLE_EQ(views[1].camera.distortion().k1, 0.1);
+  EXPECT_DOUBLE_EQ(views[2].camera.distortion().k2, 0.2);
+  EXPECT_DOUBLE_EQ(views[3].camera.distortion().k3, 0.5);
   EXPECT_DOUBLE_EQ(views[3].camera.K()(1, 1), 501.0);
   EXPECT_TRUE(views[3].camera.R().isApprox(Eigen::Matrix3d::Identity()));  // q normalised
 }
@@ -266,17 +266,17 @@ TEST_F(ColmapModel, BinaryErrorsNameTheFile) {
       << errorOf();
 }
 
-TEST_F(ColmapModel, TheHullRefusesDistortedViews) {
+TEST_F(ColmapModel, CamerasProjectThroughTheirDistortion) {
   writeText();
-  try {
-    loadHullInput(dir_, dir_, "", SilhouetteConfig(), {});
-    FAIL() << "no error";
-  } catch (const std::runtime_error& e) {
-    EXPECT_EQ(std::string(e.what()), dir_ +
-                                         "/images.txt:4: lens distortion k1=-0.1 k2=0.01 p1=0.001 "
-                                         "p2=-0.002 is not supported by the hull yet; undistort "
-                                         "the images first");
-  }
+  const std::vector<CalibratedView> views = readColmapModel(dir_);
+  const PinholeCamera& camera = views[0].camera;
+  ASSERT_TRUE(camera.distorted());
+  const Eigen::Vector3d X_W = camera.backProject(Eigen::Vector2d(10.0, 20.0), 2.0);
+  const Eigen::Vector2d normalised = camera.toCamera(X_W).hnormalized();
+  const Eigen::Vector2d expected =
+      (camera.K() * distortNormalised(camera.distortion(), normalised).homogeneous()).hnormalized();
+  EXPECT_LT((camera.project(X_W) - expected).norm(), 1e-9);
+  EXPECT_LT((camera.project(X_W) - Eigen::Vector2d(10.0, 20.0)).norm(), 1e-8);
 }
 
 }  // namespace

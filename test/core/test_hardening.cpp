@@ -123,7 +123,7 @@ TEST(Readers, NumbersWithTrailingBytesAreRefused) {
       {"a.png",
        PinholeCamera(Eigen::Matrix3d::Identity(), Eigen::Matrix3d::Identity(),
                      Eigen::Vector3d(0, 0, 1)),
-       "", LensDistortion(), ""}};
+       "", ""}};
   writeMiddleburyPar(dir + "/good.txt", views);
   std::ifstream in(dir + "/good.txt");
   std::string text((std::istreambuf_iterator<char>(in)), {});

@@ -69,7 +69,7 @@ HullData& hullData() {
     const cv::Size size(config.width_px, config.height_px);
     for (double degrees : {20.0, 45.0}) {
       for (int v = 0; v < kViews; ++v) {
-        CalibratedView view{"", turnedCamera(views[v].view.camera, degrees), "", {}, ""};
+        CalibratedView view{"", turnedCamera(views[v].view.camera, degrees), "", ""};
         const RenderedView rendered = renderView(shape, view, size, config.seed);
         d.fresh.push_back({"fresh_" + std::to_string(d.fresh.size()), view.camera, rendered.mask});
       }

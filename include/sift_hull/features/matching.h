@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "sift_hull/features/sift.h"
+#include "sift_hull/geometry/camera.h"
 
 namespace sift_hull {
 
@@ -32,8 +33,12 @@ struct PutativeMatches {
   std::vector<cv::DMatch> matches;  ///< queryIdx indexes left_keypoints, trainIdx right_keypoints
   cv::Size left_image_size;
   cv::Size right_image_size;
-  /// Fundamental matrix with x_r^T F x_l = 0, when the pair is calibrated.
+  /// Fundamental matrix with x_r^T F x_l = 0, when the pair is calibrated: between ideal pixels
+  /// (undistorted, see PinholeCamera) when `cameras` holds a lens distortion.
   std::optional<Eigen::Matrix3d> F_right_left;
+  /// The pair's cameras (left, right) when calibrated by calibratePair: the epipolar filter
+  /// undistorts the points with their lens distortion before F.
+  std::optional<std::pair<PinholeCamera, PinholeCamera>> cameras;
 
   const cv::KeyPoint& left(size_t match) const { return left_keypoints[matches[match].queryIdx]; }
   const cv::KeyPoint& right(size_t match) const { return right_keypoints[matches[match].trainIdx]; }
@@ -48,6 +53,9 @@ std::vector<cv::DMatch> matchDescriptors(const cv::Mat& left, const cv::Mat& rig
 /// Detects, describes and matches: the putative matches of two images.
 PutativeMatches matchImages(const cv::Mat& left_image, const cv::Mat& right_image,
                             const SiftConfig& sift, const MatchConfig& matching);
+
+/// Calibrates a pair: `cameras` and F_right_left = fundamentalMatrix(left, right).
+void calibratePair(PutativeMatches* matches, const PinholeCamera& left, const PinholeCamera& right);
 
 /// Fundamental matrix of a rectified pair: epipolar lines are image rows (y_r = y_l).
 Eigen::Matrix3d rectifiedFundamentalMatrix();

@@ -9,7 +9,11 @@ namespace sift_hull {
 
 /// Keeps a match when each point lies within max_epipolar_px of the other's epipolar line under
 /// the calibrated F, checked in both images ("reverse validation"). Score: the larger of the two
-/// point-to-line distances, in pixels. Needs PutativeMatches::F_right_left.
+/// point-to-line distances, in pixels. Needs PutativeMatches::F_right_left; with
+/// PutativeMatches::cameras, the points are undistorted first (F relates ideal pixels) and each
+/// distance is taken back to raw pixels by the lens's local magnification, so max_epipolar_px
+/// means pixels of the images as taken; a point beyond where the lens model can be inverted is
+/// rejected (score NaN).
 struct EpipolarConfig {
   double max_epipolar_px = 2.0;
 };

@@ -3,6 +3,9 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <optional>
+#include <utility>
+
+#include "sift_hull/geometry/distortion.h"
 
 namespace sift_hull {
 
@@ -24,6 +27,12 @@ using Matrix34d = Eigen::Matrix<double, 3, 4>;
 /// Which sign of P is the right one is a property of a set of views, not of one matrix: see
 /// orientCameras (geometry/camera_set.h). An improper R has no quaternion: a TF pose of such a
 /// camera is not a rigid motion. The constructor takes rotations only (det +1).
+///
+/// Lens distortion (as image_geometry's PinholeCameraModel and OpenCV hold it): pixels of the
+/// image as taken ("raw") are K applied to the distorted normalised point, distortNormalised(X/Z,
+/// Y/Z); "ideal" pixels are those of the undistorted pinhole K [R | t]. project, rayDirection and
+/// backProject work on raw pixels; projectionMatrix, fundamentalMatrix and triangulate on ideal
+/// ones (undistortPixel converts). Without distortion the two coincide.
 class PinholeCamera {
  public:
   PinholeCamera() = default;
@@ -45,6 +54,11 @@ class PinholeCamera {
   PinholeCamera negated() const;
   /// True when det R = -1: the camera lives in a mirrored (left-handed) world frame.
   bool improper() const { return R_.determinant() < 0.0; }
+  /// The same camera with this lens distortion. Throws std::invalid_argument for a non-finite
+  /// coefficient.
+  PinholeCamera withDistortion(const LensDistortion& distortion) const;
+  const LensDistortion& distortion() const { return distortion_; }
+  bool distorted() const { return !distortion_.isZero(); }
 
   const Eigen::Matrix3d& K() const { return K_; }
   const Eigen::Matrix3d& R() const { return R_; }
@@ -58,30 +72,53 @@ class PinholeCamera {
   Eigen::Vector3d toCamera(const Eigen::Vector3d& X_W) const { return R_ * X_W + t_; }
   /// Depth of a world point along the optical axis (positive in front of the camera).
   double depth(const Eigen::Vector3d& X_W) const { return toCamera(X_W).z(); }
-  /// Pixel of a world point; meaningful only where depth(X_W) > 0.
+  /// Raw pixel of a world point (with the lens distortion); meaningful only where depth > 0.
   Eigen::Vector2d project(const Eigen::Vector3d& X_W) const;
-  /// Unit direction, in world coordinates, of the ray from the centre through pixel (u, v).
+  /// Ideal pixel of a world point: K [R | t] X, no distortion.
+  Eigen::Vector2d projectIdeal(const Eigen::Vector3d& X_W) const;
+  /// The ideal pixel of a raw one; empty where the distortion cannot be inverted (see
+  /// undistortNormalised). The raw pixel itself without distortion.
+  std::optional<Eigen::Vector2d> undistortPixel(const Eigen::Vector2d& raw_px) const;
+  /// The raw pixel of an ideal one.
+  Eigen::Vector2d distortPixel(const Eigen::Vector2d& ideal_px) const;
+  /// Unit direction, in world coordinates, of the ray from the centre through raw pixel (u, v);
+  /// NaN where undistortPixel is empty.
   Eigen::Vector3d rayDirection(const Eigen::Vector2d& pixel) const;
-  /// The world point seen at a pixel at the given depth along the optical axis.
+  /// The world point seen at a raw pixel at the given depth along the optical axis; NaN where
+  /// undistortPixel is empty.
   Eigen::Vector3d backProject(const Eigen::Vector2d& pixel, double depth) const;
+  /// The smallest box of ideal pixels, [u_min, u_max] x [v_min, v_max] in (min, max), that holds
+  /// the undistorted image of the raw rectangle [u0, u1] x [v0, v1] (its border sampled at least
+  /// every pixel, the interior mapped inside as long as the distortion does not fold over). Throws
+  /// std::invalid_argument when a border point cannot be undistorted.
+  std::pair<Eigen::Vector2d, Eigen::Vector2d> undistortedBounds(
+      const Eigen::Vector2d& raw_min_px, const Eigen::Vector2d& raw_max_px) const;
+  /// Whether the distortion is one-to-one over raw rectangle [u0, u1] x [v0, v1]: every raw point
+  /// of a grid over it (at most 64 px apart, border included) undistorts, with a Jacobian of
+  /// positive determinant. True without distortion.
+  bool distortionInvertibleOver(const Eigen::Vector2d& raw_min_px,
+                                const Eigen::Vector2d& raw_max_px) const;
 
  private:
   Eigen::Matrix3d K_ = Eigen::Matrix3d::Identity();
   Eigen::Matrix3d R_ = Eigen::Matrix3d::Identity();
   Eigen::Vector3d t_ = Eigen::Vector3d::Zero();
   Eigen::Matrix3d K_inv_ = Eigen::Matrix3d::Identity();
+  LensDistortion distortion_;
 };
 
 /// Cross-product matrix [v]x, so that [v]x w = v x w.
 Eigen::Matrix3d skew(const Eigen::Vector3d& v);
 
 /// Fundamental matrix F with x_b^T F x_a = 0 for every scene point seen at x_a in view a and x_b in
-/// view b (pixels, homogeneous). The paper's eq. 10, F = A_r^-T [t]x R A_l^-1, with the relative
-/// pose R = R_b R_a^T and t = t_b - R t_a taking camera-a coordinates into camera b.
+/// view b (ideal pixels, homogeneous: undistortPixel first for distorted cameras). The paper's eq.
+/// 10, F = A_r^-T [t]x R A_l^-1, with the relative pose R = R_b R_a^T and t = t_b - R t_a taking
+/// camera-a coordinates into camera b.
 Eigen::Matrix3d fundamentalMatrix(const PinholeCamera& a, const PinholeCamera& b);
 
-/// The world point seen at x_a in view a and at x_b in view b, by linear triangulation (DLT, the
-/// smallest singular vector); empty when it is at infinity or not in front of both cameras.
+/// The world point seen at ideal pixel x_a in view a and at x_b in view b, by linear triangulation
+/// (DLT, the smallest singular vector); empty when it is at infinity or not in front of both
+/// cameras.
 std::optional<Eigen::Vector3d> triangulate(const PinholeCamera& a, const PinholeCamera& b,
                                            const Eigen::Vector2d& x_a, const Eigen::Vector2d& x_b);
 

@@ -1,9 +1,15 @@
 #pragma once
 
+#include <Eigen/Core>
+#include <optional>
+
 namespace sift_hull {
 
 /// Lens distortion in OpenCV's radial-tangential model and order (k1, k2, p1, p2, k3), applied to
-/// normalised camera coordinates. All zero means an ideal pinhole.
+/// normalised camera coordinates (x, y) = (X / Z, Y / Z):
+///   r^2 = x^2 + y^2,  s = 1 + k1 r^2 + k2 r^4 + k3 r^6,
+///   x_d = x s + 2 p1 x y + p2 (r^2 + 2 x^2),  y_d = y s + p1 (r^2 + 2 y^2) + 2 p2 x y.
+/// All zero means an ideal pinhole.
 struct LensDistortion {
   double k1 = 0.0;  ///< radial, r^2
   double k2 = 0.0;  ///< radial, r^4
@@ -14,5 +20,22 @@ struct LensDistortion {
   /// True when every coefficient is exactly zero.
   bool isZero() const { return k1 == 0.0 && k2 == 0.0 && p1 == 0.0 && p2 == 0.0 && k3 == 0.0; }
 };
+
+/// Throws std::invalid_argument when a coefficient is NaN or infinite.
+void validate(const LensDistortion& distortion);
+
+/// The distorted normalised point of an ideal one (the model above).
+Eigen::Vector2d distortNormalised(const LensDistortion& distortion, const Eigen::Vector2d& ideal);
+
+/// The Jacobian d(distorted) / d(ideal) at an ideal normalised point.
+Eigen::Matrix2d distortionJacobian(const LensDistortion& distortion, const Eigen::Vector2d& ideal);
+
+/// The ideal normalised point whose distortion is `distorted`, by Newton's method started at the
+/// distorted point; empty when it does not converge to 1e-12 (relative) within 50 steps, the
+/// Jacobian becomes singular, or the root found is not on the lens's branch of the model (the
+/// Jacobian's determinant or the radial factor 1 + k1 r^2 + ... not positive there: the point lies
+/// beyond where the model folds over).
+std::optional<Eigen::Vector2d> undistortNormalised(const LensDistortion& distortion,
+                                                   const Eigen::Vector2d& distorted);
 
 }  // namespace sift_hull

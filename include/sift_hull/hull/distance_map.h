@@ -24,8 +24,20 @@ class SignedDistanceMap {
   /// std::invalid_argument for another type or an empty mask.
   SignedDistanceMap(const cv::Mat& mask, const SilhouetteBounds& bounds, int padding_px);
 
+  /// This map resampled for a camera with lens distortion: a map over ideal pixels (those of the
+  /// undistorted pinhole, PinholeCamera) whose value at ideal pixel p is this map's at the raw
+  /// pixel camera.distortPixel(p), so carving with the ideal pinhole evaluates D(distort(P X)) on
+  /// the raw silhouette. The grid covers the undistorted image of this map's window plus a pixel;
+  /// look-ups beyond it clamp as here. Throws std::invalid_argument when the grid would exceed four
+  /// times this map's area (a distortion that blows the image up: check the coefficients).
+  SignedDistanceMap undistorted(const PinholeCamera& camera) const;
+
   /// Bilinear look-up at pixel coordinates (pixel centres at integers), clamped to the map.
   float at(double u_px, double v_px) const;
+  /// An upper bound of the map's change per pixel: 1 for a distance transform; for an undistorted
+  /// map, the largest spectral norm of the distortion's Jacobian in pixels over the grid (times a
+  /// 2 % margin for the spacing of its samples).
+  float lipschitz() const { return lipschitz_; }
   cv::Size imageSize() const { return image_size_; }
   /// The map (CV_32FC1, continuous, at least 2x2) and the image pixel of its first element.
   const cv::Mat& map() const { return distance_px_; }
@@ -35,6 +47,7 @@ class SignedDistanceMap {
   cv::Mat distance_px_;  ///< CV_32FC1
   cv::Size image_size_;
   cv::Point origin_;  ///< image pixel of map element (0, 0)
+  float lipschitz_ = 1.0f;
 };
 
 }  // namespace sift_hull

@@ -23,10 +23,9 @@ class ParseError : public std::runtime_error {
 
 /// One calibrated view: the image file it names and its camera.
 struct CalibratedView {
-  std::string name;  ///< image file name as written in the calibration file (may be empty)
-  PinholeCamera camera;
-  std::string source;         ///< "FILE:LINE" the view was read from; empty when made in code
-  LensDistortion distortion;  ///< zero unless the calibration gives lens distortion
+  std::string name;      ///< image file name as written in the calibration file (may be empty)
+  PinholeCamera camera;  ///< with the lens distortion the calibration gives, if any
+  std::string source;    ///< "FILE:LINE" the view was read from; empty when made in code
   /// Camera model of the calibration: a COLMAP model name ("PINHOLE", "OPENCV", ...), "LLFF",
   /// "par" or "projection"; empty when made in code.
   std::string camera_model;
@@ -66,6 +65,7 @@ std::string calibrationFormat(const std::string& path);
 std::string describeDistortion(const LensDistortion& distortion);
 
 /// Writes views as a Middlebury par file (17 significant digits, so reading it back is exact).
+/// Throws std::runtime_error for a mirrored or distorted camera, which the format cannot hold.
 void writeMiddleburyPar(const std::string& path, const std::vector<CalibratedView>& views);
 
 /// The cameras of the views, in order.

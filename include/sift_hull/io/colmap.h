@@ -45,4 +45,13 @@ std::vector<CalibratedView> parseColmapImagesBinary(
     std::istream& in, uint64_t size_bytes, const std::string& file,
     const std::map<uint32_t, ColmapCamera>& cameras);
 
+/// Writes views as a COLMAP text model into `directory` (created when missing): cameras.txt with
+/// one camera per view, PINHOLE without distortion, OPENCV with k1, k2, p1, p2, FULL_OPENCV when k3
+/// is not zero (cx, cy written 0.5 larger, COLMAP's convention), and images.txt with each view's
+/// pose and an empty point line; 17 significant digits, so readColmapModel gives the views back.
+/// Every view has the image size `width_px` x `height_px`. Throws std::runtime_error naming the
+/// view for a camera with skew or a mirrored frame (det R = -1), which COLMAP cannot hold.
+void writeColmapText(const std::string& directory, const std::vector<CalibratedView>& views,
+                     int width_px, int height_px);
+
 }  // namespace sift_hull

@@ -13,7 +13,8 @@ std::vector<std::string> readViewList(const std::string& path);
 
 /// The views of a calibration file named in `view_names` (all when empty), in the file's order,
 /// with silhouettes as loadSilhouettes() finds them. Throws std::runtime_error for a name that the
-/// calibration does not hold and for a view with lens distortion, which the hull cannot use yet.
+/// calibration does not hold. Cameras keep their lens distortion; the hull carves raw silhouettes
+/// with it (HullView).
 /// The calibration is read by readCalibrationWithImages(calibration_path, image_directory).
 HullInput loadHullInput(const std::string& calibration_path, const std::string& image_directory,
                         const std::string& mask_directory, const SilhouetteConfig& recipe,

@@ -25,12 +25,17 @@ struct SceneConfig {
   /// blue (grey level 0.196, just above the Middlebury recipe's threshold); "textured", coloured
   /// blobs on a sphere at infinity (a colour per ray direction, so the views see one world).
   std::string background = "black";
+  /// Lens distortion of every camera. Not zero: the images, masks and depth maps are those of the
+  /// distorted lens (each pixel's ray undistorted), and writeScene writes the calibration as a
+  /// COLMAP text model (sparse/), as a par file cannot hold distortion.
+  LensDistortion distortion;
 };
 
 /// The background names SceneConfig::background takes.
 const std::vector<std::string>& sceneBackgrounds();
 
-/// Throws std::invalid_argument naming the first bad field.
+/// Throws std::invalid_argument naming the first bad field; a distortion must be one-to-one over
+/// the image (PinholeCamera::distortionInvertibleOver).
 void validate(const SceneConfig& config);
 
 /// One rendered view. Pixel (u, v) is the colour seen along the ray through its centre.
@@ -60,9 +65,14 @@ inline constexpr const char* kMaskDirectory = "masks";
 inline constexpr const char* kDepthDirectory = "depth";
 
 /// Writes into `directory` (created when missing) the images view_NNNN.png, masks/view_NNNN.png,
-/// depth/view_NNNN.pfm, scene_par.txt (Middlebury format) and scene.json (the config).
+/// depth/view_NNNN.pfm, scene.json (the config) and the calibration: scene_par.txt (Middlebury
+/// format), or for a distorted lens sparse/cameras.txt and sparse/images.txt (COLMAP text).
 void writeScene(const std::string& directory, const SceneConfig& config,
                 const std::vector<RenderedView>& views);
+
+/// The calibration a scene directory holds, to give readCalibration or `--calib`:
+/// DIR/scene_par.txt, or DIR/sparse when only that exists.
+std::string sceneCalibration(const std::string& directory);
 
 /// What a scene directory holds, read back: cameras, depth maps and the config that made it.
 struct SceneData {

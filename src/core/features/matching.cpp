@@ -90,4 +90,10 @@ Eigen::Matrix3d rectifiedFundamentalMatrix() {
   return F;
 }
 
+void calibratePair(PutativeMatches* matches, const PinholeCamera& left,
+                   const PinholeCamera& right) {
+  matches->cameras = std::make_pair(left, right);
+  matches->F_right_left = fundamentalMatrix(left, right);
+}
+
 }  // namespace sift_hull

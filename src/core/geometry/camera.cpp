@@ -96,17 +96,90 @@ Matrix34d PinholeCamera::projectionMatrix() const {
   return K_ * Rt;
 }
 
-Eigen::Vector2d PinholeCamera::project(const Eigen::Vector3d& X_W) const {
+PinholeCamera PinholeCamera::withDistortion(const LensDistortion& distortion) const {
+  validate(distortion);
+  PinholeCamera camera = *this;
+  camera.distortion_ = distortion;
+  return camera;
+}
+
+Eigen::Vector2d PinholeCamera::projectIdeal(const Eigen::Vector3d& X_W) const {
   return (K_ * toCamera(X_W)).hnormalized();
 }
 
+Eigen::Vector2d PinholeCamera::project(const Eigen::Vector3d& X_W) const {
+  if (!distorted()) return projectIdeal(X_W);
+  const Eigen::Vector2d normalised = toCamera(X_W).hnormalized();
+  return (K_ * distortNormalised(distortion_, normalised).homogeneous()).hnormalized();
+}
+
+std::optional<Eigen::Vector2d> PinholeCamera::undistortPixel(const Eigen::Vector2d& raw_px) const {
+  if (!distorted()) return raw_px;
+  const Eigen::Vector2d distorted = (K_inv_ * raw_px.homogeneous()).hnormalized();
+  const std::optional<Eigen::Vector2d> ideal = undistortNormalised(distortion_, distorted);
+  if (!ideal) return std::nullopt;
+  return (K_ * ideal->homogeneous()).hnormalized();
+}
+
+Eigen::Vector2d PinholeCamera::distortPixel(const Eigen::Vector2d& ideal_px) const {
+  if (!distorted()) return ideal_px;
+  const Eigen::Vector2d ideal = (K_inv_ * ideal_px.homogeneous()).hnormalized();
+  return (K_ * distortNormalised(distortion_, ideal).homogeneous()).hnormalized();
+}
+
 Eigen::Vector3d PinholeCamera::rayDirection(const Eigen::Vector2d& pixel) const {
-  return (R_.transpose() * (K_inv_ * pixel.homogeneous())).normalized();
+  const std::optional<Eigen::Vector2d> ideal = undistortPixel(pixel);
+  if (!ideal) return Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  return (R_.transpose() * (K_inv_ * ideal->homogeneous())).normalized();
 }
 
 Eigen::Vector3d PinholeCamera::backProject(const Eigen::Vector2d& pixel, double depth) const {
-  const Eigen::Vector3d X_C = depth * (K_inv_ * pixel.homogeneous());
+  const std::optional<Eigen::Vector2d> ideal = undistortPixel(pixel);
+  if (!ideal) return Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  const Eigen::Vector3d X_C = depth * (K_inv_ * ideal->homogeneous());
   return R_.transpose() * (X_C - t_);
+}
+
+std::pair<Eigen::Vector2d, Eigen::Vector2d> PinholeCamera::undistortedBounds(
+    const Eigen::Vector2d& raw_min_px, const Eigen::Vector2d& raw_max_px) const {
+  if (!distorted()) return {raw_min_px, raw_max_px};
+  Eigen::Vector2d low = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector2d high = -low;
+  const auto include = [&](const Eigen::Vector2d& raw) {
+    const std::optional<Eigen::Vector2d> ideal = undistortPixel(raw);
+    if (!ideal) {
+      throw std::invalid_argument("the lens distortion cannot be inverted at raw pixel (" +
+                                  std::to_string(raw.x()) + ", " + std::to_string(raw.y()) + ")");
+    }
+    low = low.cwiseMin(*ideal);
+    high = high.cwiseMax(*ideal);
+  };
+  const Eigen::Vector2d extent = raw_max_px - raw_min_px;
+  const int steps = static_cast<int>(std::ceil(std::max(extent.x(), extent.y()))) + 1;
+  for (int i = 0; i <= steps; ++i) {
+    const double f = static_cast<double>(i) / steps;
+    const double u = raw_min_px.x() + f * extent.x(), v = raw_min_px.y() + f * extent.y();
+    include({u, raw_min_px.y()});
+    include({u, raw_max_px.y()});
+    include({raw_min_px.x(), v});
+    include({raw_max_px.x(), v});
+  }
+  return {low, high};
+}
+
+bool PinholeCamera::distortionInvertibleOver(const Eigen::Vector2d& raw_min_px,
+                                             const Eigen::Vector2d& raw_max_px) const {
+  if (!distorted()) return true;
+  const Eigen::Vector2d extent = raw_max_px - raw_min_px;
+  const int steps = std::max(2, static_cast<int>(std::ceil(extent.maxCoeff() / 64.0)));
+  for (int i = 0; i <= steps; ++i) {
+    for (int j = 0; j <= steps; ++j) {
+      const Eigen::Vector2d raw =
+          raw_min_px + Eigen::Vector2d(extent.x() * i, extent.y() * j) / steps;
+      if (!undistortPixel(raw)) return false;
+    }
+  }
+  return true;
 }
 
 Eigen::Matrix3d skew(const Eigen::Vector3d& v) {

@@ -1,6 +1,9 @@
 #include "sift_hull/hull/distance_map.h"
 
+#include <Eigen/LU>
+#include <Eigen/SVD>
 #include <algorithm>
+#include <cmath>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
@@ -81,6 +84,52 @@ SignedDistanceMap::SignedDistanceMap(const cv::Mat& mask, const SilhouetteBounds
       distance[col] = is_inside[col] ? 0.5f - distance[col] : outside_distance[col] - 0.5f;
     }
   }
+}
+
+SignedDistanceMap SignedDistanceMap::undistorted(const PinholeCamera& camera) const {
+  if (!camera.distorted()) return *this;
+  const Eigen::Vector2d raw_min(origin_.x, origin_.y);
+  const Eigen::Vector2d raw_max(origin_.x + distance_px_.cols - 1,
+                                origin_.y + distance_px_.rows - 1);
+  const auto [low, high] = camera.undistortedBounds(raw_min, raw_max);
+  const cv::Point first(static_cast<int>(std::floor(low.x())) - 1,
+                        static_cast<int>(std::floor(low.y())) - 1);
+  const double width = std::ceil(high.x()) + 2 - first.x,
+               height = std::ceil(high.y()) + 2 - first.y;
+  if (!(width * height <= 4.0 * distance_px_.total() + 1e4)) {
+    throw std::invalid_argument(
+        "the lens distortion maps the silhouette's window onto an ideal image more than four "
+        "times its size: check the distortion coefficients");
+  }
+  SignedDistanceMap result;
+  result.image_size_ = image_size_;
+  result.origin_ = first;
+  cv::Mat map_u(static_cast<int>(height), static_cast<int>(width), CV_32FC1);
+  cv::Mat map_v(map_u.size(), CV_32FC1);
+  const Eigen::Matrix3d& K = camera.K();
+  const Eigen::Matrix3d K_inverse = K.inverse();
+  const Eigen::Matrix2d K2 = K.topLeftCorner<2, 2>(), K2_inverse = K2.inverse();
+  double lipschitz = 1.0;
+  for (int row = 0; row < map_u.rows; ++row) {
+    float* u = map_u.ptr<float>(row);
+    float* v = map_v.ptr<float>(row);
+    for (int col = 0; col < map_u.cols; ++col) {
+      const Eigen::Vector2d ideal(first.x + col, first.y + row);
+      const Eigen::Vector2d raw = camera.distortPixel(ideal);
+      u[col] = static_cast<float>(raw.x() - origin_.x);
+      v[col] = static_cast<float>(raw.y() - origin_.y);
+      if (row % 4 == 0 && col % 4 == 0) {
+        const Eigen::Vector2d normalised = (K_inverse * ideal.homogeneous()).hnormalized();
+        const Eigen::Matrix2d J =
+            K2 * distortionJacobian(camera.distortion(), normalised) * K2_inverse;
+        lipschitz = std::max(lipschitz, Eigen::JacobiSVD<Eigen::Matrix2d>(J).singularValues()(0));
+      }
+    }
+  }
+  cv::remap(distance_px_, result.distance_px_, map_u, map_v, cv::INTER_LINEAR,
+            cv::BORDER_REPLICATE);
+  result.lipschitz_ = static_cast<float>(1.02 * lipschitz);
+  return result;
 }
 
 float SignedDistanceMap::at(double u_px, double v_px) const {

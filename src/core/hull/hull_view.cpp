@@ -40,15 +40,66 @@ bool withinBounds(const SilhouetteBounds& bounds, double u, double v) {
          (!bounds.has_v_min || v >= bounds.v_min_px) && (!bounds.has_v_max || v <= bounds.v_max_px);
 }
 
+/// The raw image with the distance map's padding, as a raw pixel rectangle (min, max).
+std::pair<Eigen::Vector2d, Eigen::Vector2d> paddedImage(const cv::Mat& mask, int padding_px) {
+  const double pad = padding_px + 0.5;
+  return {Eigen::Vector2d(-pad, -pad), Eigen::Vector2d(mask.cols - 1 + pad, mask.rows - 1 + pad)};
+}
+
+/// Throws std::invalid_argument when the view's distortion cannot be inverted over its padded
+/// image: the coefficients do not describe a lens for an image of this size.
+void checkDistortion(const std::string& name, const PinholeCamera& camera, const cv::Mat& mask,
+                     int padding_px) {
+  if (!camera.distorted()) return;
+  const auto [low, high] = paddedImage(mask, padding_px);
+  if (!camera.distortionInvertibleOver(low, high)) {
+    throw std::invalid_argument("view '" + name + "': its lens distortion " +
+                                "folds over within its " + std::to_string(mask.cols) + "x" +
+                                std::to_string(mask.rows) +
+                                " image (no one-to-one undistortion): check the coefficients and "
+                                "the image size");
+  }
+}
+
+/// The bounds of the undistorted silhouette, in ideal pixels: the extremes of its boundary pixels'
+/// corners undistorted (the boundary maps onto the boundary); open sides as in `raw`.
+SilhouetteBounds idealBounds(const SilhouetteBounds& raw, const PinholeCamera& camera,
+                             const cv::Mat& mask) {
+  if (raw.empty || !camera.distorted()) return raw;
+  std::vector<std::vector<cv::Point>> contours;
+  cv::findContours(mask != 0, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_NONE);
+  Eigen::Vector2d low = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector2d high = -low;
+  for (const std::vector<cv::Point>& contour : contours) {
+    for (const cv::Point& p : contour) {
+      for (const Eigen::Vector2d& corner :
+           {Eigen::Vector2d(p.x - 0.5, p.y - 0.5), Eigen::Vector2d(p.x + 0.5, p.y - 0.5),
+            Eigen::Vector2d(p.x - 0.5, p.y + 0.5), Eigen::Vector2d(p.x + 0.5, p.y + 0.5)}) {
+        const std::optional<Eigen::Vector2d> ideal = camera.undistortPixel(corner);
+        if (!ideal) continue;  // checkDistortion has made sure the image undistorts
+        low = low.cwiseMin(*ideal);
+        high = high.cwiseMax(*ideal);
+      }
+    }
+  }
+  SilhouetteBounds bounds = raw;
+  bounds.u_min_px = low.x(), bounds.v_min_px = low.y();
+  bounds.u_max_px = high.x(), bounds.v_max_px = high.y();
+  return bounds;
+}
+
 }  // namespace
 
 HullView::HullView(std::string name, const PinholeCamera& camera, const cv::Mat& mask,
                    const HullConfig& config)
     : name_(std::move(name)),
       camera_(camera),
-      mask_((checkMask(mask), mask.clone())),
-      bounds_(silhouetteBounds(mask, config.carve_outside_image)),
-      distance_(mask, bounds_, config.padding_px),
+      mask_(
+          (checkMask(mask), checkDistortion(name_, camera, mask, config.padding_px), mask.clone())),
+      bounds_(idealBounds(silhouetteBounds(mask, config.carve_outside_image), camera, mask)),
+      distance_(SignedDistanceMap(mask, silhouetteBounds(mask, config.carve_outside_image),
+                                  config.padding_px)
+                    .undistorted(camera)),
       carves_behind_(bounds_.empty || bounds_.boundedSides() > 0),
       kernel_(std::make_unique<detail::DistanceKernel>(makeKernel(config))) {}
 
@@ -80,8 +131,9 @@ detail::DistanceKernel HullView::makeKernel(const HullConfig& config) const {
   const Eigen::Matrix3d& K = camera_.K();
   kernel.fx = K(0, 0), kernel.skew = K(0, 1), kernel.cx = K(0, 2);
   kernel.fy = K(1, 1), kernel.cy = K(1, 2);
-  kernel.k_norm = static_cast<float>(spectralNorm2x2(K));
-  kernel.slack_px = static_cast<float>(config.distance_slack_px);
+  // The map's values change by up to lipschitz() raw pixels per ideal pixel (1 without distortion).
+  kernel.k_norm = static_cast<float>(spectralNorm2x2(K)) * distance_.lipschitz();
+  kernel.slack_px = static_cast<float>(config.distance_slack_px) * distance_.lipschitz();
   kernel.behind_value = carves_behind_ ? kFarOutside_px : -kFarOutside_px;
   const cv::Mat& map = distance_.map();
   kernel.map = map.ptr<float>();
@@ -131,7 +183,8 @@ bool HullView::keeps(const Eigen::Vector3d& X_W) const {
   const Eigen::Vector3d X_C = camera_.toCamera(X_W);
   if (!(X_C.z() > 0.0)) return !carves_behind_;
   const Eigen::Vector2d pixel = pixelOf(X_C);
-  const long u = std::lround(pixel.x()), v = std::lround(pixel.y());
+  const Eigen::Vector2d raw = camera_.distortPixel(pixel);
+  const long u = std::lround(raw.x()), v = std::lround(raw.y());
   if (u < 0 || v < 0 || u >= mask_.cols || v >= mask_.rows) {
     return withinBounds(bounds_, pixel.x(), pixel.y());
   }

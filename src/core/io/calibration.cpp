@@ -86,7 +86,7 @@ template <typename MakeCamera>
 CalibratedView makeView(const std::string& name, const Line& line, const std::string& path,
                         MakeCamera make_camera) {
   try {
-    return CalibratedView{name, make_camera(), location(path, line.number), {}, {}};
+    return CalibratedView{name, make_camera(), location(path, line.number), {}};
   } catch (const std::invalid_argument& e) {
     throw ParseError(path, line.number, e.what());
   }
@@ -314,6 +314,11 @@ void writeMiddleburyPar(const std::string& path, const std::vector<CalibratedVie
       throw std::runtime_error(path + ": view '" + view.name +
                                "' has a mirrored world frame (det R = -1), which a par file cannot "
                                "hold; write a projection list");
+    }
+    if (c.distorted()) {
+      throw std::runtime_error(path + ": view '" + view.name + "' has lens distortion (" +
+                               describeDistortion(c.distortion()) +
+                               "), which a par file cannot hold; write a COLMAP model");
     }
     out << view.name;
     for (int r = 0; r < 3; ++r) {

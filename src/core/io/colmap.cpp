@@ -143,11 +143,11 @@ CalibratedView makeView(const std::string& name, const double q[4], const double
   CalibratedView view;
   view.name = name;
   view.source = source;
-  view.distortion = camera->second.distortion;
   view.camera_model = camera->second.model;
   try {
     view.camera = PinholeCamera(camera->second.K, quaternion.toRotationMatrix(),
-                                Eigen::Vector3d(t[0], t[1], t[2]));
+                                Eigen::Vector3d(t[0], t[1], t[2]))
+                      .withDistortion(camera->second.distortion);
   } catch (const std::invalid_argument& e) {
     throw ParseError(file, line, e.what());
   }

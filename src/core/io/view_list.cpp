@@ -48,13 +48,6 @@ HullInput loadHullInput(const std::string& calibration_path, const std::string& 
                         const std::vector<std::string>& view_names) {
   const std::vector<CalibratedView> views = selectViews(
       readCalibrationWithImages(calibration_path, image_directory), view_names, calibration_path);
-  for (const CalibratedView& view : views) {
-    if (!view.distortion.isZero()) {
-      throw std::runtime_error(view.source + ": lens distortion " +
-                               describeDistortion(view.distortion) +
-                               " is not supported by the hull yet; undistort the images first");
-    }
-  }
   HullInput input;
   input.masks = loadSilhouettes(views, image_directory, mask_directory, recipe);
   for (const CalibratedView& view : views) {

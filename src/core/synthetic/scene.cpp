@@ -12,6 +12,7 @@
 #include <random>
 #include <stdexcept>
 
+#include "sift_hull/io/colmap.h"
 #include "sift_hull/io/pfm.h"
 #include "synthetic/texture.h"
 
@@ -85,7 +86,7 @@ void shadePixel(const Shape& shape, const PinholeCamera& camera, const Eigen::Ve
   const Eigen::Vector3d origin = camera.centre();
   const Eigen::Vector3d direction = camera.rayDirection(pixel);
   RayHit hit;
-  if (!shape.firstHit(origin, direction, &hit)) {
+  if (!direction.allFinite() || !shape.firstHit(origin, direction, &hit)) {
     *colour = backgroundColour(background, direction, seed);
     *inside = 0;
     *depth = std::numeric_limits<float>::infinity();
@@ -120,7 +121,9 @@ nlohmann::json toJson(const SceneConfig& c) {
           {"camera_distance_m", c.camera_distance_m},
           {"ring_elevation_deg", c.ring_elevation_deg},
           {"fill_fraction", c.fill_fraction},
-          {"background", c.background}};
+          {"background", c.background},
+          {"distortion",
+           {c.distortion.k1, c.distortion.k2, c.distortion.p1, c.distortion.p2, c.distortion.k3}}};
 }
 
 SceneConfig configFromJson(const nlohmann::json& j) {
@@ -135,6 +138,11 @@ SceneConfig configFromJson(const nlohmann::json& j) {
   c.ring_elevation_deg = j.at("ring_elevation_deg").get<double>();
   c.fill_fraction = j.at("fill_fraction").get<double>();
   c.background = j.value("background", "black");  // scenes written before it existed: black
+  if (j.contains("distortion")) {
+    const std::vector<double> d = j.at("distortion").get<std::vector<double>>();
+    if (d.size() != 5) throw std::invalid_argument("distortion must hold k1, k2, p1, p2, k3");
+    c.distortion = {d[0], d[1], d[2], d[3], d[4]};
+  }
   return c;
 }
 
@@ -163,6 +171,14 @@ void validate(const SceneConfig& config) {
   const std::vector<std::string>& backgrounds = sceneBackgrounds();
   require(std::find(backgrounds.begin(), backgrounds.end(), config.background) != backgrounds.end(),
           "background must be black, blue or textured, not '" + config.background + "'");
+  validate(config.distortion);
+  const PinholeCamera camera = PinholeCamera(intrinsics(config, Shape::byName(config.shape)),
+                                             Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero())
+                                   .withDistortion(config.distortion);
+  require(camera.distortionInvertibleOver(
+              Eigen::Vector2d(-0.5, -0.5),
+              Eigen::Vector2d(config.width_px - 0.5, config.height_px - 0.5)),
+          "distortion folds over within the image (no one-to-one undistortion)");
 }
 
 std::vector<CalibratedView> sceneCameras(const SceneConfig& config, const Shape& shape) {
@@ -175,7 +191,9 @@ std::vector<CalibratedView> sceneCameras(const SceneConfig& config, const Shape&
     const Eigen::Vector3d centre =
         target + config.camera_distance_m * viewDirection(config, i, &rng);
     views.push_back({numbered("view", i, "png"),
-                     PinholeCamera::fromCentre(K, lookAt(centre, target), centre), "", {}, ""});
+                     PinholeCamera::fromCentre(K, lookAt(centre, target), centre)
+                         .withDistortion(config.distortion),
+                     "", ""});
   }
   return views;
 }
@@ -225,7 +243,11 @@ void writeScene(const std::string& directory, const SceneConfig& config,
   makeDirectory(directory + "/" + kDepthDirectory);
   std::vector<CalibratedView> cameras;
   for (const RenderedView& view : views) cameras.push_back(view.view);
-  writeMiddleburyPar(directory + "/scene_par.txt", cameras);
+  if (config.distortion.isZero()) {
+    writeMiddleburyPar(directory + "/scene_par.txt", cameras);
+  } else {
+    writeColmapText(directory + "/sparse", cameras, config.width_px, config.height_px);
+  }
   const std::string json_path = directory + "/scene.json";
   std::ofstream json_file(json_path);
   json_file << toJson(config).dump(2) << '\n';
@@ -240,6 +262,11 @@ void writeScene(const std::string& directory, const SceneConfig& config,
   });
 }
 
+std::string sceneCalibration(const std::string& directory) {
+  const std::string par = directory + "/scene_par.txt", sparse = directory + "/sparse";
+  return !std::filesystem::exists(par) && std::filesystem::exists(sparse) ? sparse : par;
+}
+
 SceneData readScene(const std::string& directory) {
   const std::string json_path = directory + "/scene.json";
   std::ifstream json_file(json_path);
@@ -250,7 +277,7 @@ SceneData readScene(const std::string& directory) {
   } catch (const nlohmann::json::exception& e) {
     throw ParseError(json_path, 0, e.what());
   }
-  scene.views = readMiddleburyPar(directory + "/scene_par.txt");
+  scene.views = readCalibration(sceneCalibration(directory));
   for (const CalibratedView& view : scene.views) {
     scene.depths.push_back(
         readPfm(directory + "/" + kDepthDirectory + "/" + depthFileName(view.name)));

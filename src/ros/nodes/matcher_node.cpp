@@ -249,7 +249,7 @@ void MatcherNode::process(const Pipeline& pipeline, const sensor_msgs::ImageCons
                                               std::to_string(matches.right_keypoints.size()) + ")");
     return;
   }
-  if (cameras != nullptr) matches.F_right_left = fundamentalMatrix(cameras->left, cameras->right);
+  if (cameras != nullptr) calibratePair(&matches, cameras->left, cameras->right);
   std::vector<FilterResult> results;
   for (const auto& filter : pipeline.filters) results.push_back(filter->apply(matches));
   std::vector<std::string> names;

@@ -1,0 +1,61 @@
+#include "sift_hull/geometry/distortion.h"
+
+#include <Eigen/LU>
+#include <cmath>
+#include <stdexcept>
+
+namespace sift_hull {
+
+void validate(const LensDistortion& d) {
+  const double coefficients[] = {d.k1, d.k2, d.p1, d.p2, d.k3};
+  for (double c : coefficients) {
+    if (!std::isfinite(c))
+      throw std::invalid_argument("a lens distortion coefficient is not finite");
+  }
+}
+
+Eigen::Vector2d distortNormalised(const LensDistortion& d, const Eigen::Vector2d& ideal) {
+  const double x = ideal.x(), y = ideal.y();
+  const double r2 = x * x + y * y;
+  const double radial = 1.0 + r2 * (d.k1 + r2 * (d.k2 + r2 * d.k3));
+  return {x * radial + 2.0 * d.p1 * x * y + d.p2 * (r2 + 2.0 * x * x),
+          y * radial + d.p1 * (r2 + 2.0 * y * y) + 2.0 * d.p2 * x * y};
+}
+
+Eigen::Matrix2d distortionJacobian(const LensDistortion& d, const Eigen::Vector2d& ideal) {
+  const double x = ideal.x(), y = ideal.y();
+  const double r2 = x * x + y * y;
+  const double radial = 1.0 + r2 * (d.k1 + r2 * (d.k2 + r2 * d.k3));
+  const double slope = d.k1 + r2 * (2.0 * d.k2 + 3.0 * r2 * d.k3);  // d radial / d r^2
+  const double cross = 2.0 * x * y * slope + 2.0 * d.p1 * x + 2.0 * d.p2 * y;
+  Eigen::Matrix2d J;
+  J << radial + 2.0 * x * x * slope + 2.0 * d.p1 * y + 6.0 * d.p2 * x, cross, cross,
+      radial + 2.0 * y * y * slope + 6.0 * d.p1 * y + 2.0 * d.p2 * x;
+  return J;
+}
+
+std::optional<Eigen::Vector2d> undistortNormalised(const LensDistortion& d,
+                                                   const Eigen::Vector2d& distorted) {
+  if (!distorted.allFinite()) return std::nullopt;
+  if (d.isZero()) return distorted;
+  const double tolerance = 1e-12 * std::max(1.0, distorted.norm());
+  Eigen::Vector2d ideal = distorted;
+  for (int step = 0; step < 50; ++step) {
+    const Eigen::Vector2d residual = distortNormalised(d, ideal) - distorted;
+    if (!residual.allFinite()) return std::nullopt;
+    const Eigen::Matrix2d J = distortionJacobian(d, ideal);
+    const double det = J.determinant();
+    // A root where the model folds over (det <= 0), or one turned through the centre (radial
+    // factor <= 0, as r (1 + k1 r^2) has beyond its maximum), is not the point the lens imaged.
+    if (residual.norm() <= tolerance) {
+      const double r2 = ideal.squaredNorm();
+      const double radial = 1.0 + r2 * (d.k1 + r2 * (d.k2 + r2 * d.k3));
+      return det > 0.0 && radial > 0.0 ? std::optional(ideal) : std::nullopt;
+    }
+    if (!(std::abs(det) > 1e-12)) return std::nullopt;
+    ideal -= J.inverse() * residual;
+  }
+  return std::nullopt;
+}
+
+}  // namespace sift_hull
