@@ -171,6 +171,8 @@ bool ArgParser::has(const std::string& name) const {
          (specs_.count(name) > 0 && !specs_.at(name).default_value.empty());
 }
 
+bool ArgParser::given(const std::string& name) const { return values_.count(name) > 0; }
+
 std::string ArgParser::get(const std::string& name) const {
   const auto value = values_.find(name);
   if (value != values_.end()) return value->second;

@@ -39,6 +39,8 @@ class ArgParser {
 
   bool flag(const std::string& name) const;
   bool has(const std::string& name) const;
+  /// Whether the option was given on the command line (not only defaulted).
+  bool given(const std::string& name) const;
   /// Throws UsageError when the option was neither given nor has a default.
   std::string get(const std::string& name) const;
   /// Every value of an option given several times, in order; else its default, if any.

@@ -138,7 +138,8 @@ HullInput loadHullDataset(const std::string& root, const HullDataset& dataset) {
   const std::vector<std::string> names = dataset.view_list.empty()
                                              ? std::vector<std::string>{}
                                              : readViewList(directory + "/" + dataset.view_list);
-  SilhouetteConfig recipe;
+  SilhouetteConfig recipe;  // the Middlebury recipe at the set's threshold, as runs compare
+  recipe.silhouette_method = "threshold";
   recipe.threshold = dataset.threshold;
   return loadHullInput(directory + "/" + dataset.calibration, directory, "", recipe, names);
 }

@@ -15,8 +15,9 @@ void addSilhouetteOptions(ArgParser* parser) {
                     "directory of mask files named like the images (default: extract them from "
                     "the images)");
   parser->addOption("silhouette-method", "NAME",
-                    "how silhouettes come from images: threshold (grey above --threshold) or "
-                    "background (a colour model of the image border, no threshold needed)",
+                    "how silhouettes come from images: background (a colour model of the image "
+                    "border, no threshold needed) or threshold (grey above --threshold; the "
+                    "default when --threshold is given)",
                     defaults.silhouette_method);
   parser->addOption("threshold", "T", "silhouette threshold on grey intensity in [0, 1]",
                     threshold.str());
@@ -31,6 +32,10 @@ void addSilhouetteOptions(ArgParser* parser) {
 SilhouetteConfig silhouetteConfigFromArgs(const ArgParser& parser) {
   SilhouetteConfig config;
   config.silhouette_method = parser.get("silhouette-method");
+  // A threshold given asks for the threshold recipe, unless a method is named too.
+  if (parser.given("threshold") && !parser.given("silhouette-method")) {
+    config.silhouette_method = "threshold";
+  }
   config.threshold = parser.getDouble("threshold");
   config.dilate_px = parser.getInt("dilate-px");
   config.erode_px = parser.getInt("erode-px");

@@ -105,11 +105,10 @@ TEST_F(MalformedFile, BadIntrinsicsAndRotationsAreNamed) {
 
 TEST_F(MalformedFile, ProjectionListErrorsNameFileAndLine) {
   const std::string path = dir_ + "/calib.txt";
-  EXPECT_EQ(
-      errorOf("# comment\n500 0 320 0  0 500 240 0  0 0 1\n", readProjectionList),
-      path +
-          ":2: expected 12 numbers of a 3x4 matrix (or a row of 4), optionally after a name; "
-          "found 11 fields");
+  EXPECT_EQ(errorOf("# comment\n500 0 320 0  0 500 240 0  0 0 1\n", readProjectionList),
+            path +
+                ":2: expected 12 numbers of a 3x4 matrix (or a row of 4), optionally after a name; "
+                "found 11 fields");
   EXPECT_EQ(errorOf("7 500 0 320 0  0 500 240 0  0 0 1 2\n", readProjectionList),
             path + ":1: expected an image name before the 12 numbers, found '7'");
   EXPECT_EQ(errorOf("a.png 1 0 0 0  1 0 0 0  0 0 0 1\n", readProjectionList),
@@ -175,13 +174,15 @@ TEST(Silhouette, MiddleburyRecipeFillsShadowsAndGrowsByThreeClosingPixels) {
   cv::Mat image(200, 200, CV_8UC3, cv::Scalar::all(0));
   cv::circle(image, {100, 100}, 50, cv::Scalar::all(200), cv::FILLED);
   cv::circle(image, {100, 100}, 3, cv::Scalar::all(20), cv::FILLED);  // a dark shadow inside
-  const cv::Mat mask = silhouetteFromImage(image, SilhouetteConfig{});
+  SilhouetteConfig recipe;
+  recipe.silhouette_method = "threshold";
+  const cv::Mat mask = silhouetteFromImage(image, recipe);
   EXPECT_EQ(mask.at<uint8_t>(100, 100), 255);       // the shadow is closed
   EXPECT_EQ(mask.at<uint8_t>(100, 100 + 52), 255);  // dilate 10 then erode 7 grows ~3 px
   EXPECT_EQ(mask.at<uint8_t>(100, 100 + 55), 0);
   const double area = cv::countNonZero(mask);
   EXPECT_NEAR(area, CV_PI * 53 * 53, 0.03 * CV_PI * 53 * 53);
-  SilhouetteConfig raw;
+  SilhouetteConfig raw = recipe;
   raw.dilate_px = raw.erode_px = 0;
   EXPECT_EQ(silhouetteFromImage(image, raw).at<uint8_t>(100, 100), 0);
 }

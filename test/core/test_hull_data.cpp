@@ -30,6 +30,7 @@ HullResult carveRing(const RingCase& ring, int depth) {
   HullConfig config;
   config.max_depth = depth;
   SilhouetteConfig recipe;
+  recipe.silhouette_method = "threshold";
   recipe.threshold = ring.threshold;
   return buildHull(loadHullInput(dir + "/" + ring.calibration, dir, "", recipe, views), config);
 }

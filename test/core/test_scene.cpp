@@ -143,6 +143,7 @@ TEST_F(WrittenScene, SilhouettesLoadFromMasksAndFromImages) {
   const std::vector<cv::Mat> from_masks =
       loadSilhouettes(scene.views, directory_, directory_ + "/" + kMaskDirectory, {});
   SilhouetteConfig dark_background;  // the scene's background is black: a low threshold suffices
+  dark_background.silhouette_method = "threshold";
   dark_background.threshold = 0.02;
   dark_background.dilate_px = dark_background.erode_px = 1;
   const std::vector<cv::Mat> from_images =

@@ -20,9 +20,12 @@
 namespace sift_hull {
 namespace {
 
-SilhouetteConfig backgroundMethod() {
+/// The default method, the background model.
+SilhouetteConfig backgroundMethod() { return SilhouetteConfig(); }
+
+SilhouetteConfig thresholdMethod() {
   SilhouetteConfig config;
-  config.silhouette_method = "background";
+  config.silhouette_method = "threshold";
   return config;
 }
 
@@ -43,15 +46,35 @@ double smallestIoU(const std::string& background, const SilhouetteConfig& method
 }
 
 TEST(BackgroundSilhouettes, OnUniformBackgroundsTheyComeCloseToTheExactMasks) {
-  // Measured (8 views of 320x240): black 0.891, blue 0.881. What is lost are the darkest shaded
-  // parts of the object, nearer the background's colour than the threshold Otsu picks.
-  EXPECT_GE(smallestIoU("black", backgroundMethod()), 0.87);
-  EXPECT_GE(smallestIoU("blue", backgroundMethod()), 0.86);
+  // Measured (8 views of 320x240): black 0.973, blue 0.973. What is lost is where the object lets
+  // the background through (the hole of the sculpture's ring), which the filling of holes closes.
+  EXPECT_GE(smallestIoU("black", backgroundMethod()), 0.965);
+  EXPECT_GE(smallestIoU("blue", backgroundMethod()), 0.965);
+}
+
+TEST(BackgroundSilhouettes, OnATexturedBackgroundTheHullFailsAndSaysWhy) {
+  // The textured background's border holds every colour the object has: no per-image colour
+  // model separates them (measured: smallest mask IoU 0, most silhouettes empty). The hull
+  // command names the views and fails rather than carving garbage.
+  const std::string dir = test::temporaryDirectory();
+  std::string out, err;
+  ASSERT_EQ(test::runProgram(
+                "scene --out " + dir + " --views 8 --size 320x240 --background " + "textured", &out,
+                &err),
+            0)
+      << err;
+  EXPECT_EQ(
+      test::runProgram("hull --calib " + dir + "/scene_par.txt --images " + dir + " --max-depth 6",
+                       &out, &err),
+      1);
+  EXPECT_NE(err.find("view_0001.png: the silhouette is empty; leave the view out"),
+            std::string::npos)
+      << err;
 }
 
 TEST(BackgroundSilhouettes, TheGreyThresholdFailsOnDarkBlueWhereTheBackgroundModelDoesNot) {
   // Measured: 0.139, the whole image taken for the object.
-  EXPECT_LT(smallestIoU("blue", SilhouetteConfig()), 0.2);
+  EXPECT_LT(smallestIoU("blue", thresholdMethod()), 0.2);
 }
 
 /// The mean reprojection IoU of the hull of a Middlebury ring at depth 8 by `method` (NaN when the
@@ -73,18 +96,18 @@ double ringIoU(const std::string& directory, const std::string& calibration,
 }
 
 TEST(BackgroundSilhouettes, GiveTheMiddleburyRingsTheirHullWithoutAThreshold) {
-  // Measured at depth 8 (sift_hull hull ... --silhouette-method background): dino (good list)
-  // 0.986, temple (all 16) 0.990; the threshold recipe at its default gives 0.989 and 0.958.
+  // Measured at depth 8 (sift_hull hull ... with the default method): dino (good list) 0.988,
+  // temple (all 16) 0.982; the threshold recipe at its default gives 0.989 and 0.958.
   const double dino = ringIoU("middlebury_mvs_dinoSparseRing", "dinoSR_par.txt",
                               "dinoSR_good_silhouette_images.txt", backgroundMethod());
   const double temple =
       ringIoU("middlebury_mvs_templeSparseRing", "templeSR_par.txt", "", backgroundMethod());
   if (std::isnan(dino) && std::isnan(temple)) GTEST_SKIP() << "no Middlebury ring found";
   if (!std::isnan(dino)) {
-    EXPECT_GE(dino, 0.98);
+    EXPECT_GE(dino, 0.985);
   }
   if (!std::isnan(temple)) {
-    EXPECT_GE(temple, 0.985);
+    EXPECT_GE(temple, 0.98);
   }
 }
 
@@ -121,7 +144,7 @@ TEST(SilhouetteWarnings, NameTheViewFarBelowTheOthers) {
   std::vector<cv::Mat> masks;
   for (const RenderedView& view : renderScene(config)) {
     scene_names.push_back(view.view.name);
-    masks.push_back(silhouetteFromImage(view.image, SilhouetteConfig()));
+    masks.push_back(silhouetteFromImage(view.image, thresholdMethod()));
   }
   EXPECT_EQ(silhouetteWarnings(scene_names, masks).size(), 3u);
 }
@@ -136,15 +159,15 @@ TEST(SilhouetteWarnings, TheHullCommandNamesTheSuspectViews) {
   // The grey threshold takes every whole image for the object: each view is named, then no box
   // can be bounded.
   EXPECT_EQ(test::runProgram("hull --calib " + dir + "/scene_par.txt --images " + dir +
-                                 " --max-depth 6 --allow-poor --json",
+                                 " --max-depth 6 --threshold 0.19 --allow-poor --json",
                              &out, &err),
             1);
   EXPECT_NE(err.find("view_0003.png: the silhouette covers 100 %"), std::string::npos) << err;
   EXPECT_NE(err.find("bounded silhouette side"), std::string::npos) << err;
-  // The background model needs no threshold there, and warns of nothing.
-  ASSERT_EQ(test::runProgram("hull --calib " + dir + "/scene_par.txt --images " + dir +
-                                 " --max-depth 6 --silhouette-method background --json",
-                             &out, &err),
+  // The background model, the default, needs no threshold there, and warns of nothing.
+  ASSERT_EQ(test::runProgram(
+                "hull --calib " + dir + "/scene_par.txt --images " + dir + " --max-depth 6 --json",
+                &out, &err),
             0)
       << err;
   EXPECT_TRUE(nlohmann::json::parse(out).at("warnings").empty()) << out;

@@ -1,6 +1,7 @@
 #include "sift_hull/hull/silhouette.h"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
@@ -31,7 +32,22 @@ void validate(const SilhouetteConfig& config) {
 namespace {
 
 /// The least share of the border a background colour cluster holds.
-constexpr double kMinClusterShare = 0.05;
+constexpr double kMinClusterShare = 0.005;
+/// The border band's width as a share of the image's smaller side.
+constexpr double kBorderFraction = 0.03;
+/// The least colour distance (CIE Lab units) taken for the object, and the factor on the border
+/// band's spread of distances the threshold lies above (see distanceThreshold).
+constexpr float kMinObjectDistance = 3.0f;
+constexpr float kSpreadFactor = 3.0f;
+/// The least area of a silhouette component, as a share of the largest one's.
+constexpr double kMinComponentShare = 0.05;
+
+/// Width of the border band of an image of `size`: `fraction` of its smaller side, at least 2
+/// pixels and at most half that side.
+int borderBand(cv::Size size, double fraction) {
+  const int side = std::min(size.width, size.height);
+  return std::min(std::max(2, static_cast<int>(fraction * side)), std::max(1, side / 2));
+}
 
 cv::Mat disc(int radius) {
   return cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * radius + 1, 2 * radius + 1));
@@ -85,17 +101,52 @@ cv::Mat thresholdSilhouette(const cv::Mat& image, const SilhouetteConfig& config
   return mask;
 }
 
+/// The spread of the border band's own colour distances (camera noise, the background's shading):
+/// their 90th percentile, robust to the object reaching a part of the border.
+float borderSpread(const cv::Mat& distance, int band) {
+  std::vector<float> values;
+  for (int v = 0; v < distance.rows; ++v) {
+    const bool band_row = v < band || v >= distance.rows - band;
+    const float* row = distance.ptr<float>(v);
+    for (int u = 0; u < distance.cols; ++u) {
+      if (band_row || u < band || u >= distance.cols - band) values.push_back(row[u]);
+    }
+  }
+  const size_t rank = values.size() * 9 / 10;
+  std::nth_element(values.begin(), values.begin() + rank, values.end());
+  return std::isfinite(values[rank]) ? values[rank] : 0.0f;
+}
+
+/// The components of a mask holding at least kMinComponentShare of the largest one's area.
+cv::Mat largeComponents(const cv::Mat& mask) {
+  cv::Mat labels, stats, centroids;
+  const int count = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
+  int largest = 0;
+  for (int i = 1; i < count; ++i) largest = std::max(largest, stats.at<int>(i, cv::CC_STAT_AREA));
+  std::vector<uint8_t> keep(count, 0);
+  for (int i = 1; i < count; ++i) {
+    keep[i] = stats.at<int>(i, cv::CC_STAT_AREA) >= kMinComponentShare * largest ? 255 : 0;
+  }
+  cv::Mat kept(mask.size(), CV_8UC1);
+  for (int v = 0; v < mask.rows; ++v) {
+    const int* label = labels.ptr<int>(v);
+    uint8_t* out = kept.ptr<uint8_t>(v);
+    for (int u = 0; u < mask.cols; ++u) out[u] = keep[label[u]];
+  }
+  return kept;
+}
+
 cv::Mat backgroundSilhouette(const cv::Mat& image, const SilhouetteConfig& config) {
   const cv::Mat distance = backgroundDistance(image);
-  // Otsu on the distance, clipped at 100 Lab units (a colour that far is object whatever else).
-  cv::Mat levels;
-  distance.convertTo(levels, CV_8U, 255.0 / 100.0);
-  cv::Mat mask;
-  cv::threshold(levels, mask, 0, 255, cv::THRESH_BINARY | cv::THRESH_OTSU);
-  // The recipe's dilation and erosion join what a dark fold of the object split; then the holes
-  // are filled.
-  if (config.dilate_px > 0) cv::dilate(mask, mask, disc(config.dilate_px));
-  if (config.erode_px > 0) cv::erode(mask, mask, disc(config.erode_px));
+  const int band = borderBand(image.size(), kBorderFraction);
+  const float spread = borderSpread(distance, band);
+  cv::Mat mask = distance > std::max(kMinObjectDistance, kSpreadFactor * spread);
+  // Isolated noisy pixels go, then the small components (noise, dust, a reflection).
+  cv::morphologyEx(mask, mask, cv::MORPH_OPEN, disc(1));
+  mask = largeComponents(mask);
+  // A closing joins what a dark fold of the object split without moving the outline; then the
+  // holes are filled.
+  if (config.erode_px > 0) cv::morphologyEx(mask, mask, cv::MORPH_CLOSE, disc(config.erode_px));
   return filledHoles(mask);
 }
 
@@ -106,9 +157,7 @@ cv::Mat backgroundDistance(const cv::Mat& image, double border_fraction) {
     throw std::invalid_argument("backgroundDistance needs a non-empty 8-bit grey or BGR image");
   }
   const cv::Mat lab = labOf(image);
-  const int width = std::max(2, static_cast<int>(border_fraction * std::min(lab.rows, lab.cols)));
-  const cv::Mat samples =
-      borderSamples(lab, std::min(width, std::min(lab.rows, lab.cols) / 2), 4000);
+  const cv::Mat samples = borderSamples(lab, borderBand(lab.size(), border_fraction), 4000);
   const int clusters = std::min(8, samples.rows);
   cv::Mat labels, centres;
   cv::setRNGSeed(1);  // deterministic clusters

@@ -106,6 +106,10 @@ double descriptorDistanceParam(double distance) { return std::isfinite(distance)
 SilhouetteConfig readSilhouetteConfig(const ros::NodeHandle& private_nh) {
   SilhouetteConfig config;
   read(private_nh, "silhouette_method", &config.silhouette_method);
+  // A threshold given asks for the threshold recipe, unless a method is named too.
+  if (private_nh.hasParam("threshold") && !private_nh.hasParam("silhouette_method")) {
+    config.silhouette_method = "threshold";
+  }
   read(private_nh, "threshold", &config.threshold);
   read(private_nh, "dilate_px", &config.dilate_px);
   read(private_nh, "erode_px", &config.erode_px);
