@@ -136,6 +136,32 @@ TEST_F(CalibrationFormats, LlffViewsAreTheSortedImagesOfTheDirectory) {
   EXPECT_EQ(calibrationFormat(npy), "LLFF poses_bounds.npy");
 }
 
+TEST_F(CalibrationFormats, LlffDownscaledImagesScaleTheIntrinsics) {
+  const std::string images = dir_ + "/images_4";
+  ASSERT_EQ(::system(("mkdir -p " + images).c_str()), 0);
+  // 504x378 / 4 = 126x94.5: the copy is 126x95.
+  for (const char* name : {"a.png", "b.png"}) {
+    ASSERT_TRUE(cv::imwrite(images + "/" + name, cv::Mat(95, 126, CV_8UC3, cv::Scalar::all(0))));
+  }
+  const std::string npy = write("poses_bounds.npy", npyBytes(dictFor(2), llffRows(knownViews())));
+  const std::vector<CalibratedView> views = readCalibrationWithImages(npy, images);
+  ASSERT_EQ(views.size(), 2u);
+  Eigen::Matrix3d K;
+  K << kFocal / 4, 0, 62.5, 0, kFocal / 4, 47, 0, 0, 1;
+  EXPECT_TRUE(views[0].camera.K().isApprox(K, 1e-12)) << views[0].camera.K();
+  EXPECT_TRUE(views[1].camera.centre().isApprox(knownViews()[1].centre, 1e-12));
+  // Another aspect ratio is not a downscaled copy.
+  try {
+    readLlffPoses(npy, {"a.png", "b.png"}, 200, 100);
+    FAIL() << "no error";
+  } catch (const ParseError& e) {
+    EXPECT_NE(std::string(e.what()).find("the images are 200x100 but the poses' [height, width] "
+                                         "is 378x504"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 TEST_F(CalibrationFormats, MalformedNpyIsRefusedNamingTheFile) {
   const std::string path = dir_ + "/poses_bounds.npy";
   const auto rows = llffRows(knownViews());

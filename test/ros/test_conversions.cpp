@@ -121,6 +121,51 @@ TEST(CameraFromInfo, RefusesASizeMismatchWhenTheImageAreaOverflowsInt) {
                   "camera_info is 640x480 but the silhouette is 65536x32768"));
 }
 
+TEST(CameraFromInfo, KeepsThePlumbBobDistortionBothWays) {
+  const LensDistortion barrel{-0.3, 0.1, 0.002, -0.001, 0.01};
+  const PinholeCamera distorted =
+      PinholeCamera(kK, pose().linear().transpose(),
+                    -(pose().linear().transpose() * pose().translation()))
+          .withDistortion(barrel);
+  const sensor_msgs::CameraInfo message = rc::cameraInfoMessage(distorted, {320, 240}, header());
+  EXPECT_EQ(message.distortion_model, "plumb_bob");
+  EXPECT_EQ(message.D, (std::vector<double>{-0.3, 0.1, 0.002, -0.001, 0.01}));
+  PinholeCamera camera;
+  std::string why_not;
+  ASSERT_TRUE(rc::cameraFromInfo(message, pose(), {320, 240}, &camera, &why_not)) << why_not;
+  const Eigen::Vector3d X_W = pose() * Eigen::Vector3d(0.4, -0.3, 1.5);
+  EXPECT_LT((camera.project(X_W) - distorted.project(X_W)).norm(), 1e-9);
+  EXPECT_GT((camera.project(X_W) - camera.projectIdeal(X_W)).norm(), 1.0);
+  // rational_polynomial without its rational terms is the same lens; others are refused.
+  sensor_msgs::CameraInfo rational = message;
+  rational.distortion_model = "rational_polynomial";
+  rational.D = {-0.3, 0.1, 0.002, -0.001, 0.01, 0.0, 0.0, 0.0};
+  EXPECT_EQ(refusal(rational), "");
+  rational.D[5] = 0.2;
+  EXPECT_TRUE(has(refusal(rational), "distortion model 'rational_polynomial' with 8"));
+  sensor_msgs::CameraInfo fisheye = message;
+  fisheye.distortion_model = "equidistant";
+  fisheye.D = {0.1, 0.0, 0.0, 0.0};
+  EXPECT_TRUE(has(refusal(fisheye), "distortion model 'equidistant' with 4 coefficients"));
+  fisheye.distortion_model = "plumb_bob";
+  fisheye.D = {0.1, std::nan(""), 0.0, 0.0, 0.0};
+  EXPECT_EQ(refusal(fisheye), "refused: camera_info D holds a value that is not finite");
+  fisheye.D.assign(5, 0.0);  // zeros under any name: an ideal lens
+  fisheye.distortion_model = "equidistant";
+  EXPECT_EQ(refusal(fisheye), "");
+}
+
+TEST(CameraPoseMessage, RefusesAMirroredWorldCamera) {
+  const PinholeCamera proper(kK, Eigen::Matrix3d::Identity(), Eigen::Vector3d(0, 0, 2));
+  EXPECT_NO_THROW(rc::cameraPoseMessage(proper, "world", "camera", {}));
+  try {
+    rc::cameraPoseMessage(proper.negated(), "world", "camera", {});
+    FAIL() << "no error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_TRUE(has(e.what(), "camera 'camera' lives in a mirrored world frame (det R = -1)"));
+  }
+}
+
 // ---- images and masks -------------------------------------------------------------------------
 /// width x height pixels of `bytes` bytes, byte c of pixel (u, v) = 10 v + u + c, rows `step`
 /// bytes apart, the padding 0xEE.

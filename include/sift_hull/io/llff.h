@@ -30,8 +30,13 @@ NpyMatrix parseNpyMatrix(std::istream& in, uint64_t size_bytes, const std::strin
 /// width, focal]) then the near and far bounds. View i is named image_names[i] (the sorted image
 /// files: listImageFiles()); a count mismatch is refused naming both counts. K has the principal
 /// point at the image centre ((W - 1) / 2, (H - 1) / 2 in this package's pixel convention).
+/// `image_width_px` x `image_height_px`, when not zero, is the size of the images used: LLFF's
+/// downscaled copies (images_4/, images_8/) keep the full-resolution [height, width, focal], so K
+/// is scaled to the images' size; a size that is not the poses' scaled by one factor (to a pixel's
+/// rounding) is refused naming both sizes.
 std::vector<CalibratedView> readLlffPoses(const std::string& npy_path,
-                                          const std::vector<std::string>& image_names);
+                                          const std::vector<std::string>& image_names,
+                                          int image_width_px = 0, int image_height_px = 0);
 
 /// The image files (.png, .jpg, .jpeg, any case) directly in `directory`, sorted by name. Throws
 /// std::runtime_error when the directory cannot be read.

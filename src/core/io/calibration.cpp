@@ -293,7 +293,11 @@ std::vector<CalibratedView> readCalibrationWithImages(const std::string& path,
     } catch (const std::runtime_error& e) {
       throw ParseError(path, 0, std::string("the views are the images of ") + e.what());
     }
-    return readLlffPoses(path, names);
+    // LLFF's downscaled copies keep the full-resolution poses: K follows the images' size.
+    const cv::Mat first =
+        names.empty() ? cv::Mat()
+                      : cv::imread(image_directory + "/" + names.front(), cv::IMREAD_UNCHANGED);
+    return readLlffPoses(path, names, first.cols, first.rows);
   }
   const std::vector<Line> lines = readFields(path);
   if (!lines.empty() && looksLikeCountLine(lines.front())) return readMiddleburyPar(path);

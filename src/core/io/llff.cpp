@@ -10,6 +10,7 @@
 #include <cstring>
 #include <fstream>
 #include <map>
+#include <sstream>
 #include <stdexcept>
 
 #include "sift_hull/limits.h"
@@ -170,8 +171,29 @@ NpyMatrix parseNpyMatrix(std::istream& in, uint64_t size_bytes, const std::strin
   return matrix;
 }
 
+namespace {
+
+/// The factor from the poses' image size to the images' (1 when the latter is not given): one for
+/// both sides, to a pixel's rounding of each.
+double imageScale(const std::string& npy_path, const std::string& where, double width,
+                  double height, int image_width_px, int image_height_px) {
+  if (image_width_px <= 0 || image_height_px <= 0) return 1.0;
+  const double scale = image_width_px / width;
+  if (!(std::abs(scale * height - image_height_px) <= 1.0)) {
+    std::ostringstream message;
+    message << where << ": the images are " << image_width_px << "x" << image_height_px
+            << " but the poses' [height, width] is " << height << "x" << width
+            << ", not a downscaled copy of one factor";
+    fail(npy_path, message.str());
+  }
+  return scale;
+}
+
+}  // namespace
+
 std::vector<CalibratedView> readLlffPoses(const std::string& npy_path,
-                                          const std::vector<std::string>& image_names) {
+                                          const std::vector<std::string>& image_names,
+                                          int image_width_px, int image_height_px) {
   std::ifstream in(npy_path, std::ios::binary);
   struct stat info;
   if (!in || ::stat(npy_path.c_str(), &info) != 0 || !S_ISREG(info.st_mode)) {
@@ -202,10 +224,15 @@ std::vector<CalibratedView> readLlffPoses(const std::string& npy_path,
     R_c2w.col(0) = M.col(1);
     R_c2w.col(1) = M.col(0);
     R_c2w.col(2) = -M.col(2);
+    const double scale =
+        imageScale(npy_path, where, width, height, image_width_px, image_height_px);
+    // The images' own centre: a downscaled copy's side is rounded to whole pixels.
+    const double w = image_width_px > 0 ? image_width_px : width;
+    const double h = image_height_px > 0 ? image_height_px : height;
     Eigen::Matrix3d K;
     // The image centre; LLFF's pixel (0, 0) is the top-left corner, here the top-left pixel's
     // centre.
-    K << focal, 0.0, width / 2.0 - 0.5, 0.0, focal, height / 2.0 - 0.5, 0.0, 0.0, 1.0;
+    K << scale * focal, 0.0, w / 2.0 - 0.5, 0.0, scale * focal, h / 2.0 - 0.5, 0.0, 0.0, 1.0;
     CalibratedView view;
     view.name = image_names[i];
     view.source = npy_path + " (" + where + ")";

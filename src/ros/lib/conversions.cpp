@@ -118,6 +118,31 @@ bool intrinsicsFromInfo(const sensor_msgs::CameraInfo& info, Eigen::Matrix3d* K,
   return true;
 }
 
+/// The lens distortion of camera_info: plumb_bob (or an empty model) with 5 coefficients, or none;
+/// rational_polynomial with k4 = k5 = k6 = 0.
+bool distortionFromInfo(const sensor_msgs::CameraInfo& info, LensDistortion* distortion,
+                        std::string* why_not) {
+  const std::vector<double>& D = info.D;
+  const bool all_zero = std::all_of(D.begin(), D.end(), [](double d) { return d == 0.0; });
+  if (D.empty() || all_zero) return true;
+  if (!std::all_of(D.begin(), D.end(), [](double d) { return std::isfinite(d); })) {
+    *why_not = "camera_info D holds a value that is not finite";
+    return false;
+  }
+  const std::string& model = info.distortion_model;
+  const bool plumb_bob = (model == "plumb_bob" || model.empty()) && D.size() == 5;
+  const bool rational =
+      model == "rational_polynomial" && D.size() == 8 && D[5] == 0.0 && D[6] == 0.0 && D[7] == 0.0;
+  if (!plumb_bob && !rational) {
+    *why_not = "camera_info distortion model '" + model + "' with " + std::to_string(D.size()) +
+               " coefficients is not supported (plumb_bob with 5, or rational_polynomial with "
+               "k4 = k5 = k6 = 0)";
+    return false;
+  }
+  *distortion = {D[0], D[1], D[2], D[3], D[4]};
+  return true;
+}
+
 }  // namespace
 
 bool cameraFromInfo(const sensor_msgs::CameraInfo& info, const Eigen::Isometry3d& T_W_C,
@@ -138,9 +163,11 @@ bool cameraFromInfo(const sensor_msgs::CameraInfo& info, const Eigen::Isometry3d
     *why_not = "camera pose is not finite";
     return false;
   }
+  LensDistortion distortion;
+  if (!distortionFromInfo(info, &distortion, why_not)) return false;
   const Eigen::Isometry3d T_C_W = T_W_C.inverse();
   try {
-    *camera = PinholeCamera(K, T_C_W.linear(), T_C_W.translation());
+    *camera = PinholeCamera(K, T_C_W.linear(), T_C_W.translation()).withDistortion(distortion);
   } catch (const std::invalid_argument& e) {
     *why_not = std::string("camera: ") + e.what();
     return false;
@@ -172,8 +199,9 @@ sensor_msgs::CameraInfo cameraInfoMessage(const PinholeCamera& camera, cv::Size 
   info.header = header;
   info.width = size.width;
   info.height = size.height;
+  const LensDistortion& d = camera.distortion();
   info.distortion_model = "plumb_bob";
-  info.D.assign(5, 0.0);
+  info.D = {d.k1, d.k2, d.p1, d.p2, d.k3};
   for (int i = 0; i < 9; ++i) {
     info.K[i] = camera.K()(i / 3, i % 3);
     info.R[i] = i % 4 == 0 ? 1.0 : 0.0;
@@ -186,6 +214,12 @@ geometry_msgs::TransformStamped cameraPoseMessage(const PinholeCamera& camera,
                                                   const std::string& world_frame,
                                                   const std::string& camera_frame,
                                                   const ros::Time& stamp) {
+  if (camera.improper()) {
+    throw std::invalid_argument(
+        "camera '" + camera_frame +
+        "' lives in a mirrored world frame (det R = -1): it has no tf pose (no rotation gives "
+        "it); mirror the calibration's world frame (negate one axis of every P) first");
+  }
   Eigen::Isometry3d T_W_C = Eigen::Isometry3d::Identity();
   T_W_C.linear() = camera.R().transpose();
   T_W_C.translation() = camera.centre();

@@ -50,10 +50,12 @@ cv::Mat maskFromImage(const sensor_msgs::Image& image, std::string* why_not);
 /// pixels the data does not hold (holdsPixels).
 cv::Mat eightBitImage(const sensor_msgs::ImageConstPtr& image, std::string* why_not);
 
-/// The camera of a view: K from `info` (pixels) and the pose T_W_C (the camera frame in the world
-/// frame, as tf gives it). Returns false and sets `why_not` for a K that is zero, not finite or not
-/// upper triangular with K(2,2) = 1 (after scaling), a pose that is not finite, or an image size
-/// that disagrees with `image_size` (when non-zero).
+/// The camera of a view: K and the lens distortion D from `info` (pixels; plumb_bob with 5
+/// coefficients, or rational_polynomial with k4 = k5 = k6 = 0) and the pose T_W_C (the camera frame
+/// in the world frame, as tf gives it). Returns false and sets `why_not` for a K that is zero, not
+/// finite or not upper triangular with K(2,2) = 1 (after scaling), another distortion model or a
+/// non-finite coefficient, a pose that is not finite, or an image size that disagrees with
+/// `image_size` (when non-zero).
 bool cameraFromInfo(const sensor_msgs::CameraInfo& info, const Eigen::Isometry3d& T_W_C,
                     cv::Size image_size, PinholeCamera* camera, std::string* why_not);
 
@@ -61,12 +63,14 @@ bool cameraFromInfo(const sensor_msgs::CameraInfo& info, const Eigen::Isometry3d
 /// for another type.
 sensor_msgs::Image imageMessage(const cv::Mat& image, const std_msgs::Header& header);
 
-/// camera_info of a pinhole camera of the given image size: K, P = K [I | 0], R = I, no
-/// distortion (plumb_bob with zero coefficients).
+/// camera_info of a camera of the given image size: K, P = K [I | 0], R = I, and its lens
+/// distortion as plumb_bob (k1, k2, p1, p2, k3; zero for an ideal lens).
 sensor_msgs::CameraInfo cameraInfoMessage(const PinholeCamera& camera, cv::Size size,
                                           const std_msgs::Header& header);
 
 /// The camera's pose T_W_C: the transform from `world_frame` to `camera_frame` that tf needs.
+/// Throws std::invalid_argument for an improper camera (a mirrored world frame, det R = -1),
+/// which no rotation describes.
 geometry_msgs::TransformStamped cameraPoseMessage(const PinholeCamera& camera,
                                                   const std::string& world_frame,
                                                   const std::string& camera_frame,
