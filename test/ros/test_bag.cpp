@@ -8,6 +8,8 @@
 #include <sensor_msgs/Image.h>
 #include <tf2_msgs/TFMessage.h>
 
+#include <fstream>
+#include <iomanip>
 #include <map>
 
 #include "common/test_data.h"
@@ -53,6 +55,31 @@ TEST(BagCommand, WritesEveryViewOfASceneWithItsCamera) {
                             "/stereo/left/image", "/stereo/right/image"}) {
     EXPECT_EQ(counts[topic], 4) << topic;
   }
+}
+
+TEST(BagCommand, RefusesAMirroredWorldNamingTheView) {
+  const std::string dir = test::temporaryDirectory();
+  std::string out, err;
+  ASSERT_EQ(test::runProgram("scene --out " + dir + " --views 4 --size 160x120", &out, &err), 0)
+      << err;
+  // Every P times diag(-1, 1, 1, 1): the scene's world with its x axis negated.
+  std::ofstream list(dir + "/mirrored.txt");
+  list << std::setprecision(17);
+  for (const CalibratedView& view : readCalibration(dir + "/scene_par.txt")) {
+    const Matrix34d P =
+        view.camera.projectionMatrix() * Eigen::Vector4d(-1.0, 1.0, 1.0, 1.0).asDiagonal();
+    list << view.name;
+    for (int i = 0; i < 12; ++i) list << ' ' << P(i / 4, i % 4);
+    list << '\n';
+  }
+  list.close();
+  EXPECT_EQ(test::runRosProgram("bag --calib " + dir + "/mirrored.txt --images " + dir +
+                                    " --silhouettes " + dir + "/masks --out " + dir + "/m.bag",
+                                &out, &err),
+            1);
+  EXPECT_NE(err.find("view_0000.png: the calibration's world frame is mirrored (det R = -1)"),
+            std::string::npos)
+      << err;
 }
 
 }  // namespace

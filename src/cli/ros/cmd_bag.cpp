@@ -5,6 +5,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
+#include <stdexcept>
 
 #include "args.h"
 #include "commands.h"
@@ -30,6 +31,11 @@ std::vector<BagView> loadViews(const ArgParser& parser) {
   const HullInput input = viewSetFromArgs(parser);
   std::vector<BagView> views;
   for (size_t v = 0; v < input.names.size(); ++v) {
+    if (input.cameras[v].improper()) {
+      throw std::runtime_error(input.names[v] +
+                               ": the calibration's world frame is mirrored (det R = -1), and tf "
+                               "holds rotations only: negate one world axis of every P first");
+    }
     views.push_back({input.names[v], input.cameras[v],
                      readImage(parser.get("images") + "/" + input.names[v]), input.masks[v]});
   }
