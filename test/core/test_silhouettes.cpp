@@ -29,47 +29,60 @@ SilhouetteConfig thresholdMethod() {
   return config;
 }
 
-/// The smallest mask IoU of the method over the views of a scene on `background`.
-double smallestIoU(const std::string& background, const SilhouetteConfig& method) {
+struct MaskScores {
+  double smallest = 1.0, mean = 0.0;
+};
+
+/// The mask IoU of the method against the exact masks over the 8 views of a 320x240 scene on
+/// `background`.
+MaskScores maskScores(const std::string& background, const SilhouetteConfig& method) {
   SceneConfig config;
   config.views = 8;
   config.width_px = 320;
   config.height_px = 240;
   config.background = background;
-  double smallest = 1.0;
+  MaskScores scores;
   for (const RenderedView& view : renderScene(config)) {
-    smallest = std::min(smallest, maskIoU(silhouetteFromImage(view.image, method), view.mask));
+    const double iou = maskIoU(silhouetteFromImage(view.image, method), view.mask);
+    scores.smallest = std::min(scores.smallest, iou);
+    scores.mean += iou / config.views;
   }
-  std::cout << background << " background, " << method.silhouette_method << ": smallest mask IoU "
-            << smallest << "\n";
-  return smallest;
+  std::cout << background << " background, " << method.silhouette_method << ": mask IoU smallest "
+            << scores.smallest << ", mean " << scores.mean << "\n";
+  return scores;
 }
 
-TEST(BackgroundSilhouettes, OnUniformBackgroundsTheyComeCloseToTheExactMasks) {
-  // Measured (8 views of 320x240): black 0.973, blue 0.973. What is lost is where the object lets
-  // the background through (the hole of the sculpture's ring), which the filling of holes closes.
-  EXPECT_GE(smallestIoU("black", backgroundMethod()), 0.965);
-  EXPECT_GE(smallestIoU("blue", backgroundMethod()), 0.965);
+double smallestIoU(const std::string& background, const SilhouetteConfig& method) {
+  return maskScores(background, method).smallest;
 }
 
-TEST(BackgroundSilhouettes, OnATexturedBackgroundTheHullFailsAndSaysWhy) {
-  // The textured background's border holds every colour the object has: no per-image colour
-  // model separates them (measured: smallest mask IoU 0, most silhouettes empty). The hull
-  // command names the views and fails rather than carving garbage.
+TEST(BackgroundSilhouettes, ComeCloseToTheExactMasksOnEveryBackground) {
+  // Measured (8 views of 320x240), smallest / mean: black 0.973 / 0.991, blue 0.973 / 0.991,
+  // textured 0.971 / 0.986. What is lost is mostly where the object lets the background through
+  // (the hole of the sculpture's ring), which the filling of holes closes.
+  for (const char* background : {"black", "blue", "textured"}) {
+    const MaskScores scores = maskScores(background, backgroundMethod());
+    EXPECT_GE(scores.smallest, 0.96) << background;
+    EXPECT_GE(scores.mean, 0.98) << background;
+  }
+}
+
+TEST(BackgroundSilhouettes, GiveATexturedSceneItsHull) {
   const std::string dir = test::temporaryDirectory();
   std::string out, err;
+  ASSERT_EQ(
+      test::runProgram("scene --out " + dir + " --views 8 --size 320x240 --background textured",
+                       &out, &err),
+      0)
+      << err;
   ASSERT_EQ(test::runProgram(
-                "scene --out " + dir + " --views 8 --size 320x240 --background " + "textured", &out,
-                &err),
+                "hull --calib " + dir + "/scene_par.txt --images " + dir + " --max-depth 7 --json",
+                &out, &err),
             0)
       << err;
-  EXPECT_EQ(
-      test::runProgram("hull --calib " + dir + "/scene_par.txt --images " + dir + " --max-depth 6",
-                       &out, &err),
-      1);
-  EXPECT_NE(err.find("view_0001.png: the silhouette is empty; leave the view out"),
-            std::string::npos)
-      << err;
+  const nlohmann::json result = nlohmann::json::parse(out);
+  EXPECT_GT(result["reprojection_iou"]["mean"].get<double>(), 0.97) << out;
+  EXPECT_TRUE(result["warnings"].empty()) << out;
 }
 
 TEST(BackgroundSilhouettes, TheGreyThresholdFailsOnDarkBlueWhereTheBackgroundModelDoesNot) {

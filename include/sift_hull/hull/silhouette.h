@@ -12,7 +12,11 @@ namespace sift_hull {
 ///   (k-means, k = 8; clusters under 0.5 % of the border dropped), a threshold on that distance
 ///   chosen per image above the border's own spread of distances (3 times its 90th percentile, at
 ///   least 3 Lab units), isolated pixels and components under 5 % of the largest removed, a
-///   closing by a disc of `erode_px` and the holes filled. It needs no threshold from the user.
+///   closing by a disc of `erode_px` and the holes filled. When the clusters do not describe the
+///   border (its spread above 4 Lab units: a textured background), OpenCV's GrabCut, the border
+///   band as certain background, makes the silhouette (at most 640 px on the longest side,
+///   upsampled), joined with the colour model's where the two agree (IoU > 0.8), then the same
+///   clean-up. It needs no threshold from the user.
 /// - "threshold", the Middlebury recipe: grey intensity above `threshold` (on [0, 1]), then a
 ///   dilation and an erosion with discs of the given radii. The command line and the nodes take
 ///   it when a threshold is given and no method is named.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
@@ -39,6 +40,15 @@ constexpr double kBorderFraction = 0.03;
 /// band's spread of distances the threshold lies above (see distanceThreshold).
 constexpr float kMinObjectDistance = 3.0f;
 constexpr float kSpreadFactor = 3.0f;
+/// The largest spread of the border band's colour distances (CIE Lab) for which the border's
+/// clusters alone make the silhouette; above it (a textured background) GrabCut does.
+constexpr float kMaxClusteredSpread = 4.0f;
+/// The longest image side GrabCut runs at (the silhouette is upsampled, its outline interpolated).
+constexpr double kWorkingSidePx = 640.0;
+constexpr int kGrabCutIterations = 5;
+constexpr uint64_t kGrabCutSeed = 0x12345678;
+/// The least IoU of the colour model's silhouette with GrabCut's for the two to be joined.
+constexpr double kMinAgreement = 0.8;
 /// The least area of a silhouette component, as a share of the largest one's.
 constexpr double kMinComponentShare = 0.05;
 
@@ -136,18 +146,65 @@ cv::Mat largeComponents(const cv::Mat& mask) {
   return kept;
 }
 
-cv::Mat backgroundSilhouette(const cv::Mat& image, const SilhouetteConfig& config) {
-  const cv::Mat distance = backgroundDistance(image);
-  const int band = borderBand(image.size(), kBorderFraction);
-  const float spread = borderSpread(distance, band);
-  cv::Mat mask = distance > std::max(kMinObjectDistance, kSpreadFactor * spread);
-  // Isolated noisy pixels go, then the small components (noise, dust, a reflection).
+/// Whether a mask looks like the background taken for the object, or nothing: empty, over 90 % of
+/// the image, or touching all four borders (as silhouetteWarnings).
+bool suspect(const cv::Mat& mask) {
+  const double share = static_cast<double>(cv::countNonZero(mask)) / mask.total();
+  return share == 0.0 || share > 0.9 ||
+         (cv::countNonZero(mask.row(0)) > 0 && cv::countNonZero(mask.row(mask.rows - 1)) > 0 &&
+          cv::countNonZero(mask.col(0)) > 0 && cv::countNonZero(mask.col(mask.cols - 1)) > 0);
+}
+
+/// Isolated pixels and small components removed, a closing by a disc of erode_px, holes filled.
+cv::Mat cleaned(cv::Mat mask, const SilhouetteConfig& config) {
   cv::morphologyEx(mask, mask, cv::MORPH_OPEN, disc(1));
   mask = largeComponents(mask);
-  // A closing joins what a dark fold of the object split without moving the outline; then the
-  // holes are filled.
   if (config.erode_px > 0) cv::morphologyEx(mask, mask, cv::MORPH_CLOSE, disc(config.erode_px));
   return filledHoles(mask);
+}
+
+/// GrabCut's silhouette of a BGR image, the border band as certain background: colour mixtures of
+/// the object and the background and a graph cut that follows colour edges. It separates
+/// backgrounds whose colours the border's clusters do not exhaust (texture). Run at most
+/// kWorkingSidePx on the longest side, the result upsampled with its outline interpolated.
+cv::Mat grabCutSilhouette(const cv::Mat& bgr) {
+  const double scale = std::min(1.0, kWorkingSidePx / std::max(bgr.cols, bgr.rows));
+  cv::Mat small = bgr;
+  if (scale < 1.0) cv::resize(bgr, small, cv::Size(), scale, scale, cv::INTER_AREA);
+  const int band = borderBand(small.size(), kBorderFraction);
+  const cv::Rect inner(band, band, small.cols - 2 * band, small.rows - 2 * band);
+  cv::Mat labels, background_model, object_model;
+  cv::theRNG().state = kGrabCutSeed;  // its k-means: the same silhouette every run, every thread
+  cv::grabCut(small, labels, inner, background_model, object_model, kGrabCutIterations,
+              cv::GC_INIT_WITH_RECT);
+  cv::Mat mask = (labels == cv::GC_FGD) | (labels == cv::GC_PR_FGD);
+  if (scale < 1.0) {
+    cv::Mat full;
+    cv::resize(mask, full, bgr.size(), 0.0, 0.0, cv::INTER_LINEAR);
+    mask = full > 127;
+  }
+  return mask;
+}
+
+cv::Mat backgroundSilhouette(const cv::Mat& image, const SilhouetteConfig& config) {
+  const cv::Mat distance = backgroundDistance(image, kBorderFraction);
+  const float spread = borderSpread(distance, borderBand(image.size(), kBorderFraction));
+  const cv::Mat colour = distance > std::max(kMinObjectDistance, kSpreadFactor * spread);
+  // A border its clusters describe to within a few Lab units (a uniform or few-coloured
+  // background, camera noise) is all the model needs.
+  if (spread <= kMaxClusteredSpread) return cleaned(colour, config);
+  cv::Mat bgr = image;
+  if (image.channels() == 1) cv::cvtColor(image, bgr, cv::COLOR_GRAY2BGR);
+  cv::Mat mask = grabCutSilhouette(bgr);
+  // The colour model keeps the dark parts of an object on a dark background, which the mixtures
+  // may give to the background; it is added where it agrees with the cut (IoU > kMinAgreement),
+  // not where it has taken a textured background for the object.
+  const cv::Mat prior = cleaned(colour, config);
+  if (!suspect(prior)) {
+    const double both = cv::countNonZero(mask & prior), either = cv::countNonZero(mask | prior);
+    if (either > 0 && both / either > kMinAgreement) mask |= prior;
+  }
+  return cleaned(mask, config);
 }
 
 }  // namespace
