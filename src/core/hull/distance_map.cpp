@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
+#include <utility>
 
 #include "hull/distance_kernel.h"
 
@@ -83,11 +84,27 @@ SignedDistanceMap::SignedDistanceMap(const cv::Mat& mask, const SilhouetteBounds
   }
 }
 
+SignedDistanceMap::SignedDistanceMap(cv::Mat distance_px, cv::Size image_size, cv::Point origin,
+                                     int reduction, float error_px)
+    : distance_px_(std::move(distance_px)),
+      image_size_(image_size),
+      origin_(origin),
+      reduction_(reduction),
+      error_px_(error_px) {
+  if (distance_px_.type() != CV_32FC1 || distance_px_.rows < 2 || distance_px_.cols < 2 ||
+      !distance_px_.isContinuous() || reduction < 1) {
+    throw std::invalid_argument("SignedDistanceMap: not a continuous CV_32FC1 map of 2x2 or more");
+  }
+}
+
 float SignedDistanceMap::at(double u_px, double v_px) const {
+  // Map coordinates of an image pixel: (u - first sample's u) / reduction.
+  const double first_sample = 0.5 * (reduction_ - 1);
   return detail::lookUp(distance_px_.ptr<float>(), distance_px_.cols,
                         detail::lookUpLimit(distance_px_.cols),
                         detail::lookUpLimit(distance_px_.rows),
-                        static_cast<float>(u_px - origin_.x), static_cast<float>(v_px - origin_.y));
+                        static_cast<float>((u_px - origin_.x - first_sample) / reduction_),
+                        static_cast<float>((v_px - origin_.y - first_sample) / reduction_));
 }
 
 }  // namespace sift_hull

@@ -12,6 +12,7 @@
 
 #include "common/parallel.h"
 #include "hull/distance_kernel.h"
+#include "sift_hull/hull/reduced_distance_map.h"
 #include "sift_hull/limits.h"
 
 namespace sift_hull {
@@ -46,9 +47,19 @@ HullView::HullView(std::string name, const PinholeCamera& camera, const cv::Mat&
                    const HullConfig& config)
     : name_(std::move(name)),
       camera_(camera),
-      mask_((checkMask(mask), mask.clone())),
+      mask_((checkMask(mask), RunLengthMask(mask))),
       bounds_(silhouetteBounds(mask, config.carve_outside_image)),
       distance_(mask, bounds_, config.padding_px),
+      carves_behind_(bounds_.empty || bounds_.boundedSides() > 0),
+      kernel_(std::make_unique<detail::DistanceKernel>(makeKernel(config))) {}
+
+HullView::HullView(std::string name, const PinholeCamera& camera, RunLengthMask mask,
+                   const HullConfig& config, int distance_reduction)
+    : name_(std::move(name)),
+      camera_(camera),
+      mask_(std::move(mask)),
+      bounds_(silhouetteBounds(mask_, config.carve_outside_image)),
+      distance_(reducedSignedDistanceMap(mask_, bounds_, config.padding_px, distance_reduction)),
       carves_behind_(bounds_.empty || bounds_.boundedSides() > 0),
       kernel_(std::make_unique<detail::DistanceKernel>(makeKernel(config))) {}
 
@@ -77,17 +88,22 @@ detail::DistanceKernel HullView::makeKernel(const HullConfig& config) const {
   const Eigen::Matrix3d& R = camera_.R();
   for (int i = 0; i < 9; ++i) kernel.R[i] = static_cast<float>(R(i / 3, i % 3));
   for (int i = 0; i < 3; ++i) kernel.t[i] = static_cast<float>(camera_.t()(i));
+  // Map column = (u - first sample's u) / reduction: K scaled by 1 / reduction, the first
+  // sample's offset in offset_u / offset_v. The map's values and k_norm stay in image pixels.
   const Eigen::Matrix3d& K = camera_.K();
-  kernel.fx = K(0, 0), kernel.skew = K(0, 1), kernel.cx = K(0, 2);
-  kernel.fy = K(1, 1), kernel.cy = K(1, 2);
+  const double reduction = distance_.reduction();
+  kernel.fx = K(0, 0) / reduction, kernel.skew = K(0, 1) / reduction;
+  kernel.cx = K(0, 2) / reduction;
+  kernel.fy = K(1, 1) / reduction, kernel.cy = K(1, 2) / reduction;
   kernel.k_norm = static_cast<float>(spectralNorm2x2(K));
-  kernel.slack_px = static_cast<float>(config.distance_slack_px);
+  kernel.slack_px = static_cast<float>(config.distance_slack_px + distance_.errorBound_px());
   kernel.behind_value = carves_behind_ ? kFarOutside_px : -kFarOutside_px;
   const cv::Mat& map = distance_.map();
   kernel.map = map.ptr<float>();
   kernel.stride = map.cols;
-  kernel.offset_u = static_cast<float>(-distance_.origin().x);
-  kernel.offset_v = static_cast<float>(-distance_.origin().y);
+  const double first_sample = 0.5 * (reduction - 1);
+  kernel.offset_u = static_cast<float>(-(distance_.origin().x + first_sample) / reduction);
+  kernel.offset_v = static_cast<float>(-(distance_.origin().y + first_sample) / reduction);
   kernel.u_high = detail::lookUpLimit(map.cols), kernel.v_high = detail::lookUpLimit(map.rows);
   return kernel;
 }
@@ -132,10 +148,10 @@ bool HullView::keeps(const Eigen::Vector3d& X_W) const {
   if (!(X_C.z() > 0.0)) return !carves_behind_;
   const Eigen::Vector2d pixel = pixelOf(X_C);
   const long u = std::lround(pixel.x()), v = std::lround(pixel.y());
-  if (u < 0 || v < 0 || u >= mask_.cols || v >= mask_.rows) {
+  if (u < 0 || v < 0 || u >= mask_.size().width || v >= mask_.size().height) {
     return withinBounds(bounds_, pixel.x(), pixel.y());
   }
-  return mask_.at<uint8_t>(static_cast<int>(v), static_cast<int>(u)) != 0;
+  return mask_.at(static_cast<int>(u), static_cast<int>(v));
 }
 
 void HullView::maxInto(const PointBatch& points, float* values) const {

@@ -1,0 +1,51 @@
+#pragma once
+
+#include "sift_hull/geometry/camera.h"
+#include "sift_hull/hull/bounding_box.h"
+#include "sift_hull/hull/distance_map.h"
+#include "sift_hull/hull/hull_config.h"
+#include "sift_hull/hull/run_length_mask.h"
+
+namespace sift_hull {
+
+/// The largest reduction distanceReduction() chooses by itself.
+constexpr int kMaxAutomaticDistanceReduction = 8;
+/// The largest HullConfig::distance_reduction accepted.
+constexpr int kMaxDistanceReduction = 15;
+
+/// How many image pixels per side one element of a view's distance map may cover:
+/// `config.distance_reduction` when it is positive; when 0, the largest power of two s (1 to
+/// kMaxAutomaticDistanceReduction) that does not exceed the edge in pixels of a finest voxel
+/// (HullCube::around(box, max_depth).resolution_m) seen at the farthest depth of the box's
+/// corners with the smaller focal length, so that a finest voxel still covers about one map
+/// element. 1 when a corner of the box is not in front of the camera.
+int distanceReduction(const PinholeCamera& camera, const Box3d& box, const HullConfig& config);
+
+/// The error bound e of a map of reducedSignedDistanceMap(), in pixels: `reduction` (0 for 1).
+/// Within a block of the contour, |reduced look-up - full-resolution look-up| <= e: the samples
+/// there are the full-resolution map's values, and bilinear interpolation between samples
+/// `reduction` apart of a field whose slope is at most sqrt(2) px per px (the full-resolution
+/// map's bilinear cells) errs by at most that. Farther away the samples are lower bounds of the
+/// full-resolution map's magnitude with its sign, so a look-up exceeds the full-resolution
+/// magnitude by at most e and takes the wrong sign by at most e. Either way adding e to the slack
+/// keeps the ball verdicts conservative.
+float reducedDistanceErrorBound_px(int reduction);
+
+/// SignedDistanceMap(mask.decode(), bounds, padding_px) sampled every `reduction` pixels, computed
+/// without a full-resolution transform: a block of reduction x reduction pixels per element,
+/// its coverage counted from the mask; blocks whose 3x3 neighbourhood holds both inside and
+/// outside pixels carry the contour, and a transform of that block grid gives every sample's
+/// distance to the contour up to half a block diagonal (kept as a lower bound with the sign of the
+/// block). Samples within kExactBandBlocks blocks of the contour get the full-resolution map's
+/// exact value from transforms of the mask in tiles around the contour. The values are image
+/// pixels; errorBound_px() is reducedDistanceErrorBound_px(reduction). `reduction` 1, or an
+/// empty silhouette, gives the full-resolution map. Throws std::invalid_argument for an empty
+/// mask or a reduction outside [1, kMaxDistanceReduction].
+SignedDistanceMap reducedSignedDistanceMap(const RunLengthMask& mask,
+                                           const SilhouetteBounds& bounds, int padding_px,
+                                           int reduction);
+
+/// Blocks around the contour blocks whose samples are exact (reducedSignedDistanceMap()).
+constexpr int kExactBandBlocks = 3;
+
+}  // namespace sift_hull

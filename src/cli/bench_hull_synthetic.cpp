@@ -1,0 +1,180 @@
+// bench-hull's synthetic case: 120 views of 4000x3000 of the default sculpture at depth 9, hull
+// with distance maps at the reduction each view allows against full-resolution maps.
+
+#include "bench_hull_synthetic.h"
+
+#include <algorithm>
+#include <chrono>
+#include <memory>
+#include <optional>
+#include <sstream>
+
+#include "bench_timing.h"
+#include "sift_hull/hull/reduced_distance_map.h"
+#include "sift_hull/synthetic/mask_render.h"
+#include "sift_hull/synthetic/scene.h"
+
+namespace sift_hull {
+namespace cli {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double millisecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+/// The case's cameras and masks, each mask run-length encoded as soon as it is rendered.
+HullInput renderCase(const SyntheticHullCase& config, double* masks_mib) {
+  SceneConfig scene;
+  scene.views = config.views;
+  scene.layout = "sphere";
+  scene.width_px = config.width_px;
+  scene.height_px = config.height_px;
+  const Shape shape = Shape::byName(scene.shape);
+  const std::vector<CalibratedView> cameras = sceneCameras(scene, shape);
+  HullInput input;
+  size_t bytes = 0;
+  for (const CalibratedView& view : cameras) {  // renderMask runs on OpenCV's threads
+    input.names.push_back(view.name);
+    input.cameras.push_back(view.camera);
+    input.run_length_masks.emplace_back(
+        renderMask(shape, view.camera, cv::Size(config.width_px, config.height_px)));
+  }
+  for (const RunLengthMask& mask : input.run_length_masks) bytes += mask.memoryBytes();
+  *masks_mib = bytes / (1024.0 * 1024.0);
+  return input;
+}
+
+HullTimings medianTimings(const std::vector<HullTimings>& runs) {
+  const auto field = [&](double HullTimings::*member) {
+    std::vector<double> values;
+    for (const HullTimings& run : runs) values.push_back(run.*member);
+    return median(values);
+  };
+  HullTimings time;
+  for (double HullTimings::*member :
+       {&HullTimings::masks_ms, &HullTimings::distance_ms, &HullTimings::bbox_ms,
+        &HullTimings::octree_ms, &HullTimings::mesh_ms, &HullTimings::total_ms}) {
+    time.*member = field(member);
+  }
+  return time;
+}
+
+SyntheticHullRun runSetting(const HullInput& input, const SyntheticHullCase& config,
+                            int distance_reduction, bool* peak_reset) {
+  HullConfig hull_config;
+  hull_config.max_depth = config.max_depth;
+  hull_config.distance_reduction = distance_reduction;
+  SyntheticHullRun run;
+  run.distance_reduction = distance_reduction;
+  *peak_reset = resetResidentPeak();
+  std::vector<HullTimings> times;
+  std::optional<HullResult> last;
+  for (int i = 0; i < std::max(config.runs, 1); ++i) {
+    last.reset();
+    last.emplace(buildHull(input, hull_config));
+    times.push_back(last->time);
+  }
+  run.peak_mib = residentPeakMiB();
+  run.time = medianTimings(times);
+  run.reduction_min = kMaxDistanceReduction;
+  for (const HullView& view : last->hull.views()) {
+    run.reduction_min = std::min(run.reduction_min, view.distanceReduction());
+    run.reduction_max = std::max(run.reduction_max, view.distanceReduction());
+  }
+  run.surface_leaves = last->hull.stats().surface_leaves;
+  run.mesh_faces = last->mesh.faces.size();
+  run.watertight = last->mesh_check.watertight;
+  run.iou = reprojectionIoU(last->mesh, last->hull.views());
+  return run;
+}
+
+nlohmann::json runJson(const SyntheticHullRun& run) {
+  return {{"distance_reduction", run.distance_reduction},
+          {"reductions_used", {{"min", run.reduction_min}, {"max", run.reduction_max}}},
+          {"time_ms",
+           {{"masks", run.time.masks_ms},
+            {"bbox", run.time.bbox_ms},
+            {"distance", run.time.distance_ms},
+            {"octree", run.time.octree_ms},
+            {"mesh", run.time.mesh_ms},
+            {"total", run.time.total_ms}}},
+          {"peak_mib", run.peak_mib},
+          {"reprojection_iou", {{"min", run.iou.min}, {"mean", run.iou.mean}}},
+          {"surface_leaves", run.surface_leaves},
+          {"mesh_faces", run.mesh_faces},
+          {"watertight", run.watertight}};
+}
+
+std::string runRow(const std::string& label, const SyntheticHullRun& run) {
+  std::ostringstream out;
+  out << "| " << label << " | " << run.reduction_min << ".." << run.reduction_max << " | "
+      << fixed(run.time.masks_ms, 0) << " | " << fixed(run.time.bbox_ms, 0) << " | "
+      << fixed(run.time.distance_ms, 0) << " | " << fixed(run.time.octree_ms, 0) << " | "
+      << fixed(run.time.mesh_ms, 0) << " | **" << fixed(run.time.total_ms, 0) << "** | "
+      << fixed(run.peak_mib, 0) << " | " << fixed(run.iou.min, 4) << " / "
+      << fixed(run.iou.mean, 4) << " | " << run.surface_leaves << " |\n";
+  return out.str();
+}
+
+}  // namespace
+
+SyntheticHullBench benchSyntheticHull(const SyntheticHullCase& config) {
+  SyntheticHullBench bench;
+  bench.config = config;
+  const Clock::time_point start = Clock::now();
+  const HullInput input = renderCase(config, &bench.masks_mib);
+  bench.render_ms = millisecondsSince(start);
+  bench.input_peak_mib = residentPeakMiB();
+  bool reset_reduced = false, reset_full = false;
+  bench.reduced = runSetting(input, config, 0, &reset_reduced);
+  bench.full = runSetting(input, config, 1, &reset_full);
+  bench.peak_reset = reset_reduced && reset_full;
+  return bench;
+}
+
+nlohmann::json syntheticJson(const SyntheticHullBench& bench) {
+  const SyntheticHullCase& c = bench.config;
+  const double iou_difference = std::abs(bench.reduced.iou.mean - bench.full.iou.mean);
+  return {{"views", c.views},
+          {"image", {c.width_px, c.height_px}},
+          {"max_depth", c.max_depth},
+          {"runs", c.runs},
+          {"cpu", cpuModel()},
+          {"render_ms", bench.render_ms},
+          {"run_length_masks_mib", bench.masks_mib},
+          {"peak_measured_per_setting", bench.peak_reset},
+          {"reduced", runJson(bench.reduced)},
+          {"full_resolution", runJson(bench.full)},
+          {"targets",
+           {{"hull_total_ms<=3000",
+             {{"measured_ms", bench.reduced.time.total_ms},
+              {"met", bench.reduced.time.total_ms <= 3000.0}}},
+            {"peak_MiB<=1536",
+             {{"measured", bench.reduced.peak_mib}, {"met", bench.reduced.peak_mib <= 1536.0}}},
+            {"|mean_iou - full_resolution|<=0.002",
+             {{"measured", iou_difference}, {"met", iou_difference <= 0.002}}}}}};
+}
+
+std::string syntheticMarkdown(const SyntheticHullBench& bench) {
+  const SyntheticHullCase& c = bench.config;
+  std::ostringstream out;
+  out << "Synthetic case: " << c.views << " views of " << c.width_px << "x" << c.height_px
+      << " (the default sculpture, sphere layout, masks by `renderMask`, run-length encoded as "
+      << "rendered: " << fixed(bench.masks_mib, 1) << " MiB for all, rendering "
+      << fixed(bench.render_ms / 1000.0, 1) << " s), depth " << c.max_depth << ", median of "
+      << c.runs << " runs, 2 threads, CPU " << cpuModel() << ". Times in ms; peak = VmHWM of "
+      << "the process during the runs of that setting, MiB"
+      << (bench.peak_reset ? "" : " (could not be reset: the process's peak so far)") << ".\n\n"
+      << "| distance maps | reduction | masks | bbox | distance | octree | mesh | total | peak | "
+         "reproj. IoU min / mean | surface leaves |\n"
+      << "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n"
+      << runRow("per view (`distance_reduction` 0)", bench.reduced)
+      << runRow("full resolution (`distance_reduction` 1)", bench.full) << '\n'
+      << targetsMarkdown(syntheticJson(bench)["targets"]);
+  return out.str();
+}
+
+}  // namespace cli
+}  // namespace sift_hull
