@@ -82,6 +82,9 @@ SyntheticHullRun runSetting(const HullInput& input, const SyntheticHullCase& con
   for (const HullView& view : last->hull.views()) {
     run.reduction_min = std::min(run.reduction_min, view.distanceReduction());
     run.reduction_max = std::max(run.reduction_max, view.distanceReduction());
+    run.error_bound_max_px =
+        std::max(run.error_bound_max_px, static_cast<double>(view.distanceErrorBound_px()));
+    run.error_bound_mean_px += view.distanceErrorBound_px() / last->hull.views().size();
   }
   run.surface_leaves = last->hull.stats().surface_leaves;
   run.mesh_faces = last->mesh.faces.size();
@@ -93,6 +96,7 @@ SyntheticHullRun runSetting(const HullInput& input, const SyntheticHullCase& con
 nlohmann::json runJson(const SyntheticHullRun& run) {
   return {{"distance_reduction", run.distance_reduction},
           {"reductions_used", {{"min", run.reduction_min}, {"max", run.reduction_max}}},
+          {"error_bound_px", {{"mean", run.error_bound_mean_px}, {"max", run.error_bound_max_px}}},
           {"time_ms",
            {{"masks", run.time.masks_ms},
             {"bbox", run.time.bbox_ms},
@@ -110,6 +114,7 @@ nlohmann::json runJson(const SyntheticHullRun& run) {
 std::string runRow(const std::string& label, const SyntheticHullRun& run) {
   std::ostringstream out;
   out << "| " << label << " | " << run.reduction_min << ".." << run.reduction_max << " | "
+      << fixed(run.error_bound_mean_px, 2) << " / " << fixed(run.error_bound_max_px, 2) << " | "
       << fixed(run.time.masks_ms, 0) << " | " << fixed(run.time.bbox_ms, 0) << " | "
       << fixed(run.time.distance_ms, 0) << " | " << fixed(run.time.octree_ms, 0) << " | "
       << fixed(run.time.mesh_ms, 0) << " | **" << fixed(run.time.total_ms, 0) << "** | "
@@ -167,9 +172,9 @@ std::string syntheticMarkdown(const SyntheticHullBench& bench) {
       << c.runs << " runs, 2 threads, CPU " << cpuModel() << ". Times in ms; peak = VmHWM of "
       << "the process during the runs of that setting, MiB"
       << (bench.peak_reset ? "" : " (could not be reset: the process's peak so far)") << ".\n\n"
-      << "| distance maps | reduction | masks | bbox | distance | octree | mesh | total | peak | "
+      << "| distance maps | reduction | map error bound mean / max (px) | masks | bbox | distance | octree | mesh | total | peak | "
          "reproj. IoU min / mean | surface leaves |\n"
-      << "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n"
+      << "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n"
       << runRow("per view (`distance_reduction` 0)", bench.reduced)
       << runRow("full resolution (`distance_reduction` 1)", bench.full) << '\n'
       << targetsMarkdown(syntheticJson(bench)["targets"]);

@@ -22,6 +22,7 @@ struct SyntheticHullCase {
 struct SyntheticHullRun {
   int distance_reduction = 0;  ///< the setting (0: per view)
   int reduction_min = 0, reduction_max = 0;  ///< the views' reductions
+  double error_bound_mean_px = 0.0, error_bound_max_px = 0.0;  ///< the views' map error bounds
   HullTimings time;                          ///< medians
   double peak_mib = 0.0;  ///< the process's peak resident memory during the runs (VmHWM)
   ReprojectionIoU iou;

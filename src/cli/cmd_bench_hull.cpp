@@ -233,6 +233,8 @@ int runBenchHull(const std::vector<std::string>& args) {
   parser.addFlag("json", "print the result as one JSON object");
   parser.addFlag("synthetic-only", "run only the synthetic case (120 views of 4000x3000)");
   parser.addFlag("skip-synthetic", "leave the synthetic case out");
+  parser.addOption("synthetic-views", "N", "views of the synthetic case",
+                   std::to_string(SyntheticHullCase().views));
   if (!parser.parse(args)) return 0;
   if (parser.flag("synthetic-only") && parser.flag("skip-synthetic")) {
     throw UsageError("--synthetic-only and --skip-synthetic exclude each other");
@@ -241,7 +243,12 @@ int runBenchHull(const std::vector<std::string>& args) {
 
   std::vector<DatasetRuns> all;
   std::optional<SyntheticHullBench> synthetic;
-  if (!parser.flag("skip-synthetic")) synthetic = benchSyntheticHull(SyntheticHullCase());
+  if (!parser.flag("skip-synthetic")) {
+    SyntheticHullCase synthetic_case;
+    synthetic_case.views = parser.getInt("synthetic-views");
+    if (synthetic_case.views < 2) throw UsageError("--synthetic-views must be at least 2");
+    synthetic = benchSyntheticHull(synthetic_case);
+  }
   for (const HullDataset& dataset : hullDatasets()) {
     if (parser.flag("synthetic-only")) break;
     const std::string directory = root + "/" + dataset.directory;

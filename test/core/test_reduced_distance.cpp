@@ -35,11 +35,10 @@ cv::Mat testMask() {
 }
 
 /// Over points spread over the full map's window (a pixel inside its edges): the largest
-/// |reduced - full| where the full map is within `band_px` of the contour, and elsewhere the
-/// largest excess of the reduced map's magnitude over the full one's and the largest value of the
-/// wrong sign (each should stay within the reduced map's error bound).
+/// |reduced - full| where the full map is within `band_px` of the contour, and the largest
+/// excess sign(reduced) (reduced - full), which the stated bound must cover.
 struct Differences {
-  double near_contour = 0.0, excess = 0.0, wrong_sign = 0.0, mean_near_contour = 0.0;
+  double near_contour = 0.0, excess = 0.0, mean_near_contour = 0.0;
 };
 
 Differences compare(const SignedDistanceMap& full, const SignedDistanceMap& reduced,
@@ -58,11 +57,9 @@ Differences compare(const SignedDistanceMap& full, const SignedDistanceMap& redu
       result.near_contour = std::max(result.near_contour, std::abs(value - exact));
       result.mean_near_contour += std::abs(value - exact);
       ++near;
-    } else {
-      const double signed_value = exact > 0.0 ? value : -value;
-      result.excess = std::max(result.excess, signed_value - std::abs(exact));
-      result.wrong_sign = std::max(result.wrong_sign, -signed_value);
     }
+    const double sign = value > 0.0 ? 1.0 : (value < 0.0 ? -1.0 : 0.0);
+    result.excess = std::max(result.excess, sign * (value - exact));
   }
   result.mean_near_contour /= std::max(near, 1);
   return result;
@@ -98,16 +95,17 @@ TEST_P(ReducedMap, EqualsTheFullResolutionMapWithinItsBoundAndExactlyAtSamplesNe
   const SignedDistanceMap reduced =
       reducedSignedDistanceMap(RunLengthMask(mask), bounds, 16, reduction);
   ASSERT_EQ(reduced.reduction(), reduction);
-  EXPECT_EQ(reduced.errorBound_px(), reducedDistanceErrorBound_px(reduction));
-  EXPECT_LE(reduced.errorBound_px(), reduction);
+  EXPECT_LE(reduced.errorBound_px(), reducedDistanceErrorBound_px(reduction));
+  EXPECT_LT(reduced.errorBound_px(), 0.75 * reduction);  // measured, well below the a-priori one
+  EXPECT_GT(reduced.errorBound_px(), 0.0f);
   const Differences differences = compare(full, reduced, reduction);
-  EXPECT_LE(differences.near_contour, reduced.errorBound_px());
+  EXPECT_LE(differences.near_contour, reducedDistanceErrorBound_px(reduction));
   EXPECT_LT(differences.mean_near_contour, 0.05 * reduction);
   EXPECT_LE(differences.excess, reduced.errorBound_px());
-  EXPECT_LE(differences.wrong_sign, reduced.errorBound_px());
-  std::cout << "reduction " << reduction << ": near the contour max " << differences.near_contour
-            << " mean " << differences.mean_near_contour << " px; elsewhere excess "
-            << differences.excess << ", wrong sign " << differences.wrong_sign << " px\n";
+  std::cout << "reduction " << reduction << ": stated bound " << reduced.errorBound_px()
+            << " px; near the contour max |difference| " << differences.near_contour << " mean "
+            << differences.mean_near_contour << " px; largest excess " << differences.excess
+            << " px\n";
   // At the samples within a block of the contour, the full map's value itself.
   const double first = 0.5 * (reduction - 1);
   for (int row = 0; row < reduced.map().rows - 1; ++row) {

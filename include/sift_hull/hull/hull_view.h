@@ -57,6 +57,8 @@ class HullView {
   const RunLengthMask& runLengthMask() const { return mask_; }
   /// Image pixels per side of one element of the distance map (1: full resolution).
   int distanceReduction() const { return distance_.reduction(); }
+  /// The distance map's error bound, added to the slack (SignedDistanceMap::errorBound_px()).
+  float distanceErrorBound_px() const { return distance_.errorBound_px(); }
   /// The silhouette's 2-D bounds; open sides where the border cuts it, unless carving outside.
   const SilhouetteBounds& bounds() const { return bounds_; }
   cv::Size imageSize() const { return mask_.size(); }

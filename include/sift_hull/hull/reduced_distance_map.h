@@ -14,21 +14,23 @@ constexpr int kMaxAutomaticDistanceReduction = 8;
 constexpr int kMaxDistanceReduction = 15;
 
 /// How many image pixels per side one element of a view's distance map may cover:
-/// `config.distance_reduction` when it is positive; when 0, the largest power of two s (1 to
+/// `config.distance_reduction` when it is positive; when 0, the largest integer s (1 to
 /// kMaxAutomaticDistanceReduction) that does not exceed the edge in pixels of a finest voxel
 /// (HullCube::around(box, max_depth).resolution_m) seen at the farthest depth of the box's
 /// corners with the smaller focal length, so that a finest voxel still covers about one map
 /// element. 1 when a corner of the box is not in front of the camera.
 int distanceReduction(const PinholeCamera& camera, const Box3d& box, const HullConfig& config);
 
-/// The error bound e of a map of reducedSignedDistanceMap(), in pixels: `reduction` (0 for 1).
-/// Within a block of the contour, |reduced look-up - full-resolution look-up| <= e: the samples
-/// there are the full-resolution map's values, and bilinear interpolation between samples
-/// `reduction` apart of a field whose slope is at most sqrt(2) px per px (the full-resolution
-/// map's bilinear cells) errs by at most that. Farther away the samples are lower bounds of the
-/// full-resolution map's magnitude with its sign, so a look-up exceeds the full-resolution
-/// magnitude by at most e and takes the wrong sign by at most e. Either way adding e to the slack
-/// keeps the ball verdicts conservative.
+/// The a-priori error bound of a map of reducedSignedDistanceMap(), in pixels: `reduction` (0
+/// for 1), the bilinear interpolation between samples `reduction` apart of a field whose slope is
+/// at most sqrt(2) px per px (the full-resolution map's bilinear cells). A map states a bound e <=
+/// this (SignedDistanceMap::errorBound_px()) such that, wherever its look-up r is not 0,
+/// sign(r) (r - f) <= e for the full-resolution look-up f: r never exceeds f's magnitude by more
+/// than e, nor takes the wrong sign by more than e. So adding e to the slack keeps the ball
+/// verdicts conservative. Near the contour e is measured (the excess at every pixel centre and,
+/// for an even reduction, every half-pixel point around the exact band: where the pieces of both
+/// bilinear interpolants meet, so the excess is largest at one of them); farther away the
+/// samples are lowered by `reduction` below a lower bound of the full-resolution magnitude.
 float reducedDistanceErrorBound_px(int reduction);
 
 /// SignedDistanceMap(mask.decode(), bounds, padding_px) sampled every `reduction` pixels, computed
@@ -38,7 +40,7 @@ float reducedDistanceErrorBound_px(int reduction);
 /// distance to the contour up to half a block diagonal (kept as a lower bound with the sign of the
 /// block). Samples within kExactBandBlocks blocks of the contour get the full-resolution map's
 /// exact value from transforms of the mask in tiles around the contour. The values are image
-/// pixels; errorBound_px() is reducedDistanceErrorBound_px(reduction). `reduction` 1, or an
+/// pixels; errorBound_px() is the bound described at reducedDistanceErrorBound_px(). `reduction` 1, or an
 /// empty silhouette, gives the full-resolution map. Throws std::invalid_argument for an empty
 /// mask or a reduction outside [1, kMaxDistanceReduction].
 SignedDistanceMap reducedSignedDistanceMap(const RunLengthMask& mask,
@@ -46,6 +48,6 @@ SignedDistanceMap reducedSignedDistanceMap(const RunLengthMask& mask,
                                            int reduction);
 
 /// Blocks around the contour blocks whose samples are exact (reducedSignedDistanceMap()).
-constexpr int kExactBandBlocks = 3;
+constexpr int kExactBandBlocks = 6;
 
 }  // namespace sift_hull

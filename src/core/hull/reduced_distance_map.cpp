@@ -5,14 +5,16 @@
 #include <limits>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
+#include <vector>
 
+#include "hull/distance_kernel.h"
 #include "sift_hull/hull/octree.h"
 
 namespace sift_hull {
 namespace {
 
 /// Blocks per side of the tiles whose full-resolution transforms give the exact band.
-constexpr int kTileBlocks = 32;
+constexpr int kTileBlocks = 64;
 /// Half a block's diagonal over its edge, rounded up.
 constexpr float kHalfDiagonal = 0.7072f;
 
@@ -53,17 +55,21 @@ cv::Mat paddedRegion(const RunLengthMask& mask, const SilhouetteBounds& bounds, 
 cv::Mat blockCounts(const cv::Mat& inside, int reduction) {
   const int block_cols = inside.cols / reduction;
   cv::Mat counts(inside.rows / reduction, block_cols, CV_8UC1);
-  std::vector<int> row_counts(inside.cols);
   std::vector<int> sums(block_cols);
   for (int block_row = 0; block_row < counts.rows; ++block_row) {
     std::fill(sums.begin(), sums.end(), 0);
     for (int row = block_row * reduction; row < (block_row + 1) * reduction; ++row) {
       const uint8_t* pixel = inside.ptr<uint8_t>(row);
-      for (int col = 0; col < inside.cols; ++col) row_counts[col] = pixel[col] & 1;
-      for (int col = 0; col < inside.cols; ++col) sums[col / reduction] += row_counts[col];
+      for (int block = 0; block < block_cols; ++block, pixel += reduction) {
+        int sum = 0;  // of 0 / 255 values
+        for (int k = 0; k < reduction; ++k) sum += pixel[k];
+        sums[block] += sum;
+      }
     }
     uint8_t* count = counts.ptr<uint8_t>(block_row);
-    for (int block = 0; block < block_cols; ++block) count[block] = static_cast<uint8_t>(sums[block]);
+    for (int block = 0; block < block_cols; ++block) {
+      count[block] = static_cast<uint8_t>(sums[block] / 255);
+    }
   }
   return counts;
 }
@@ -91,94 +97,152 @@ cv::Mat coarseDistances(const cv::Mat& counts, const cv::Mat& contour, int reduc
     const float* blocks = blocks_to_contour->ptr<float>(row);
     float* value = distance.ptr<float>(row);
     for (int col = 0; col < counts.cols; ++col) {
+      // Lowered by `reduction` more, the interpolation's bound (refineBand).
       const float magnitude =
-          std::max(0.0f, reduction * (blocks[col] - kHalfDiagonal) - 0.5f);
+          std::max(0.0f, reduction * (blocks[col] - kHalfDiagonal - 1.0f) - 0.5f);
       value[col] = count[col] == full ? -magnitude : (count[col] == 0 ? magnitude : 0.0f);
     }
   }
   return distance;
 }
 
-/// Full-resolution transforms of one crop of the padded mask: the map's values at its pixels,
-/// and which pixels' values cannot depend on what lies beyond the crop.
-struct CropDistances {
-  cv::Rect crop;         ///< in the region's pixels
-  cv::Mat value_px;      ///< CV_32FC1, SignedDistanceMap's values
-  cv::Mat distance_px;   ///< CV_32FC1, distance to the nearest opposite pixel
-  bool open[4] = {};     ///< sides (left, top, right, bottom) cut inside the region
-  /// The value at crop pixel (col, row), or NaN when a nearer opposite pixel may lie beyond an
-  /// open side.
-  float valueAt(int col, int row) const {
-    const float distance = distance_px.at<float>(row, col);
-    const float far = std::numeric_limits<float>::infinity();
-    const float reach = std::min({open[0] ? col + 1.0f : far, open[1] ? row + 1.0f : far,
-                                  open[2] ? float(crop.width - col) : far,
-                                  open[3] ? float(crop.height - row) : far});
-    return distance <= reach ? value_px.at<float>(row, col)
-                             : std::numeric_limits<float>::quiet_NaN();
-  }
-};
-
-CropDistances cropDistances(const cv::Mat& inside, const cv::Rect& crop) {
-  CropDistances result;
-  result.crop = crop;
-  result.open[0] = crop.x > 0, result.open[1] = crop.y > 0;
-  result.open[2] = crop.br().x < inside.cols, result.open[3] = crop.br().y < inside.rows;
+/// SignedDistanceMap's values over one crop of the padded mask (CV_32FC1), NaN where a nearer
+/// opposite pixel may lie beyond a side of the crop that is not the region's edge.
+cv::Mat cropValues(const cv::Mat& inside, const cv::Rect& crop) {
+  const bool open_left = crop.x > 0, open_top = crop.y > 0;
+  const bool open_right = crop.br().x < inside.cols, open_bottom = crop.br().y < inside.rows;
   const cv::Mat region = inside(crop);
   cv::Mat to_outside, to_inside;
   cv::distanceTransform(region, to_outside, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
   cv::distanceTransform(region == 0, to_inside, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
-  result.distance_px = to_outside + to_inside;  // one of the two is 0 at each pixel
-  result.value_px.create(region.size(), CV_32FC1);
+  const float far = std::numeric_limits<float>::infinity();
+  cv::Mat values(region.size(), CV_32FC1);
   for (int row = 0; row < region.rows; ++row) {
     const uint8_t* is_inside = region.ptr<uint8_t>(row);
-    const float* distance = result.distance_px.ptr<float>(row);
-    float* value = result.value_px.ptr<float>(row);
+    const float* outward = to_outside.ptr<float>(row);
+    const float* inward = to_inside.ptr<float>(row);
+    float* value = values.ptr<float>(row);
+    const float vertical = std::min(open_top ? row + 1.0f : far,
+                                    open_bottom ? static_cast<float>(region.rows - row) : far);
     for (int col = 0; col < region.cols; ++col) {
-      value[col] = is_inside[col] ? 0.5f - distance[col] : distance[col] - 0.5f;
+      const float reach = std::min({vertical, open_left ? col + 1.0f : far,
+                                    open_right ? static_cast<float>(region.cols - col) : far});
+      const float distance = is_inside[col] ? outward[col] : inward[col];
+      value[col] = distance > reach ? std::numeric_limits<float>::quiet_NaN()
+                                    : (is_inside[col] ? 0.5f - distance : distance - 0.5f);
     }
   }
-  return result;
+  return values;
 }
 
-/// The full-resolution map's bilinear look-up at the sample of block (col, row): the mean of
-/// the one (odd reduction) or four (even) pixels around it; NaN when one of them is not exact.
-float exactSample(const CropDistances& crop, int block_col, int block_row, int reduction) {
-  const int first_col = block_col * reduction + (reduction - 1) / 2 - crop.crop.x;
-  const int first_row = block_row * reduction + (reduction - 1) / 2 - crop.crop.y;
-  const int last = reduction % 2 == 0 ? 1 : 0;
-  float sum = 0.0f;
-  for (int dr = 0; dr <= last; ++dr) {
-    for (int dc = 0; dc <= last; ++dc) sum += crop.valueAt(first_col + dc, first_row + dr);
-  }
-  return last == 1 ? 0.25f * sum : sum;
+/// The full-resolution map's bilinear look-up at crop coordinates (u, v), clamped to the crop
+/// (reached only where the crop ends with the region, as the full map clamps to its window);
+/// NaN when a pixel it needs is unknown.
+float cropLookUp(const cv::Mat& values, float u, float v) {
+  u = detail::clampToMap(u, detail::lookUpLimit(values.cols));
+  v = detail::clampToMap(v, detail::lookUpLimit(values.rows));
+  const int u0 = static_cast<int>(u), v0 = static_cast<int>(v);
+  const float fu = u - u0, fv = v - v0;
+  const float* top = values.ptr<float>(v0) + u0;
+  const float* bottom = values.ptr<float>(v0 + 1) + u0;
+  const float upper = top[0] + fu * (top[1] - top[0]);
+  const float lower = bottom[0] + fu * (bottom[1] - bottom[0]);
+  return upper + fv * (lower - upper);
 }
 
-/// Replaces the samples within kExactBandBlocks blocks of the contour by exact ones, tile by
-/// tile.
-void refineBand(const cv::Mat& inside, const cv::Mat& blocks_to_contour, int reduction,
-                cv::Mat* distance) {
-  const cv::Mat band = blocks_to_contour <= kExactBandBlocks;
-  const int margin = (kExactBandBlocks + 2) * reduction + 2;
+/// One tile of blocks and the full-resolution values around it.
+struct Tile {
+  cv::Rect blocks;  ///< in the block grid
+  cv::Rect crop;    ///< in the region's pixels
+  cv::Mat values;   ///< cropValues
+};
+
+/// The tiles holding a block of `needed`, with their crops' full-resolution values.
+std::vector<Tile> bandTiles(const cv::Mat& inside, const cv::Mat& needed, int reduction) {
+  // A checked block lies within kExactBandBlocks + 1 blocks of a contour block, which has both
+  // kinds of pixels in its 3x3 neighbourhood: the nearest opposite pixel is nearer than this.
+  const int margin = (kExactBandBlocks + 5) * reduction + 2;
   const cv::Rect all(0, 0, inside.cols, inside.rows);
-  for (int tile_row = 0; tile_row < band.rows; tile_row += kTileBlocks) {
-    for (int tile_col = 0; tile_col < band.cols; tile_col += kTileBlocks) {
-      const cv::Rect tile = cv::Rect(tile_col, tile_row, kTileBlocks, kTileBlocks) &
-                            cv::Rect(0, 0, band.cols, band.rows);
-      if (cv::countNonZero(band(tile)) == 0) continue;
-      const cv::Rect pixels(tile.x * reduction - margin, tile.y * reduction - margin,
-                            tile.width * reduction + 2 * margin,
-                            tile.height * reduction + 2 * margin);
-      const CropDistances crop = cropDistances(inside, pixels & all);
-      for (int row = tile.y; row < tile.br().y; ++row) {
-        for (int col = tile.x; col < tile.br().x; ++col) {
-          if (!band.at<uint8_t>(row, col)) continue;
-          const float exact = exactSample(crop, col, row, reduction);
-          if (!std::isnan(exact)) distance->at<float>(row, col) = exact;
+  std::vector<Tile> tiles;
+  for (int tile_row = 0; tile_row < needed.rows; tile_row += kTileBlocks) {
+    for (int tile_col = 0; tile_col < needed.cols; tile_col += kTileBlocks) {
+      Tile tile;
+      tile.blocks = cv::Rect(tile_col, tile_row, kTileBlocks, kTileBlocks) &
+                    cv::Rect(0, 0, needed.cols, needed.rows);
+      if (cv::countNonZero(needed(tile.blocks)) == 0) continue;
+      tile.crop = cv::Rect(tile.blocks.x * reduction - margin, tile.blocks.y * reduction - margin,
+                           tile.blocks.width * reduction + 2 * margin,
+                           tile.blocks.height * reduction + 2 * margin) &
+                  all;
+      tile.values = cropValues(inside, tile.crop);
+      tiles.push_back(std::move(tile));
+    }
+  }
+  return tiles;
+}
+
+/// Sets the samples of the band's blocks of a tile to the full-resolution map's look-up there
+/// (the mean of the one or four pixels around the sample), where it is known.
+void setExactSamples(const Tile& tile, const cv::Mat& band, int reduction, cv::Mat* distance) {
+  const float first = 0.5f * (reduction - 1);
+  for (int row = tile.blocks.y; row < tile.blocks.br().y; ++row) {
+    for (int col = tile.blocks.x; col < tile.blocks.br().x; ++col) {
+      if (!band.at<uint8_t>(row, col)) continue;
+      const float exact = cropLookUp(tile.values, col * reduction + first - tile.crop.x,
+                                     row * reduction + first - tile.crop.y);
+      if (!std::isnan(exact)) distance->at<float>(row, col) = exact;
+    }
+  }
+}
+
+/// The largest excess of the reduced map over the full-resolution one, sign(r) (r - f), over the
+/// pixels of a tile's `checked` blocks: at pixel centres, and for an even reduction also halfway
+/// between them, where the pieces of both bilinear interpolants meet, so that this is the
+/// largest excess anywhere in those blocks. +inf when a full-resolution value is unknown.
+float largestExcess(const Tile& tile, const cv::Mat& checked, const cv::Mat& distance,
+                    int reduction) {
+  const float first = 0.5f * (reduction - 1), inverse = 1.0f / reduction;
+  const float step = reduction % 2 == 0 ? 0.5f : 1.0f;
+  const float u_high = detail::lookUpLimit(distance.cols);
+  const float v_high = detail::lookUpLimit(distance.rows);
+  float largest = 0.0f;
+  for (int row = tile.blocks.y; row < tile.blocks.br().y; ++row) {
+    for (int col = tile.blocks.x; col < tile.blocks.br().x; ++col) {
+      if (!checked.at<uint8_t>(row, col)) continue;
+      for (float v = row * reduction; v < (row + 1) * reduction; v += step) {
+        for (float u = col * reduction; u < (col + 1) * reduction; u += step) {
+          const float full = cropLookUp(tile.values, u - tile.crop.x, v - tile.crop.y);
+          if (std::isnan(full)) return std::numeric_limits<float>::infinity();
+          const float reduced =
+              detail::lookUp(distance.ptr<float>(), distance.cols, u_high, v_high,
+                             (u - first) * inverse, (v - first) * inverse);
+          const float sign = reduced > 0.0f ? 1.0f : (reduced < 0.0f ? -1.0f : 0.0f);
+          largest = std::max(largest, sign * (reduced - full));
         }
       }
     }
   }
+  return largest;
+}
+
+/// Replaces the samples within kExactBandBlocks blocks of the contour by exact ones, tile by
+/// tile, and returns the map's error bound: the largest excess over the full-resolution map
+/// around the band (largestExcess), at most `reduction`. Elsewhere the samples are lowered by
+/// `reduction` below the full-resolution magnitude (coarseDistances), which covers the
+/// interpolation between them.
+float refineBand(const cv::Mat& inside, const cv::Mat& blocks_to_contour, int reduction,
+                 cv::Mat* distance) {
+  const cv::Mat band = blocks_to_contour <= kExactBandBlocks;
+  cv::Mat checked;  // every block a cell with an exact sample reaches
+  cv::dilate(band, checked, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3)));
+  const std::vector<Tile> tiles = bandTiles(inside, checked, reduction);
+  for (const Tile& tile : tiles) setExactSamples(tile, band, reduction, distance);
+  float largest = 0.0f;
+  for (const Tile& tile : tiles) {
+    largest = std::max(largest, largestExcess(tile, checked, *distance, reduction));
+  }
+  // Rounding of the kernel's folded projection: a thousandth of a pixel.
+  return std::min(largest + 1e-3f, reducedDistanceErrorBound_px(reduction));
 }
 
 }  // namespace
@@ -197,11 +261,8 @@ int distanceReduction(const PinholeCamera& camera, const Box3d& box, const HullC
   }
   const double focal_px = std::min(camera.K()(0, 0), camera.K()(1, 1));
   const double voxel_px = focal_px * voxel_m / farthest_m;
-  int reduction = 1;
-  while (2 * reduction <= voxel_px && 2 * reduction <= kMaxAutomaticDistanceReduction) {
-    reduction *= 2;
-  }
-  return reduction;
+  return static_cast<int>(
+      std::clamp(std::floor(voxel_px), 1.0, static_cast<double>(kMaxAutomaticDistanceReduction)));
 }
 
 float reducedDistanceErrorBound_px(int reduction) {
@@ -229,9 +290,9 @@ SignedDistanceMap reducedSignedDistanceMap(const RunLengthMask& mask,
   cv::Mat blocks_to_contour;
   cv::Mat distance = coarseDistances(counts, contourBlocks(counts, reduction * reduction),
                                      reduction, &blocks_to_contour);
-  refineBand(inside, blocks_to_contour, reduction, &distance);
+  const float error_px = refineBand(inside, blocks_to_contour, reduction, &distance);
   return SignedDistanceMap(distance, mask.size(), region.tl() - cv::Point(padding_px, padding_px),
-                           reduction, reducedDistanceErrorBound_px(reduction));
+                           reduction, error_px);
 }
 
 }  // namespace sift_hull
