@@ -168,6 +168,28 @@ TEST(ReducedMap, HullReprojectsAsTheFullResolutionHullDoes) {
   EXPECT_TRUE(reduced.mesh_check.watertight);
 }
 
+TEST(ReducedMap, ReductionFollowsTheVoxelsProjectedSize) {
+  const HullInput input = highResolutionScene();
+  Box3d box;
+  box.min_W = Eigen::Vector3d::Constant(-1.0);
+  box.max_W = Eigen::Vector3d::Constant(1.0);
+  HullConfig config;
+  config.max_depth = 7;
+  const cv::Size size = input.run_length_masks[0].size();
+  const int at_depth_7 = distanceReduction(input.cameras[0], size, box, config);
+  EXPECT_GE(at_depth_7, 2);
+  config.max_depth = 9;
+  const int at_depth_9 = distanceReduction(input.cameras[0], size, box, config);
+  EXPECT_LT(at_depth_9, at_depth_7);  // a quarter of the voxel edge
+  EXPECT_EQ(distanceReduction(input.cameras[0], cv::Size(640, 480), box, config), 1);
+  config.distance_reduction = 5;
+  EXPECT_EQ(distanceReduction(input.cameras[0], cv::Size(640, 480), box, config), 5);
+  Box3d behind = box;  // a box reaching behind the camera
+  behind.min_W = input.cameras[0].centre() - Eigen::Vector3d::Constant(0.1);
+  config.distance_reduction = 0;
+  EXPECT_EQ(distanceReduction(input.cameras[0], size, behind, config), 1);
+}
+
 /// How many points of a grid in the ball of radius `radius` around `centre` the view keeps, of
 /// `total`.
 int keptShare(const HullView& view, const Eigen::Vector3d& centre, double radius, int* total) {

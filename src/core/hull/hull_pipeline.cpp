@@ -32,7 +32,8 @@ std::vector<HullView> viewsFor(const HullInput& input, std::vector<RunLengthMask
                                const Box3d& box, const HullConfig& config) {
   std::vector<std::unique_ptr<HullView>> made(masks->size());
   detail::parallelFor(made.size(), config.threads, [&](size_t i) {
-    const int reduction = distanceReduction(input.cameras[i], box, config);
+    const int reduction =
+        distanceReduction(input.cameras[i], (*masks)[i].size(), box, config);
     made[i] = std::make_unique<HullView>(input.names[i], input.cameras[i],
                                          std::move((*masks)[i]), config, reduction);
   });

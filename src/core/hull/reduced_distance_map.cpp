@@ -247,8 +247,10 @@ float refineBand(const cv::Mat& inside, const cv::Mat& blocks_to_contour, int re
 
 }  // namespace
 
-int distanceReduction(const PinholeCamera& camera, const Box3d& box, const HullConfig& config) {
+int distanceReduction(const PinholeCamera& camera, cv::Size image_size, const Box3d& box,
+                      const HullConfig& config) {
   if (config.distance_reduction > 0) return config.distance_reduction;
+  if (image_size.area() < kMinReducedImagePixels) return 1;
   const double voxel_m = HullCube::around(box, config.max_depth).resolution_m;
   double farthest_m = 0.0;
   for (int corner = 0; corner < 8; ++corner) {
