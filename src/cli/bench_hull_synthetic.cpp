@@ -3,11 +3,14 @@
 
 #include "bench_hull_synthetic.h"
 
+#include <malloc.h>
+
 #include <algorithm>
 #include <chrono>
 #include <memory>
 #include <optional>
 #include <sstream>
+#include <vector>
 
 #include "bench_timing.h"
 #include "sift_hull/hull/reduced_distance_map.h"
@@ -61,35 +64,46 @@ HullTimings medianTimings(const std::vector<HullTimings>& runs) {
   return time;
 }
 
-SyntheticHullRun runSetting(const HullInput& input, const SyntheticHullCase& config,
-                            int distance_reduction, bool* peak_reset) {
-  HullConfig hull_config;
-  hull_config.max_depth = config.max_depth;
-  hull_config.distance_reduction = distance_reduction;
-  SyntheticHullRun run;
-  run.distance_reduction = distance_reduction;
-  *peak_reset = resetResidentPeak();
+/// One setting's runs so far.
+struct SettingRuns {
+  HullConfig config;
   std::vector<HullTimings> times;
+  double peak_mib = 0.0;
   std::optional<HullResult> last;
-  for (int i = 0; i < std::max(config.runs, 1); ++i) {
-    last.reset();
-    last.emplace(buildHull(input, hull_config));
-    times.push_back(last->time);
-  }
-  run.peak_mib = residentPeakMiB();
-  run.time = medianTimings(times);
+};
+
+/// One more run of a setting, its peak resident memory measured alone when the kernel lets the
+/// peak be reset (after returning freed heap memory to the system); its result kept only when
+/// `keep` (no other result is alive during a run).
+bool runOnce(const HullInput& input, bool keep, SettingRuns* runs) {
+  malloc_trim(0);  // what the previous run freed leaves the resident set before the reset
+  const bool reset = resetResidentPeak();
+  runs->last.emplace(buildHull(input, runs->config));
+  runs->times.push_back(runs->last->time);
+  runs->peak_mib = std::max(runs->peak_mib, residentPeakMiB());
+  if (!keep) runs->last.reset();
+  return reset;
+}
+
+SyntheticHullRun summary(SettingRuns* runs) {
+  SyntheticHullRun run;
+  run.distance_reduction = runs->config.distance_reduction;
+  run.peak_mib = runs->peak_mib;
+  run.time = medianTimings(runs->times);
+  const HullResult& last = *runs->last;
   run.reduction_min = kMaxDistanceReduction;
-  for (const HullView& view : last->hull.views()) {
+  for (const HullView& view : last.hull.views()) {
     run.reduction_min = std::min(run.reduction_min, view.distanceReduction());
     run.reduction_max = std::max(run.reduction_max, view.distanceReduction());
     run.error_bound_max_px =
         std::max(run.error_bound_max_px, static_cast<double>(view.distanceErrorBound_px()));
-    run.error_bound_mean_px += view.distanceErrorBound_px() / last->hull.views().size();
+    run.error_bound_mean_px += view.distanceErrorBound_px() / last.hull.views().size();
   }
-  run.surface_leaves = last->hull.stats().surface_leaves;
-  run.mesh_faces = last->mesh.faces.size();
-  run.watertight = last->mesh_check.watertight;
-  run.iou = reprojectionIoU(last->mesh, last->hull.views());
+  run.surface_leaves = last.hull.stats().surface_leaves;
+  run.mesh_faces = last.mesh.faces.size();
+  run.watertight = last.mesh_check.watertight;
+  run.iou = reprojectionIoU(last.mesh, last.hull.views());
+  runs->last.reset();
   return run;
 }
 
@@ -132,10 +146,20 @@ SyntheticHullBench benchSyntheticHull(const SyntheticHullCase& config) {
   const HullInput input = renderCase(config, &bench.masks_mib);
   bench.render_ms = millisecondsSince(start);
   bench.input_peak_mib = residentPeakMiB();
-  bool reset_reduced = false, reset_full = false;
-  bench.reduced = runSetting(input, config, 0, &reset_reduced);
-  bench.full = runSetting(input, config, 1, &reset_full);
-  bench.peak_reset = reset_reduced && reset_full;
+  // The settings alternate run by run, so that a load on the machine that comes and goes
+  // weighs on both alike.
+  SettingRuns reduced, full;
+  reduced.config.max_depth = full.config.max_depth = config.max_depth;
+  full.config.distance_reduction = 1;
+  bench.peak_reset = true;
+  const int runs = std::max(config.runs, 1);
+  for (int i = 0; i < runs; ++i) {
+    const bool keep = i + 1 == runs;
+    bench.peak_reset = runOnce(input, keep, &reduced) && bench.peak_reset;
+    if (keep) bench.reduced = summary(&reduced);  // frees its result
+    bench.peak_reset = runOnce(input, keep, &full) && bench.peak_reset;
+    if (keep) bench.full = summary(&full);
+  }
   return bench;
 }
 
@@ -169,8 +193,8 @@ std::string syntheticMarkdown(const SyntheticHullBench& bench) {
       << " (the default sculpture, sphere layout, masks by `renderMask`, run-length encoded as "
       << "rendered: " << fixed(bench.masks_mib, 1) << " MiB for all, rendering "
       << fixed(bench.render_ms / 1000.0, 1) << " s), depth " << c.max_depth << ", median of "
-      << c.runs << " runs, 2 threads, CPU " << cpuModel() << ". Times in ms; peak = VmHWM of "
-      << "the process during the runs of that setting, MiB"
+      << c.runs << " runs per setting (the settings alternating), 2 threads, CPU " << cpuModel()
+      << ". Times in ms; peak = VmHWM of the process during the runs of that setting, MiB"
       << (bench.peak_reset ? "" : " (could not be reset: the process's peak so far)") << ".\n\n"
       << "| distance maps | reduction | map error bound mean / max (px) | masks | bbox | distance | octree | mesh | total | peak | "
          "reproj. IoU min / mean | surface leaves |\n"

@@ -40,8 +40,8 @@ struct SyntheticHullBench {
   SyntheticHullRun full;         ///< distance_reduction 1, the baseline
 };
 
-/// Renders the case's masks (renderMask, views in parallel) and runs the hull with the chosen
-/// reductions and at full resolution, `config.runs` times each.
+/// Renders the case's masks (renderMask, each on OpenCV's threads) and runs the hull with the
+/// chosen reductions and at full resolution, alternately, `config.runs` times each.
 SyntheticHullBench benchSyntheticHull(const SyntheticHullCase& config);
 
 nlohmann::json syntheticJson(const SyntheticHullBench& bench);
