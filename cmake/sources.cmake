@@ -28,6 +28,8 @@ set(SIFT_HULL_CORE_SOURCES
   src/core/hull/marching_cubes.cpp
   src/core/hull/mesh.cpp
   src/core/hull/octree.cpp
+  src/core/hull/reduced_distance_map.cpp
+  src/core/hull/run_length_mask.cpp
   src/core/hull/silhouette.cpp
 )
 set(SIFT_HULL_IO_SOURCES
@@ -43,6 +45,7 @@ set(SIFT_HULL_IO_SOURCES
   src/core/io/view_orientation.cpp
 )
 set(SIFT_HULL_EVAL_SOURCES
+  src/core/synthetic/mask_render.cpp
   src/core/synthetic/scene.cpp
   src/core/synthetic/shape.cpp
   src/core/synthetic/synthetic_matches.cpp

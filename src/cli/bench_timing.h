@@ -24,5 +24,15 @@ double medianMs(const std::function<void()>& run, double budget_ms, int min_repe
 /// The process's peak resident memory so far, in MiB (getrusage).
 double peakMemoryMiB();
 
+/// Resets the peak resident memory that residentPeakMiB() reads (writes 5 to
+/// /proc/self/clear_refs); false when the kernel refuses.
+bool resetResidentPeak();
+/// VmHWM of /proc/self/status in MiB: the peak resident memory since the start or since the last
+/// resetResidentPeak(); 0 when unreadable.
+double residentPeakMiB();
+
+/// The CPU's "model name" in /proc/cpuinfo, or "unknown".
+std::string cpuModel();
+
 }  // namespace cli
 }  // namespace sift_hull

@@ -1,5 +1,6 @@
 // bench-hull: the visual hull on dino and temple at depths 7, 8 and 9 against dense voxel carving
-// at the same resolution, in one run; medians of repeated runs.
+// at the same resolution, and a synthetic case of many high-resolution views
+// (bench_hull_synthetic.h), in one run; medians of repeated runs.
 
 #include <algorithm>
 #include <filesystem>
@@ -9,6 +10,7 @@
 #include <thread>
 
 #include "args.h"
+#include "bench_hull_synthetic.h"
 #include "bench_timing.h"
 #include "commands.h"
 #include "hull_options.h"
@@ -40,9 +42,11 @@ HullTimings medianTimings(const std::vector<HullTimings>& runs) {
     for (const HullTimings& run : runs) values.push_back(run.*member);
     return median(values);
   };
-  return {field(&HullTimings::distance_ms), field(&HullTimings::bbox_ms),
-          field(&HullTimings::octree_ms), field(&HullTimings::mesh_ms),
-          field(&HullTimings::total_ms)};
+  HullTimings time{field(&HullTimings::distance_ms), field(&HullTimings::bbox_ms),
+                   field(&HullTimings::octree_ms), field(&HullTimings::mesh_ms),
+                   field(&HullTimings::total_ms)};
+  time.masks_ms = field(&HullTimings::masks_ms);
+  return time;
 }
 
 /// Runs the hull at least 3 times (more while under ~2 s) and keeps the last result.
@@ -186,8 +190,11 @@ std::string markdownReport(const std::vector<DatasetRuns>& all, const nlohmann::
   return out.str();
 }
 
-int reportBench(const ArgParser& parser, const std::vector<DatasetRuns>& all) {
-  nlohmann::json json = {{"datasets", nlohmann::json::array()}, {"targets", targetsJson(all)}};
+int reportBench(const ArgParser& parser, const std::vector<DatasetRuns>& all,
+                const std::optional<SyntheticHullBench>& synthetic) {
+  nlohmann::json json = {{"datasets", nlohmann::json::array()},
+                         {"targets", targetsJson(all)},
+                         {"cpu", cpuModel()}};
   for (const DatasetRuns& runs : all) {
     nlohmann::json depths = nlohmann::json::array();
     for (const DepthRun& run : runs.depths) depths.push_back(depthJson(run));
@@ -197,8 +204,18 @@ int reportBench(const ArgParser& parser, const std::vector<DatasetRuns>& all) {
                                 {"depth9_peak_mib", runs.peak_mib_depth9},
                                 {"depth9_command_peak_mib", runs.command_peak_mib_depth9}});
   }
-  const std::string report = markdownReport(all, json["targets"]);
-  if (parser.has("write")) replaceMarkedSection(parser.get("write"), "bench-hull", report);
+  std::string report = all.empty() ? "" : markdownReport(all, json["targets"]);
+  if (parser.has("write") && !all.empty()) {
+    replaceMarkedSection(parser.get("write"), "bench-hull", report);
+  }
+  if (synthetic) {
+    json["synthetic"] = syntheticJson(*synthetic);
+    const std::string synthetic_report = syntheticMarkdown(*synthetic);
+    if (parser.has("write")) {
+      replaceMarkedSection(parser.get("write"), "bench-hull-synthetic", synthetic_report);
+    }
+    report += (report.empty() ? "" : "\n") + synthetic_report;
+  }
   printResult(parser.flag("json"), json, report);
   return 0;
 }
@@ -208,15 +225,32 @@ int reportBench(const ArgParser& parser, const std::vector<DatasetRuns>& all) {
 int runBenchHull(const std::vector<std::string>& args) {
   ArgParser parser("bench-hull",
                    "Times the visual hull (distance transforms, LP box, octree, mesh) on dino and\n"
-                   "temple at depths 7, 8, 9 against dense voxel carving at the same resolution.");
+                   "temple at depths 7, 8, 9 against dense voxel carving at the same resolution,\n"
+                   "and on 120 rendered views of 4000x3000 at depth 9 with reduced and with\n"
+                   "full-resolution distance maps.");
   parser.addOption("data", "DIR", "data root (default: $SIFT_HULL_DATA or ../shared/data)");
   parser.addOption("write", "MD", "replace the bench-hull section of this Markdown file");
   parser.addFlag("json", "print the result as one JSON object");
+  parser.addFlag("synthetic-only", "run only the synthetic case (120 views of 4000x3000)");
+  parser.addFlag("skip-synthetic", "leave the synthetic case out");
+  parser.addOption("synthetic-views", "N", "views of the synthetic case",
+                   std::to_string(SyntheticHullCase().views));
   if (!parser.parse(args)) return 0;
+  if (parser.flag("synthetic-only") && parser.flag("skip-synthetic")) {
+    throw UsageError("--synthetic-only and --skip-synthetic exclude each other");
+  }
   const std::string root = parser.has("data") ? parser.get("data") : defaultDataRoot();
 
   std::vector<DatasetRuns> all;
+  std::optional<SyntheticHullBench> synthetic;
+  if (!parser.flag("skip-synthetic")) {
+    SyntheticHullCase synthetic_case;
+    synthetic_case.views = parser.getInt("synthetic-views");
+    if (synthetic_case.views < 2) throw UsageError("--synthetic-views must be at least 2");
+    synthetic = benchSyntheticHull(synthetic_case);
+  }
   for (const HullDataset& dataset : hullDatasets()) {
+    if (parser.flag("synthetic-only")) break;
     const std::string directory = root + "/" + dataset.directory;
     if (root.empty() || !std::filesystem::exists(directory)) {
       std::cerr << "bench-hull: skipping " << dataset.name << ": no " << directory << '\n';
@@ -227,7 +261,7 @@ int runBenchHull(const std::vector<std::string>& args) {
     all.back().peak_mib_depth9 = peak.at("through_hull").get<double>();
     all.back().command_peak_mib_depth9 = peak.at("total").get<double>();
   }
-  return reportBench(parser, all);
+  return reportBench(parser, all, synthetic);
 }
 
 }  // namespace cli

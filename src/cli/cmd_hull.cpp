@@ -126,8 +126,9 @@ int runHull(const std::vector<std::string>& args) {
 
   const HullConfig config = hullConfigFromArgs(parser);
   PoorResults poor(parser.flag("allow-poor"));
-  const HullInput input = viewSetFromArgs(parser);
-  for (const std::string& warning : silhouetteWarnings(input.names, input.masks))
+  const HullInput input = runLengthViewSetFromArgs(parser);
+  for (const std::string& warning :
+       runLengthSilhouetteWarnings(input.names, input.run_length_masks))
     poor.warn(warning);
   const std::optional<Box3d> box = boxFromArgs(parser);
   if (box) checkBox(*box, input, &poor);

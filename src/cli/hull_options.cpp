@@ -1,5 +1,6 @@
 #include "hull_options.h"
 
+#include <algorithm>
 #include <sstream>
 #include <stdexcept>
 
@@ -58,6 +59,12 @@ HullInput viewSetFromArgs(const ArgParser& parser) {
                        silhouetteConfigFromArgs(parser), viewNamesFromArgs(parser));
 }
 
+HullInput runLengthViewSetFromArgs(const ArgParser& parser) {
+  const std::string masks = parser.has("silhouettes") ? parser.get("silhouettes") : "";
+  return loadRunLengthHullInput(parser.get("calib"), parser.get("images"), masks,
+                                silhouetteConfigFromArgs(parser), viewNamesFromArgs(parser));
+}
+
 void addHullOptions(ArgParser* parser) {
   const HullConfig defaults;
   std::ostringstream slack;
@@ -69,6 +76,10 @@ void addHullOptions(ArgParser* parser) {
   parser->addOption("distance-slack-px", "PX",
                     "margin added to a cell's projected radius, in pixels", slack.str());
   parser->addDeprecatedAlias("slack", {"distance-slack-px"});
+  parser->addOption("distance-reduction", "S",
+                    "image pixels per distance-map element: 0 = per view from the voxel's "
+                    "projected size, 1 = full resolution, 2..15 = forced",
+                    std::to_string(defaults.distance_reduction));
   parser->addOption("threads", "N", "threads for distance transforms, carving and meshing",
                     std::to_string(defaults.threads));
   parser->addOption("box", "XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX",
@@ -81,6 +92,7 @@ HullConfig hullConfigFromArgs(const ArgParser& parser) {
   config.carve_outside_image = parser.flag("carve-outside-image");
   config.distance_slack_px = parser.getDouble("distance-slack-px");
   config.threads = parser.getInt("threads");
+  config.distance_reduction = parser.getInt("distance-reduction");
   validateOptions(config);
   return config;
 }
@@ -102,12 +114,28 @@ std::optional<Box3d> boxFromArgs(const ArgParser& parser) {
   return box;
 }
 
+namespace {
+
+/// The distance reductions the views used: smallest and largest.
+nlohmann::json distanceReductionsJson(const std::vector<HullView>& views) {
+  int smallest = 0, largest = 0;
+  for (const HullView& view : views) {
+    const int reduction = view.distanceReduction();
+    smallest = smallest == 0 ? reduction : std::min(smallest, reduction);
+    largest = std::max(largest, reduction);
+  }
+  return {{"min", smallest}, {"max", largest}};
+}
+
+}  // namespace
+
 nlohmann::json hullJson(const HullResult& result, size_t occupied_leaves,
                         const ReprojectionIoU& iou) {
   const HullTimings& time = result.time;
   return {{"views", result.hull.views().size()},
           {"bbox", {{"min", vectorJson(result.box.min_W)}, {"max", vectorJson(result.box.max_W)}}},
           {"max_depth", result.hull.cube().depth},
+          {"distance_reduction", distanceReductionsJson(result.hull.views())},
           {"resolution", result.hull.cube().resolution_m},
           {"occupied_leaves", occupied_leaves},
           {"mesh",
@@ -117,6 +145,7 @@ nlohmann::json hullJson(const HullResult& result, size_t occupied_leaves,
           {"time_ms",
            {{"distance", time.distance_ms},
             {"bbox", time.bbox_ms},
+            {"masks", time.masks_ms},
             {"octree", time.octree_ms},
             {"mesh", time.mesh_ms},
             {"total", time.total_ms}}},

@@ -18,9 +18,11 @@ namespace cli {
 void addViewSetOptions(ArgParser* parser);
 /// The views those options name (all when neither --views nor --views-file is given).
 HullInput viewSetFromArgs(const ArgParser& parser);
+/// The same views with their silhouettes run-length encoded (HullInput::run_length_masks).
+HullInput runLengthViewSetFromArgs(const ArgParser& parser);
 
-/// --max-depth, --carve-outside-image, --distance-slack-px, --threads, with HullConfig's
-/// defaults (deprecated: --depth, --slack).
+/// --max-depth, --carve-outside-image, --distance-slack-px, --distance-reduction, --threads, with
+/// HullConfig's defaults (deprecated: --depth, --slack).
 void addHullOptions(ArgParser* parser);
 HullConfig hullConfigFromArgs(const ArgParser& parser);
 

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <iostream>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -13,6 +14,7 @@
 #include "sift_hull/filters/epipolar.h"
 #include "sift_hull/hull/hull_pipeline.h"
 #include "sift_hull/io/colmap.h"
+#include "sift_hull/synthetic/mask_render.h"
 #include "sift_hull/synthetic/scene.h"
 #include "sift_hull/synthetic/shape.h"
 
@@ -78,6 +80,33 @@ TEST(DistortedScene, HullEqualsTheIdealLensHullWithinAVoxel) {
   const double voxel = reference.box.size().maxCoeff() / cells;
   EXPECT_LT((own_box.box.min_W - reference.box.min_W).cwiseAbs().maxCoeff(), voxel);
   EXPECT_LT((own_box.box.max_W - reference.box.max_W).cwiseAbs().maxCoeff(), voxel);
+}
+
+TEST(DistortedScene, ReducedDistanceMapsKeepTheHullOfADistortedHighResolutionSet) {
+  SceneConfig config = ring(kBarrel);
+  config.views = 8;
+  config.width_px = 2400;
+  config.height_px = 1800;
+  const Shape shape = Shape::byName(config.shape);
+  HullInput input;
+  for (const CalibratedView& view : sceneCameras(config, shape)) {
+    input.names.push_back(view.name);
+    input.cameras.push_back(view.camera);
+    input.masks.push_back(renderMask(shape, view.camera, {config.width_px, config.height_px}));
+  }
+  HullConfig full;
+  full.max_depth = 7;
+  full.distance_reduction = 1;
+  HullConfig reduced = full;
+  reduced.distance_reduction = 3;
+  const HullResult a = buildHull(input, full);
+  const HullResult b = buildHull(input, reduced, a.box);
+  const double iou_full = reprojectionIoU(a.mesh, a.hull.views()).mean;
+  const double iou_reduced = reprojectionIoU(b.mesh, b.hull.views()).mean;
+  EXPECT_GT(iou_full, 0.98);
+  EXPECT_NEAR(iou_reduced, iou_full, 0.002);
+  std::cout << "mean reprojection IoU, full " << iou_full << ", reduced by 3 " << iou_reduced
+            << ", distance stage " << a.time.distance_ms << " / " << b.time.distance_ms << " ms\n";
 }
 
 TEST(DistortedScene, HullRefusesADistortionThatFoldsOverInTheImage) {

@@ -61,6 +61,7 @@ void expectDefaultHull(const ros::NodeHandle& nh) {
   EXPECT_EQ(hull.hull.carve_outside_image, hull_default.hull.carve_outside_image);
   EXPECT_EQ(hull.hull.distance_slack_px, hull_default.hull.distance_slack_px);
   EXPECT_EQ(hull.hull.threads, hull_default.hull.threads);
+  EXPECT_EQ(hull.hull.distance_reduction, hull_default.hull.distance_reduction);
   EXPECT_FALSE(hull.box.has_value());
   EXPECT_TRUE(hull.skip_views.empty());
   EXPECT_EQ(hull.min_view_distance_m, hull_default.min_view_distance_m);

@@ -23,6 +23,13 @@ class SignedDistanceMap {
   /// `mask`: CV_8UC1, non-zero inside; `bounds`: silhouetteBounds() of the mask. Throws
   /// std::invalid_argument for another type or an empty mask.
   SignedDistanceMap(const cv::Mat& mask, const SilhouetteBounds& bounds, int padding_px);
+  /// A map sampled every `reduction` pixels (reducedSignedDistanceMap() makes it): element (c, r)
+  /// holds the distance in image pixels at u = origin.x + c * reduction + (reduction - 1) / 2,
+  /// v likewise, and differs from the full-resolution map's look-ups by at most `error_px`.
+  /// Throws std::invalid_argument for a map that is not CV_32FC1 and at least 2x2, or a
+  /// reduction below 1.
+  SignedDistanceMap(cv::Mat distance_px, cv::Size image_size, cv::Point origin, int reduction,
+                    float error_px);
 
   /// This map resampled for a camera with lens distortion: a map over ideal pixels (those of the
   /// undistorted pinhole, PinholeCamera) whose value at ideal pixel p is this map's at the raw
@@ -42,11 +49,17 @@ class SignedDistanceMap {
   /// The map (CV_32FC1, continuous, at least 2x2) and the image pixel of its first element.
   const cv::Mat& map() const { return distance_px_; }
   cv::Point origin() const { return origin_; }
+  /// Image pixels per map element along u and v (1: full resolution).
+  int reduction() const { return reduction_; }
+  /// Largest difference of a look-up from the full-resolution map's (0 at full resolution).
+  float errorBound_px() const { return error_px_; }
 
  private:
   cv::Mat distance_px_;  ///< CV_32FC1
   cv::Size image_size_;
-  cv::Point origin_;  ///< image pixel of map element (0, 0)
+  cv::Point origin_;  ///< image pixel of map element (0, 0), or of its block's first pixel
+  int reduction_ = 1;
+  float error_px_ = 0.0f;
   float lipschitz_ = 1.0f;
 };
 

@@ -9,6 +9,7 @@
 #include "sift_hull/hull/hull_view.h"
 #include "sift_hull/hull/mesh.h"
 #include "sift_hull/hull/octree.h"
+#include "sift_hull/hull/run_length_mask.h"
 
 namespace sift_hull {
 
@@ -17,11 +18,19 @@ struct HullInput {
   std::vector<std::string> names;
   std::vector<PinholeCamera> cameras;
   std::vector<cv::Mat> masks;  ///< CV_8UC1, non-zero inside
+  /// The silhouettes run-length encoded, used when `masks` is empty (loadHullInput gives these,
+  /// so that no full-resolution mask stays in memory).
+  std::vector<RunLengthMask> run_length_masks;
+
+  /// Number of views: of `masks`, else of `run_length_masks`.
+  size_t viewCount() const { return masks.empty() ? run_length_masks.size() : masks.size(); }
 };
 
-/// Wall-clock times of the stages of buildHull, in milliseconds.
+/// Wall-clock times of the stages of buildHull, in milliseconds: the masks' run-length encoding
+/// and 2-D bounds, the bounding box, the distance maps, carving, marching cubes, and all of them.
 struct HullTimings {
   double distance_ms = 0.0, bbox_ms = 0.0, octree_ms = 0.0, mesh_ms = 0.0, total_ms = 0.0;
+  double masks_ms = 0.0;
 };
 
 struct HullResult {
@@ -32,7 +41,9 @@ struct HullResult {
   HullTimings time;
 };
 
-/// Distance transforms, bounding box (the LP of eq. 8 unless `box` is given), octree carving and
+/// The masks' bounds (run-length encoding the masks given as images, on `config.threads`
+/// threads), the bounding box (the LP of eq. 8 unless `box` is given), each view's distance map
+/// at the reduction distanceReduction() chooses for the box (in parallel), octree carving and
 /// marching cubes. Throws HullBoxError when no box exists, std::invalid_argument for bad input.
 HullResult buildHull(const HullInput& input, const HullConfig& config,
                      const std::optional<Box3d>& box = std::nullopt);

@@ -11,6 +11,7 @@
 #include "sift_hull/hull/bounding_box.h"
 #include "sift_hull/hull/distance_map.h"
 #include "sift_hull/hull/hull_config.h"
+#include "sift_hull/hull/run_length_mask.h"
 
 namespace sift_hull {
 
@@ -36,6 +37,12 @@ class HullView {
   /// Throws std::invalid_argument for a mask that is not a non-empty CV_8UC1.
   HullView(std::string name, const PinholeCamera& camera, const cv::Mat& mask,
            const HullConfig& config);
+  /// A view whose distance map is sampled every `distance_reduction` pixels
+  /// (reducedSignedDistanceMap(); 1: full resolution, as the constructor above), its error bound
+  /// added to the slack of the ball verdicts. Throws std::invalid_argument for an empty mask or a
+  /// reduction outside [1, kMaxDistanceReduction].
+  HullView(std::string name, const PinholeCamera& camera, RunLengthMask mask,
+           const HullConfig& config, int distance_reduction);
   HullView(const HullView& other);
   HullView& operator=(const HullView& other);
   HullView(HullView&& other) noexcept;
@@ -44,7 +51,14 @@ class HullView {
 
   const std::string& name() const { return name_; }
   const PinholeCamera& camera() const { return camera_; }
-  const cv::Mat& mask() const { return mask_; }
+  /// The silhouette at full resolution, decoded from its run-length form (a new image per call).
+  cv::Mat mask() const { return mask_.decode(); }
+  /// The silhouette as the view holds it.
+  const RunLengthMask& runLengthMask() const { return mask_; }
+  /// Image pixels per side of one element of the distance map (1: full resolution).
+  int distanceReduction() const { return distance_.reduction(); }
+  /// The distance map's error bound, added to the slack (SignedDistanceMap::errorBound_px()).
+  float distanceErrorBound_px() const { return distance_.errorBound_px(); }
   /// The silhouette's 2-D bounds; open sides where the border cuts it, unless carving outside.
   const SilhouetteBounds& bounds() const { return bounds_; }
   cv::Size imageSize() const { return mask_.size(); }
@@ -85,7 +99,7 @@ class HullView {
 
   std::string name_;
   PinholeCamera camera_;
-  cv::Mat mask_;
+  RunLengthMask mask_;
   SilhouetteBounds bounds_;
   SignedDistanceMap distance_;
   bool carves_behind_ = true;
@@ -100,5 +114,12 @@ class HullView {
 std::vector<HullView> makeHullViews(const std::vector<std::string>& names,
                                     const std::vector<PinholeCamera>& cameras,
                                     const std::vector<cv::Mat>& masks, const HullConfig& config);
+
+/// The bounds of a view's silhouette in the ideal pixels of its camera, as HullView::bounds()
+/// gives them and the box LP takes them: the mask's bounds, or for a camera with lens distortion
+/// those of the undistorted silhouette (its outline's pixel corners undistorted; open sides kept).
+/// Throws std::invalid_argument naming the view when its distortion folds over within its image.
+SilhouetteBounds viewBounds(const std::string& name, const PinholeCamera& camera,
+                            const RunLengthMask& mask, const HullConfig& config);
 
 }  // namespace sift_hull

@@ -4,6 +4,8 @@
 #include <string>
 #include <vector>
 
+#include "sift_hull/hull/run_length_mask.h"
+
 namespace sift_hull {
 
 /// Silhouette extraction from an image. Two methods:
@@ -45,6 +47,9 @@ cv::Mat backgroundDistance(const cv::Mat& image, double border_fraction = 0.03);
 /// suspect view, "NAME: reason; leave the view out or give its mask"; none for a good one.
 std::vector<std::string> silhouetteWarnings(const std::vector<std::string>& names,
                                             const std::vector<cv::Mat>& masks);
+/// silhouetteWarnings() of run-length encoded masks, decoding one at a time.
+std::vector<std::string> runLengthSilhouetteWarnings(const std::vector<std::string>& names,
+                                                     const std::vector<RunLengthMask>& masks);
 
 /// The views whose reprojection IoU (one per view, e.g. ReprojectionIoU::per_view) lies far below
 /// the others': more than 0.1 under the median and under 0.9. One message per such view, naming

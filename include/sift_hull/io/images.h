@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "sift_hull/hull/run_length_mask.h"
 #include "sift_hull/hull/silhouette.h"
 #include "sift_hull/io/calibration.h"
 
@@ -29,5 +30,12 @@ std::vector<cv::Mat> loadSilhouettes(const std::vector<CalibratedView>& views,
                                      const std::string& image_directory,
                                      const std::string& mask_directory,
                                      const SilhouetteConfig& recipe);
+
+/// loadSilhouettes(), each silhouette run-length encoded as soon as it is made: at most one
+/// full-resolution image and mask per thread stays in memory at a time.
+std::vector<RunLengthMask> loadRunLengthSilhouettes(const std::vector<CalibratedView>& views,
+                                                    const std::string& image_directory,
+                                                    const std::string& mask_directory,
+                                                    const SilhouetteConfig& recipe);
 
 }  // namespace sift_hull

@@ -20,4 +20,11 @@ HullInput loadHullInput(const std::string& calibration_path, const std::string& 
                         const std::string& mask_directory, const SilhouetteConfig& recipe,
                         const std::vector<std::string>& view_names);
 
+/// loadHullInput() with the silhouettes run-length encoded as they are read
+/// (HullInput::run_length_masks, `masks` empty): no full-resolution mask is kept.
+HullInput loadRunLengthHullInput(const std::string& calibration_path,
+                                 const std::string& image_directory,
+                                 const std::string& mask_directory, const SilhouetteConfig& recipe,
+                                 const std::vector<std::string>& view_names);
+
 }  // namespace sift_hull

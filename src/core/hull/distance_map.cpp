@@ -6,6 +6,7 @@
 #include <cmath>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
+#include <utility>
 
 #include "hull/distance_kernel.h"
 
@@ -86,16 +87,32 @@ SignedDistanceMap::SignedDistanceMap(const cv::Mat& mask, const SilhouetteBounds
   }
 }
 
+SignedDistanceMap::SignedDistanceMap(cv::Mat distance_px, cv::Size image_size, cv::Point origin,
+                                     int reduction, float error_px)
+    : distance_px_(std::move(distance_px)),
+      image_size_(image_size),
+      origin_(origin),
+      reduction_(reduction),
+      error_px_(error_px) {
+  if (distance_px_.type() != CV_32FC1 || distance_px_.rows < 2 || distance_px_.cols < 2 ||
+      !distance_px_.isContinuous() || reduction < 1) {
+    throw std::invalid_argument("SignedDistanceMap: not a continuous CV_32FC1 map of 2x2 or more");
+  }
+}
+
 SignedDistanceMap SignedDistanceMap::undistorted(const PinholeCamera& camera) const {
   if (!camera.distorted()) return *this;
-  const Eigen::Vector2d raw_min(origin_.x, origin_.y);
-  const Eigen::Vector2d raw_max(origin_.x + distance_px_.cols - 1,
-                                origin_.y + distance_px_.rows - 1);
+  // Element (c, r) of a map lies at image pixel origin + (c, r) * s + (s - 1) / 2, here and in
+  // the result, whose pixels are ideal ones.
+  const double s = reduction_, first_sample = 0.5 * (s - 1.0);
+  const Eigen::Vector2d raw_min(origin_.x + first_sample, origin_.y + first_sample);
+  const Eigen::Vector2d raw_max =
+      raw_min + s * Eigen::Vector2d(distance_px_.cols - 1, distance_px_.rows - 1);
   const auto [low, high] = camera.undistortedBounds(raw_min, raw_max);
-  const cv::Point first(static_cast<int>(std::floor(low.x())) - 1,
-                        static_cast<int>(std::floor(low.y())) - 1);
-  const double width = std::ceil(high.x()) + 2 - first.x,
-               height = std::ceil(high.y()) + 2 - first.y;
+  const cv::Point first(static_cast<int>(std::floor(low.x() - first_sample - s)),
+                        static_cast<int>(std::floor(low.y() - first_sample - s)));
+  const double width = std::ceil((high.x() - first.x - first_sample) / s) + 2,
+               height = std::ceil((high.y() - first.y - first_sample) / s) + 2;
   if (!(width * height <= 4.0 * distance_px_.total() + 1e4)) {
     throw std::invalid_argument(
         "the lens distortion maps the silhouette's window onto an ideal image more than four "
@@ -104,6 +121,8 @@ SignedDistanceMap SignedDistanceMap::undistorted(const PinholeCamera& camera) co
   SignedDistanceMap result;
   result.image_size_ = image_size_;
   result.origin_ = first;
+  result.reduction_ = reduction_;
+  result.error_px_ = error_px_;
   cv::Mat map_u(static_cast<int>(height), static_cast<int>(width), CV_32FC1);
   cv::Mat map_v(map_u.size(), CV_32FC1);
   const Eigen::Matrix3d& K = camera.K();
@@ -114,10 +133,11 @@ SignedDistanceMap SignedDistanceMap::undistorted(const PinholeCamera& camera) co
     float* u = map_u.ptr<float>(row);
     float* v = map_v.ptr<float>(row);
     for (int col = 0; col < map_u.cols; ++col) {
-      const Eigen::Vector2d ideal(first.x + col, first.y + row);
+      const Eigen::Vector2d ideal(first.x + first_sample + s * col,
+                                  first.y + first_sample + s * row);
       const Eigen::Vector2d raw = camera.distortPixel(ideal);
-      u[col] = static_cast<float>(raw.x() - origin_.x);
-      v[col] = static_cast<float>(raw.y() - origin_.y);
+      u[col] = static_cast<float>((raw.x() - origin_.x - first_sample) / s);
+      v[col] = static_cast<float>((raw.y() - origin_.y - first_sample) / s);
       if (row % 4 == 0 && col % 4 == 0) {
         const Eigen::Vector2d normalised = (K_inverse * ideal.homogeneous()).hnormalized();
         const Eigen::Matrix2d J =
@@ -133,10 +153,13 @@ SignedDistanceMap SignedDistanceMap::undistorted(const PinholeCamera& camera) co
 }
 
 float SignedDistanceMap::at(double u_px, double v_px) const {
+  // Map coordinates of an image pixel: (u - first sample's u) / reduction.
+  const double first_sample = 0.5 * (reduction_ - 1);
   return detail::lookUp(distance_px_.ptr<float>(), distance_px_.cols,
                         detail::lookUpLimit(distance_px_.cols),
                         detail::lookUpLimit(distance_px_.rows),
-                        static_cast<float>(u_px - origin_.x), static_cast<float>(v_px - origin_.y));
+                        static_cast<float>((u_px - origin_.x - first_sample) / reduction_),
+                        static_cast<float>((v_px - origin_.y - first_sample) / reduction_));
 }
 
 }  // namespace sift_hull

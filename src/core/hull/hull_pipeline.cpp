@@ -2,9 +2,12 @@
 
 #include <algorithm>
 #include <chrono>
+#include <memory>
 #include <stdexcept>
 
+#include "common/parallel.h"
 #include "sift_hull/hull/bounding_box.h"
+#include "sift_hull/hull/reduced_distance_map.h"
 
 namespace sift_hull {
 namespace {
@@ -13,6 +16,30 @@ using Clock = std::chrono::steady_clock;
 
 double millisecondsSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+/// The input's silhouettes run-length encoded (those given as images on `threads` threads).
+std::vector<RunLengthMask> encodedMasks(const HullInput& input, int threads) {
+  if (input.masks.empty()) return input.run_length_masks;
+  std::vector<RunLengthMask> encoded(input.masks.size());
+  detail::parallelFor(encoded.size(), threads,
+                      [&](size_t i) { encoded[i] = RunLengthMask(input.masks[i]); });
+  return encoded;
+}
+
+/// The views of a box, each with the distance reduction distanceReduction() chooses for it.
+std::vector<HullView> viewsFor(const HullInput& input, std::vector<RunLengthMask>* masks,
+                               const Box3d& box, const HullConfig& config) {
+  std::vector<std::unique_ptr<HullView>> made(masks->size());
+  detail::parallelFor(made.size(), config.threads, [&](size_t i) {
+    const int reduction = distanceReduction(input.cameras[i], (*masks)[i].size(), box, config);
+    made[i] = std::make_unique<HullView>(input.names[i], input.cameras[i], std::move((*masks)[i]),
+                                         config, reduction);
+  });
+  std::vector<HullView> views;
+  views.reserve(made.size());
+  for (auto& view : made) views.push_back(std::move(*view));
+  return views;
 }
 
 }  // namespace
@@ -33,13 +60,25 @@ HullResult buildHull(const HullInput& input, const HullConfig& config,
                      const std::optional<Box3d>& box) {
   validate(config);
   HullTimings time;
+  const size_t count = input.viewCount();
+  if (input.names.size() != count || input.cameras.size() != count) {
+    throw std::invalid_argument("buildHull: names, cameras and masks differ in count");
+  }
   const Clock::time_point start = Clock::now();
-  std::vector<HullView> views = makeHullViews(input.names, input.cameras, input.masks, config);
-  time.distance_ms = millisecondsSince(start);
+  std::vector<RunLengthMask> masks = encodedMasks(input, config.threads);
+  std::vector<SilhouetteBounds> bounds(count);
+  detail::parallelFor(count, config.threads, [&](size_t i) {
+    bounds[i] = viewBounds(input.names[i], input.cameras[i], masks[i], config);
+  });
+  time.masks_ms = millisecondsSince(start);
 
   Clock::time_point stage = Clock::now();
-  const Box3d hull_box = box ? *box : boundingBoxOf(views);
+  const Box3d hull_box = box ? *box : hullBoundingBox(input.cameras, bounds, input.names);
   time.bbox_ms = millisecondsSince(stage);
+
+  stage = Clock::now();
+  std::vector<HullView> views = viewsFor(input, &masks, hull_box, config);
+  time.distance_ms = millisecondsSince(stage);
 
   stage = Clock::now();
   VisualHull hull(hull_box, config);

@@ -12,6 +12,7 @@
 
 #include "common/parallel.h"
 #include "hull/distance_kernel.h"
+#include "sift_hull/hull/reduced_distance_map.h"
 #include "sift_hull/limits.h"
 
 namespace sift_hull {
@@ -41,21 +42,22 @@ bool withinBounds(const SilhouetteBounds& bounds, double u, double v) {
 }
 
 /// The raw image with the distance map's padding, as a raw pixel rectangle (min, max).
-std::pair<Eigen::Vector2d, Eigen::Vector2d> paddedImage(const cv::Mat& mask, int padding_px) {
+std::pair<Eigen::Vector2d, Eigen::Vector2d> paddedImage(cv::Size size, int padding_px) {
   const double pad = padding_px + 0.5;
-  return {Eigen::Vector2d(-pad, -pad), Eigen::Vector2d(mask.cols - 1 + pad, mask.rows - 1 + pad)};
+  return {Eigen::Vector2d(-pad, -pad),
+          Eigen::Vector2d(size.width - 1 + pad, size.height - 1 + pad)};
 }
 
 /// Throws std::invalid_argument when the view's distortion cannot be inverted over its padded
 /// image: the coefficients do not describe a lens for an image of this size.
-void checkDistortion(const std::string& name, const PinholeCamera& camera, const cv::Mat& mask,
+void checkDistortion(const std::string& name, const PinholeCamera& camera, cv::Size size,
                      int padding_px) {
   if (!camera.distorted()) return;
-  const auto [low, high] = paddedImage(mask, padding_px);
+  const auto [low, high] = paddedImage(size, padding_px);
   if (!camera.distortionInvertibleOver(low, high)) {
     throw std::invalid_argument("view '" + name + "': its lens distortion " +
-                                "folds over within its " + std::to_string(mask.cols) + "x" +
-                                std::to_string(mask.rows) +
+                                "folds over within its " + std::to_string(size.width) + "x" +
+                                std::to_string(size.height) +
                                 " image (no one-to-one undistortion): check the coefficients and "
                                 "the image size");
   }
@@ -88,20 +90,45 @@ SilhouetteBounds idealBounds(const SilhouetteBounds& raw, const PinholeCamera& c
   return bounds;
 }
 
+/// idealBounds of a run-length mask, decoded for the contours only when the camera is distorted.
+SilhouetteBounds idealBounds(const SilhouetteBounds& raw, const PinholeCamera& camera,
+                             const RunLengthMask& mask) {
+  if (raw.empty || !camera.distorted()) return raw;
+  return idealBounds(raw, camera, mask.decode());
+}
+
 }  // namespace
 
 HullView::HullView(std::string name, const PinholeCamera& camera, const cv::Mat& mask,
                    const HullConfig& config)
     : name_(std::move(name)),
       camera_(camera),
-      mask_(
-          (checkMask(mask), checkDistortion(name_, camera, mask, config.padding_px), mask.clone())),
+      mask_((checkMask(mask), checkDistortion(name_, camera, mask.size(), config.padding_px),
+             RunLengthMask(mask))),
       bounds_(idealBounds(silhouetteBounds(mask, config.carve_outside_image), camera, mask)),
       distance_(SignedDistanceMap(mask, silhouetteBounds(mask, config.carve_outside_image),
                                   config.padding_px)
                     .undistorted(camera)),
       carves_behind_(bounds_.empty || bounds_.boundedSides() > 0),
       kernel_(std::make_unique<detail::DistanceKernel>(makeKernel(config))) {}
+
+HullView::HullView(std::string name, const PinholeCamera& camera, RunLengthMask mask,
+                   const HullConfig& config, int distance_reduction)
+    : name_(std::move(name)),
+      camera_(camera),
+      mask_(std::move(mask)),
+      bounds_(viewBounds(name_, camera, mask_, config)),
+      distance_(reducedSignedDistanceMap(mask_, silhouetteBounds(mask_, config.carve_outside_image),
+                                         config.padding_px, distance_reduction)
+                    .undistorted(camera)),
+      carves_behind_(bounds_.empty || bounds_.boundedSides() > 0),
+      kernel_(std::make_unique<detail::DistanceKernel>(makeKernel(config))) {}
+
+SilhouetteBounds viewBounds(const std::string& name, const PinholeCamera& camera,
+                            const RunLengthMask& mask, const HullConfig& config) {
+  checkDistortion(name, camera, mask.size(), config.padding_px);
+  return idealBounds(silhouetteBounds(mask, config.carve_outside_image), camera, mask);
+}
 
 HullView::HullView(const HullView& other)
     : name_(other.name_),
@@ -128,18 +155,24 @@ detail::DistanceKernel HullView::makeKernel(const HullConfig& config) const {
   const Eigen::Matrix3d& R = camera_.R();
   for (int i = 0; i < 9; ++i) kernel.R[i] = static_cast<float>(R(i / 3, i % 3));
   for (int i = 0; i < 3; ++i) kernel.t[i] = static_cast<float>(camera_.t()(i));
+  // Map column = (u - first sample's u) / reduction: K scaled by 1 / reduction, the first
+  // sample's offset in offset_u / offset_v. The map's values and k_norm stay in image pixels.
   const Eigen::Matrix3d& K = camera_.K();
-  kernel.fx = K(0, 0), kernel.skew = K(0, 1), kernel.cx = K(0, 2);
-  kernel.fy = K(1, 1), kernel.cy = K(1, 2);
+  const double reduction = distance_.reduction();
+  kernel.fx = K(0, 0) / reduction, kernel.skew = K(0, 1) / reduction;
+  kernel.cx = K(0, 2) / reduction;
+  kernel.fy = K(1, 1) / reduction, kernel.cy = K(1, 2) / reduction;
   // The map's values change by up to lipschitz() raw pixels per ideal pixel (1 without distortion).
   kernel.k_norm = static_cast<float>(spectralNorm2x2(K)) * distance_.lipschitz();
-  kernel.slack_px = static_cast<float>(config.distance_slack_px) * distance_.lipschitz();
+  kernel.slack_px = static_cast<float>(config.distance_slack_px + distance_.errorBound_px()) *
+                    distance_.lipschitz();
   kernel.behind_value = carves_behind_ ? kFarOutside_px : -kFarOutside_px;
   const cv::Mat& map = distance_.map();
   kernel.map = map.ptr<float>();
   kernel.stride = map.cols;
-  kernel.offset_u = static_cast<float>(-distance_.origin().x);
-  kernel.offset_v = static_cast<float>(-distance_.origin().y);
+  const double first_sample = 0.5 * (reduction - 1);
+  kernel.offset_u = static_cast<float>(-(distance_.origin().x + first_sample) / reduction);
+  kernel.offset_v = static_cast<float>(-(distance_.origin().y + first_sample) / reduction);
   kernel.u_high = detail::lookUpLimit(map.cols), kernel.v_high = detail::lookUpLimit(map.rows);
   return kernel;
 }
@@ -185,10 +218,10 @@ bool HullView::keeps(const Eigen::Vector3d& X_W) const {
   const Eigen::Vector2d pixel = pixelOf(X_C);
   const Eigen::Vector2d raw = camera_.distortPixel(pixel);
   const long u = std::lround(raw.x()), v = std::lround(raw.y());
-  if (u < 0 || v < 0 || u >= mask_.cols || v >= mask_.rows) {
+  if (u < 0 || v < 0 || u >= mask_.size().width || v >= mask_.size().height) {
     return withinBounds(bounds_, pixel.x(), pixel.y());
   }
-  return mask_.at<uint8_t>(static_cast<int>(v), static_cast<int>(u)) != 0;
+  return mask_.at(static_cast<int>(u), static_cast<int>(v));
 }
 
 void HullView::maxInto(const PointBatch& points, float* values) const {

@@ -9,6 +9,7 @@
 #include <thread>
 
 #include "common/parallel.h"
+#include "sift_hull/hull/reduced_distance_map.h"
 #include "sift_hull/limits.h"
 
 namespace sift_hull {
@@ -403,6 +404,8 @@ void validate(const HullConfig& config) {
   }
   limits::requireInRange("HullConfig::padding_px", config.padding_px, 1, limits::kMaxPaddingPx);
   limits::requireInRange("HullConfig::threads", config.threads, 1, limits::kMaxThreads);
+  limits::requireInRange("HullConfig::distance_reduction", config.distance_reduction, 0,
+                         kMaxDistanceReduction);
 }
 
 HullCube HullCube::around(const Box3d& box, int depth) {

@@ -283,6 +283,20 @@ std::vector<std::string> silhouetteWarnings(const std::vector<std::string>& name
   return warnings;
 }
 
+std::vector<std::string> runLengthSilhouetteWarnings(const std::vector<std::string>& names,
+                                                     const std::vector<RunLengthMask>& masks) {
+  if (names.size() != masks.size()) {
+    throw std::invalid_argument("silhouetteWarnings: one name per mask");
+  }
+  std::vector<std::string> warnings;
+  for (size_t i = 0; i < masks.size(); ++i) {
+    const std::vector<std::string> found = silhouetteWarnings(
+        std::vector<std::string>{names[i]}, std::vector<cv::Mat>{masks[i].decode()});
+    warnings.insert(warnings.end(), found.begin(), found.end());
+  }
+  return warnings;
+}
+
 std::vector<std::string> disagreeingViewWarnings(const std::vector<std::string>& names,
                                                  const std::vector<double>& reprojection_iou) {
   if (names.size() != reprojection_iou.size()) {

@@ -43,15 +43,19 @@ cv::Mat loadMask(const std::string& path) {
   return mask;
 }
 
-std::vector<cv::Mat> loadSilhouettes(const std::vector<CalibratedView>& views,
-                                     const std::string& image_directory,
-                                     const std::string& mask_directory,
-                                     const SilhouetteConfig& recipe) {
+namespace {
+
+/// loadSilhouettes, each silhouette converted by `keep` (cv::Mat -> Kept) as soon as it is made.
+template <typename Kept, typename Keep>
+std::vector<Kept> loadSilhouettesAs(const std::vector<CalibratedView>& views,
+                                    const std::string& image_directory,
+                                    const std::string& mask_directory,
+                                    const SilhouetteConfig& recipe, const Keep& keep) {
   // Each view read and its silhouette made on OpenCV's threads, one image in memory per thread;
   // then the checks in view order, so the first error is the one a sequential read would meet.
   struct Loaded {
-    cv::Size image_size;
-    cv::Mat silhouette;
+    cv::Size image_size, silhouette_size;
+    Kept silhouette;
     std::exception_ptr error;
   };
   std::vector<Loaded> loaded(views.size());
@@ -60,15 +64,17 @@ std::vector<cv::Mat> loadSilhouettes(const std::vector<CalibratedView>& views,
       try {
         const cv::Mat image = loadViewImage(image_directory, views[i]);
         loaded[i].image_size = image.size();
-        loaded[i].silhouette = mask_directory.empty()
-                                   ? silhouetteFromImage(image, recipe)
-                                   : loadMask(mask_directory + "/" + views[i].name);
+        const cv::Mat silhouette = mask_directory.empty()
+                                       ? silhouetteFromImage(image, recipe)
+                                       : loadMask(mask_directory + "/" + views[i].name);
+        loaded[i].silhouette_size = silhouette.size();
+        loaded[i].silhouette = keep(silhouette);
       } catch (...) {
         loaded[i].error = std::current_exception();
       }
     }
   });
-  std::vector<cv::Mat> silhouettes;
+  std::vector<Kept> silhouettes;
   for (size_t i = 0; i < views.size(); ++i) {
     const CalibratedView& view = views[i];
     // A sequential read meets a bad image, then a size other than the first's, then a bad mask.
@@ -83,13 +89,32 @@ std::vector<cv::Mat> loadSilhouettes(const std::vector<CalibratedView>& views,
                                "): one calibration set is for one image size");
     }
     if (loaded[i].error) std::rethrow_exception(loaded[i].error);
-    if (loaded[i].silhouette.size() != size) {
+    if (loaded[i].silhouette_size != size) {
       throw std::runtime_error(mask_directory + "/" + view.name +
                                ": mask size differs from the image's");
     }
     silhouettes.push_back(std::move(loaded[i].silhouette));
   }
   return silhouettes;
+}
+
+}  // namespace
+
+std::vector<cv::Mat> loadSilhouettes(const std::vector<CalibratedView>& views,
+                                     const std::string& image_directory,
+                                     const std::string& mask_directory,
+                                     const SilhouetteConfig& recipe) {
+  return loadSilhouettesAs<cv::Mat>(views, image_directory, mask_directory, recipe,
+                                    [](const cv::Mat& silhouette) { return silhouette; });
+}
+
+std::vector<RunLengthMask> loadRunLengthSilhouettes(const std::vector<CalibratedView>& views,
+                                                    const std::string& image_directory,
+                                                    const std::string& mask_directory,
+                                                    const SilhouetteConfig& recipe) {
+  return loadSilhouettesAs<RunLengthMask>(
+      views, image_directory, mask_directory, recipe,
+      [](const cv::Mat& silhouette) { return RunLengthMask(silhouette); });
 }
 
 }  // namespace sift_hull

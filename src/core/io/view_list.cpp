@@ -43,17 +43,45 @@ std::vector<std::string> readViewList(const std::string& path) {
   return names;
 }
 
+namespace {
+
+/// The selected views of a calibration file (loadHullInput).
+std::vector<CalibratedView> hullViews(const std::string& calibration_path,
+                                      const std::string& image_directory,
+                                      const std::vector<std::string>& view_names) {
+  return selectViews(readCalibrationWithImages(calibration_path, image_directory), view_names,
+                     calibration_path);
+}
+
+void addCameras(const std::vector<CalibratedView>& views, HullInput* input) {
+  for (const CalibratedView& view : views) {
+    input->names.push_back(view.name);
+    input->cameras.push_back(view.camera);
+  }
+}
+
+}  // namespace
+
 HullInput loadHullInput(const std::string& calibration_path, const std::string& image_directory,
                         const std::string& mask_directory, const SilhouetteConfig& recipe,
                         const std::vector<std::string>& view_names) {
-  const std::vector<CalibratedView> views = selectViews(
-      readCalibrationWithImages(calibration_path, image_directory), view_names, calibration_path);
+  const std::vector<CalibratedView> views =
+      hullViews(calibration_path, image_directory, view_names);
   HullInput input;
   input.masks = loadSilhouettes(views, image_directory, mask_directory, recipe);
-  for (const CalibratedView& view : views) {
-    input.names.push_back(view.name);
-    input.cameras.push_back(view.camera);
-  }
+  addCameras(views, &input);
+  return input;
+}
+
+HullInput loadRunLengthHullInput(const std::string& calibration_path,
+                                 const std::string& image_directory,
+                                 const std::string& mask_directory, const SilhouetteConfig& recipe,
+                                 const std::vector<std::string>& view_names) {
+  const std::vector<CalibratedView> views =
+      hullViews(calibration_path, image_directory, view_names);
+  HullInput input;
+  input.run_length_masks = loadRunLengthSilhouettes(views, image_directory, mask_directory, recipe);
+  addCameras(views, &input);
   return input;
 }
 

@@ -123,6 +123,7 @@ HullConfig readHullConfig(const ros::NodeHandle& private_nh) {
   read(private_nh, "carve_outside_image", &config.carve_outside_image);
   readRenamed(private_nh, "distance_slack_px", "slack_px", &config.distance_slack_px);
   read(private_nh, "threads", &config.threads);
+  read(private_nh, "distance_reduction", &config.distance_reduction);
   validate(config);
   return config;
 }

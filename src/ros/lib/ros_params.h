@@ -35,7 +35,7 @@ double descriptorDistanceParam(double distance);
 /// ~threshold (grey level in [0, 1]), ~dilate_px, ~erode_px: the Middlebury silhouette recipe.
 SilhouetteConfig readSilhouetteConfig(const ros::NodeHandle& private_nh);
 
-/// ~max_depth, ~carve_outside_image, ~distance_slack_px, ~threads.
+/// ~max_depth, ~carve_outside_image, ~distance_slack_px, ~threads, ~distance_reduction.
 /// Deprecated: ~depth (~max_depth), ~slack_px (~distance_slack_px).
 HullConfig readHullConfig(const ros::NodeHandle& private_nh);
 
