@@ -21,6 +21,7 @@ set(SIFT_HULL_CORE_SOURCES
   src/core/hull/bounding_box.cpp
   src/core/hull/distance_kernel.cpp
   src/core/hull/distance_map.cpp
+  src/core/hull/field_sampling.cpp
   src/core/hull/hull_octomap.cpp
   src/core/hull/hull_pipeline.cpp
   src/core/hull/hull_stream.cpp

@@ -132,6 +132,28 @@ TEST_F(SphereHull, MeshLiesNearTheSphere) {
   EXPECT_LT(meanDistanceToSphere(result_->mesh, Eigen::Vector3d::Zero(), 0.8), 2.0 * voxel);
 }
 
+TEST(VisualHull, SampledFieldIsTheMaximumOverEveryView) {
+  // sampleField looks up only the views that can hold the maximum in each tile of 8 voxels;
+  // valueAt looks up every view. At depth 8 a tile spans a few pixels, so most of the 24 views
+  // are left out near the surface, where the points are taken.
+  HullConfig config;
+  config.max_depth = 8;
+  const HullResult result = buildHull(test::ring(24), config);
+  std::vector<Eigen::Vector3d> points;
+  for (size_t i = 0; i < result.mesh.vertices_W.size(); i += 5) {
+    const Eigen::Vector3d vertex = result.mesh.vertices_W[i].cast<double>();
+    for (double scale : {0.98, 1.0, 1.02}) points.push_back(scale * vertex);
+  }
+  std::vector<float> sampled;
+  result.hull.sampleField(points, &sampled);
+  ASSERT_EQ(sampled.size(), points.size());
+  size_t differing = 0;
+  for (size_t i = 0; i < points.size(); ++i) {
+    differing += sampled[i] != result.hull.valueAt(points[i]);
+  }
+  EXPECT_EQ(differing, 0u) << "of " << points.size();
+}
+
 TEST_F(SphereHull, OctomapHoldsTheOccupiedCells) {
   const std::unique_ptr<octomap::OcTree> tree = toOctomap(result_->hull);
   EXPECT_DOUBLE_EQ(tree->getResolution(), result_->hull.cube().resolution_m);

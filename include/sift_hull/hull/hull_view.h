@@ -79,6 +79,11 @@ class HullView {
   void classifyBalls(const PointBatch& centres, float radius_m, float* values, uint32_t* out_bits,
                      uint32_t* in_bits) const;
 
+  /// The distance at a centre (local frame) and `reach`, the most it can change within
+  /// `radius` (local units) of it: the ball's projected radius plus the slack, the bound
+  /// classifyBalls uses; infinite when the ball reaches the camera's plane.
+  void ballBound(float x, float y, float z, float radius, float* value, float* reach) const;
+
   static constexpr float kFarOutside_px = 1e6f;
 
   /// The frame of the batched look-ups: X_local = (X_W - origin_W) / scale. Single-precision

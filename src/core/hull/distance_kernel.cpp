@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace sift_hull {
 namespace detail {
@@ -168,6 +169,19 @@ void maxDistances(const DistanceKernel& kernel, const PointBatch& points, float*
   for (size_t i = 0; i < points.count; ++i) {
     values[i] = std::max(values[i], project(kernel, points.x[i], points.y[i], points.z[i]).value);
   }
+}
+
+void ballBound(const DistanceKernel& kernel, float x, float y, float z, float radius, float* value,
+               float* reach) {
+  const Projected p = project(kernel, x, y, z);
+  *value = p.value;
+  const float clearance = p.z - radius;
+  if (!(clearance > 0.0f)) {
+    *reach = std::numeric_limits<float>::infinity();
+    return;
+  }
+  const float norm = std::sqrt(p.x * p.x + p.y * p.y + p.z * p.z);
+  *reach = kernel.k_norm * norm * radius / (p.z * clearance) + kernel.slack_px;
 }
 
 void classifyBalls(const DistanceKernel& kernel, const PointBatch& centres, float radius,

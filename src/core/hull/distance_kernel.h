@@ -50,6 +50,10 @@ inline float lookUp(const float* map, int stride, float u_high, float v_high, fl
 /// values[i] = max(values[i], distance look-up of point i) for one view (HullView::maxInto).
 void maxDistances(const DistanceKernel& kernel, const PointBatch& points, float* values);
 
+/// The distance at a centre and the most it changes within `radius` of it (HullView::ballBound).
+void ballBound(const DistanceKernel& kernel, float x, float y, float z, float radius, float* value,
+               float* reach);
+
 /// The ball verdicts of one view for up to 32 centres (HullView::classifyBalls).
 void classifyBalls(const DistanceKernel& kernel, const PointBatch& centres, float radius,
                    float* values, uint32_t* out_bits, uint32_t* in_bits);

@@ -228,6 +228,11 @@ void HullView::maxInto(const PointBatch& points, float* values) const {
   detail::maxDistances(*kernel_, points, values);
 }
 
+void HullView::ballBound(float x, float y, float z, float radius, float* value,
+                         float* reach) const {
+  detail::ballBound(*kernel_, x, y, z, radius, value, reach);
+}
+
 void HullView::classifyBalls(const PointBatch& centres, float radius_m, float* values,
                              uint32_t* out_bits, uint32_t* in_bits) const {
   if (centres.count > 32) throw std::invalid_argument("classifyBalls: more than 32 centres");

@@ -9,10 +9,15 @@
 #include <thread>
 
 #include "common/parallel.h"
+#include "hull/field_sampling.h"
 #include "sift_hull/hull/reduced_distance_map.h"
 #include "sift_hull/limits.h"
 
 namespace sift_hull {
+namespace {
+/// The edge, in finest voxels, of the tiles sampleField culls views in.
+constexpr double kFieldTileVoxels = 8.0;
+}  // namespace
 namespace detail {
 
 struct OctreeNode {
@@ -352,23 +357,16 @@ float VisualHull::valueAt(const Eigen::Vector3d& X_W) const {
 void VisualHull::sampleField(const std::vector<Eigen::Vector3d>& points_W,
                              std::vector<float>* values) const {
   values->resize(points_W.size());
-  constexpr size_t kChunk = 4096;
-  const size_t chunks = (points_W.size() + kChunk - 1) / kChunk;
-  // View by view within a chunk, as single-precision coordinates for the batched look-ups.
-  detail::parallelFor(chunks, config_.threads, [&](size_t chunk) {
-    const size_t begin = chunk * kChunk, end = std::min(points_W.size(), begin + kChunk);
-    std::vector<float> x, y, z;
-    for (size_t i = begin; i < end; ++i) {
-      const Eigen::Vector3d X_local = (points_W[i] - frame_origin_W_) / frame_scale_;
-      x.push_back(static_cast<float>(X_local.x()));
-      y.push_back(static_cast<float>(X_local.y()));
-      z.push_back(static_cast<float>(X_local.z()));
-    }
-    float* values_out = values->data() + begin;
-    std::fill(values_out, values_out + (end - begin), -HullView::kFarOutside_px);
-    for (const HullView& view : views_)
-      view.maxInto({x.data(), y.data(), z.data(), end - begin}, values_out);
-  });
+  std::vector<float> x(points_W.size()), y(points_W.size()), z(points_W.size());
+  for (size_t i = 0; i < points_W.size(); ++i) {
+    const Eigen::Vector3d X_local = (points_W[i] - frame_origin_W_) / frame_scale_;
+    x[i] = static_cast<float>(X_local.x());
+    y[i] = static_cast<float>(X_local.y());
+    z[i] = static_cast<float>(X_local.z());
+  }
+  // Tiles of kFieldTileVoxels finest voxels: in each, only the views that can hold the maximum.
+  const double tile_edge = kFieldTileVoxels * cube_.resolution_m / frame_scale_;
+  detail::sampleMaxField(views_, x, y, z, tile_edge, config_.threads, values->data());
 }
 
 SurfaceCells VisualHull::surfaceCells() const {
