@@ -44,6 +44,11 @@ std::vector<std::string> viewsSeeingBoxBehind(const Box3d& box,
 /// it). Throws std::invalid_argument for an empty Mat or another type.
 SilhouetteBounds silhouetteBounds(const cv::Mat& mask, bool border_bounds_object);
 
+/// The bounds of a silhouette whose inside pixels span the rectangle `inside` (empty: none) of an
+/// image of `image_size`, as silhouetteBounds gives them.
+SilhouetteBounds boundsOfInside(const cv::Rect& inside, cv::Size image_size,
+                                bool border_bounds_object);
+
 /// Why no bounding box exists.
 class HullBoxError : public std::runtime_error {
  public:

@@ -264,8 +264,13 @@ std::vector<std::string> viewsSeeingBoxBehind(const Box3d& box,
 SilhouetteBounds silhouetteBounds(const cv::Mat& mask, bool border_bounds_object) {
   if (mask.empty()) throw std::invalid_argument("silhouetteBounds: the mask is empty");
   if (mask.type() != CV_8UC1) throw std::invalid_argument("silhouetteBounds: mask is not CV_8UC1");
+  // cv::boundingRect of a CV_8UC1 image: the rectangle of its non-zero pixels.
+  return boundsOfInside(cv::boundingRect(mask), mask.size(), border_bounds_object);
+}
+
+SilhouetteBounds boundsOfInside(const cv::Rect& inside, cv::Size image_size,
+                                bool border_bounds_object) {
   SilhouetteBounds bounds;
-  const cv::Rect inside = cv::boundingRect(mask);  // of the non-zero pixels of a CV_8UC1 image
   if (inside.empty()) return bounds;
   bounds.empty = false;
   bounds.u_min_px = inside.x - 0.5;
@@ -273,9 +278,9 @@ SilhouetteBounds silhouetteBounds(const cv::Mat& mask, bool border_bounds_object
   bounds.v_min_px = inside.y - 0.5;
   bounds.v_max_px = inside.y + inside.height - 0.5;
   bounds.has_u_min = border_bounds_object || inside.x > 0;
-  bounds.has_u_max = border_bounds_object || inside.x + inside.width < mask.cols;
+  bounds.has_u_max = border_bounds_object || inside.x + inside.width < image_size.width;
   bounds.has_v_min = border_bounds_object || inside.y > 0;
-  bounds.has_v_max = border_bounds_object || inside.y + inside.height < mask.rows;
+  bounds.has_v_max = border_bounds_object || inside.y + inside.height < image_size.height;
   return bounds;
 }
 

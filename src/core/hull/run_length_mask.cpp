@@ -83,20 +83,7 @@ cv::Rect RunLengthMask::insideBounds() const {
 
 SilhouetteBounds silhouetteBounds(const RunLengthMask& mask, bool border_bounds_object) {
   if (mask.empty()) throw std::invalid_argument("silhouetteBounds: the mask is empty");
-  SilhouetteBounds bounds;
-  const cv::Rect inside = mask.insideBounds();
-  if (inside.empty()) return bounds;
-  // As silhouetteBounds(const cv::Mat&, bool).
-  bounds.empty = false;
-  bounds.u_min_px = inside.x - 0.5;
-  bounds.u_max_px = inside.x + inside.width - 0.5;
-  bounds.v_min_px = inside.y - 0.5;
-  bounds.v_max_px = inside.y + inside.height - 0.5;
-  bounds.has_u_min = border_bounds_object || inside.x > 0;
-  bounds.has_u_max = border_bounds_object || inside.x + inside.width < mask.size().width;
-  bounds.has_v_min = border_bounds_object || inside.y > 0;
-  bounds.has_v_max = border_bounds_object || inside.y + inside.height < mask.size().height;
-  return bounds;
+  return boundsOfInside(mask.insideBounds(), mask.size(), border_bounds_object);
 }
 
 }  // namespace sift_hull

@@ -37,7 +37,7 @@ constexpr double kMinClusterShare = 0.005;
 /// The border band's width as a share of the image's smaller side.
 constexpr double kBorderFraction = 0.03;
 /// The least colour distance (CIE Lab units) taken for the object, and the factor on the border
-/// band's spread of distances the threshold lies above (see distanceThreshold).
+/// band's spread of distances the threshold lies above (see borderSpread).
 constexpr float kMinObjectDistance = 3.0f;
 constexpr float kSpreadFactor = 3.0f;
 /// The largest spread of the border band's colour distances (CIE Lab) for which the border's
