@@ -101,6 +101,7 @@ TEST(DistortedScene, ReducedDistanceMapsKeepTheHullOfADistortedHighResolutionSet
   reduced.distance_reduction = 3;
   const HullResult a = buildHull(input, full);
   const HullResult b = buildHull(input, reduced, a.box);
+  ASSERT_EQ(b.hull.views()[0].distanceReduction(), 3);
   const double iou_full = reprojectionIoU(a.mesh, a.hull.views()).mean;
   const double iou_reduced = reprojectionIoU(b.mesh, b.hull.views()).mean;
   EXPECT_GT(iou_full, 0.98);

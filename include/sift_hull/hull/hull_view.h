@@ -31,10 +31,13 @@ struct PointBatch {
   size_t count;
 };
 
-/// One calibrated silhouette, ready for carving.
+/// One calibrated silhouette, ready for carving. With a distorted camera the distance map is
+/// resampled onto ideal pixels (SignedDistanceMap::undistorted) and the bounds are those of the
+/// undistorted silhouette (viewBounds), so that carving and the LP use the ideal pinhole.
 class HullView {
  public:
-  /// Throws std::invalid_argument for a mask that is not a non-empty CV_8UC1.
+  /// Throws std::invalid_argument for a mask that is not a non-empty CV_8UC1, or a camera whose
+  /// lens distortion folds over within the image (naming the view).
   HullView(std::string name, const PinholeCamera& camera, const cv::Mat& mask,
            const HullConfig& config);
   /// A view whose distance map is sampled every `distance_reduction` pixels
@@ -59,7 +62,8 @@ class HullView {
   int distanceReduction() const { return distance_.reduction(); }
   /// The distance map's error bound, added to the slack (SignedDistanceMap::errorBound_px()).
   float distanceErrorBound_px() const { return distance_.errorBound_px(); }
-  /// The silhouette's 2-D bounds; open sides where the border cuts it, unless carving outside.
+  /// The silhouette's 2-D bounds in ideal pixels (viewBounds); open sides where the border cuts
+  /// it, unless carving outside.
   const SilhouetteBounds& bounds() const { return bounds_; }
   cv::Size imageSize() const { return mask_.size(); }
 
