@@ -3,6 +3,7 @@
 // (bench_hull_synthetic.h), in one run; medians of repeated runs.
 
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
@@ -235,6 +236,9 @@ int runBenchHull(const std::vector<std::string>& args) {
   parser.addFlag("skip-synthetic", "leave the synthetic case out");
   parser.addOption("synthetic-views", "N", "views of the synthetic case",
                    std::to_string(SyntheticHullCase().views));
+  parser.addOption("synthetic-size", "WxH", "image size of the synthetic case",
+                   std::to_string(SyntheticHullCase().width_px) + "x" +
+                       std::to_string(SyntheticHullCase().height_px));
   if (!parser.parse(args)) return 0;
   if (parser.flag("synthetic-only") && parser.flag("skip-synthetic")) {
     throw UsageError("--synthetic-only and --skip-synthetic exclude each other");
@@ -247,6 +251,15 @@ int runBenchHull(const std::vector<std::string>& args) {
     SyntheticHullCase synthetic_case;
     synthetic_case.views = parser.getInt("synthetic-views");
     if (synthetic_case.views < 2) throw UsageError("--synthetic-views must be at least 2");
+    const std::string size = parser.get("synthetic-size");
+    char tail = 0;
+    if (std::sscanf(size.c_str(), "%dx%d%c", &synthetic_case.width_px, &synthetic_case.height_px,
+                    &tail) != 2 ||
+        synthetic_case.width_px < 8 || synthetic_case.height_px < 8 ||
+        synthetic_case.width_px > 8192 || synthetic_case.height_px > 8192) {
+      throw UsageError("--synthetic-size expects WIDTHxHEIGHT, each side in [8, 8192], got '" +
+                       size + "'");
+    }
     synthetic = benchSyntheticHull(synthetic_case);
   }
   for (const HullDataset& dataset : hullDatasets()) {
