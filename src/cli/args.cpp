@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <iostream>
 #include <sstream>
@@ -202,6 +203,15 @@ double ArgParser::getDouble(const std::string& name) const {
     throw UsageError("--" + name + " expects a number, got '" + text + "'");
   }
   return value;
+}
+
+cv::Size parseSizeOption(const std::string& option, const std::string& text) {
+  int width = 0, height = 0;
+  char tail = 0;
+  if (std::sscanf(text.c_str(), "%dx%d%c", &width, &height, &tail) != 2) {
+    throw UsageError(option + " expects WIDTHxHEIGHT, got '" + text + "'");
+  }
+  return {width, height};
 }
 
 }  // namespace cli

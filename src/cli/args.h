@@ -1,6 +1,7 @@
 #pragma once
 
 #include <map>
+#include <opencv2/core/types.hpp>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -66,6 +67,9 @@ class ArgParser {
   std::map<std::string, std::string> values_;  ///< the last value of each option
   std::map<std::string, std::vector<std::string>> repeated_values_;
 };
+
+/// "WIDTHxHEIGHT" as a size; throws UsageError naming `option` ("--size") otherwise.
+cv::Size parseSizeOption(const std::string& option, const std::string& text);
 
 /// validate(config), a bad value reported as a bad command line (UsageError).
 template <typename Config>

@@ -193,9 +193,8 @@ std::string markdownReport(const std::vector<DatasetRuns>& all, const nlohmann::
 
 int reportBench(const ArgParser& parser, const std::vector<DatasetRuns>& all,
                 const std::optional<SyntheticHullBench>& synthetic) {
-  nlohmann::json json = {{"datasets", nlohmann::json::array()},
-                         {"targets", targetsJson(all)},
-                         {"cpu", cpuModel()}};
+  nlohmann::json json = {
+      {"datasets", nlohmann::json::array()}, {"targets", targetsJson(all)}, {"cpu", cpuModel()}};
   for (const DatasetRuns& runs : all) {
     nlohmann::json depths = nlohmann::json::array();
     for (const DepthRun& run : runs.depths) depths.push_back(depthJson(run));
@@ -252,10 +251,10 @@ int runBenchHull(const std::vector<std::string>& args) {
     synthetic_case.views = parser.getInt("synthetic-views");
     if (synthetic_case.views < 2) throw UsageError("--synthetic-views must be at least 2");
     const std::string size = parser.get("synthetic-size");
-    char tail = 0;
-    if (std::sscanf(size.c_str(), "%dx%d%c", &synthetic_case.width_px, &synthetic_case.height_px,
-                    &tail) != 2 ||
-        synthetic_case.width_px < 8 || synthetic_case.height_px < 8 ||
+    const cv::Size parsed = parseSizeOption("--synthetic-size", size);
+    synthetic_case.width_px = parsed.width;
+    synthetic_case.height_px = parsed.height;
+    if (synthetic_case.width_px < 8 || synthetic_case.height_px < 8 ||
         synthetic_case.width_px > 8192 || synthetic_case.height_px > 8192) {
       throw UsageError("--synthetic-size expects WIDTHxHEIGHT, each side in [8, 8192], got '" +
                        size + "'");

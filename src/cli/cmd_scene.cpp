@@ -17,15 +17,6 @@ double millisecondsSince(std::chrono::steady_clock::time_point start) {
       .count();
 }
 
-cv::Size parseSize(const std::string& text) {
-  int width = 0, height = 0;
-  char tail = 0;
-  if (std::sscanf(text.c_str(), "%dx%d%c", &width, &height, &tail) != 2) {
-    throw UsageError("--size expects WIDTHxHEIGHT, got '" + text + "'");
-  }
-  return {width, height};
-}
-
 /// "K1,K2,P1,P2" or "K1,K2,P1,P2,K3", OpenCV's order.
 LensDistortion parseDistortion(const std::string& text) {
   std::vector<double> values;
@@ -61,7 +52,7 @@ std::string joined(const std::vector<std::string>& words) {
 SceneConfig configFromArgs(const ArgParser& parser) {
   SceneConfig config;
   config.views = parser.getInt("views");
-  const cv::Size size = parseSize(parser.get("size"));
+  const cv::Size size = parseSizeOption("--size", parser.get("size"));
   config.width_px = size.width;
   config.height_px = size.height;
   config.shape = parser.get("shape");

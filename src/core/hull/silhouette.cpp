@@ -146,13 +146,20 @@ cv::Mat largeComponents(const cv::Mat& mask) {
   return kept;
 }
 
-/// Whether a mask looks like the background taken for the object, or nothing: empty, over 90 % of
-/// the image, or touching all four borders (as silhouetteWarnings).
-bool suspect(const cv::Mat& mask) {
+/// Why a mask looks like the background taken for the object, or like nothing: empty, over 90 %
+/// of the image, or touching all four borders; empty for a good one (silhouetteWarnings).
+std::string suspectReason(const cv::Mat& mask) {
   const double share = static_cast<double>(cv::countNonZero(mask)) / mask.total();
-  return share == 0.0 || share > 0.9 ||
-         (cv::countNonZero(mask.row(0)) > 0 && cv::countNonZero(mask.row(mask.rows - 1)) > 0 &&
-          cv::countNonZero(mask.col(0)) > 0 && cv::countNonZero(mask.col(mask.cols - 1)) > 0);
+  if (share == 0.0) return "the silhouette is empty";
+  if (share > 0.9) {
+    return "the silhouette covers " + std::to_string(static_cast<int>(100 * share)) +
+           " % of the image (the background taken for the object?)";
+  }
+  if (cv::countNonZero(mask.row(0)) > 0 && cv::countNonZero(mask.row(mask.rows - 1)) > 0 &&
+      cv::countNonZero(mask.col(0)) > 0 && cv::countNonZero(mask.col(mask.cols - 1)) > 0) {
+    return "the silhouette touches all four image borders (the background taken for the object?)";
+  }
+  return "";
 }
 
 /// Isolated pixels and small components removed, a closing by a disc of erode_px, holes filled.
@@ -200,7 +207,7 @@ cv::Mat backgroundSilhouette(const cv::Mat& image, const SilhouetteConfig& confi
   // may give to the background; it is added where it agrees with the cut (IoU > kMinAgreement),
   // not where it has taken a textured background for the object.
   const cv::Mat prior = cleaned(colour, config);
-  if (!suspect(prior)) {
+  if (suspectReason(prior).empty()) {
     const double both = cv::countNonZero(mask & prior), either = cv::countNonZero(mask | prior);
     if (either > 0 && both / either > kMinAgreement) mask |= prior;
   }
@@ -263,19 +270,7 @@ std::vector<std::string> silhouetteWarnings(const std::vector<std::string>& name
     if (mask.empty() || mask.type() != CV_8UC1) {
       throw std::invalid_argument("silhouetteWarnings: '" + names[i] + "' is not a CV_8UC1 mask");
     }
-    const double share = static_cast<double>(cv::countNonZero(mask)) / mask.total();
-    std::string reason;
-    if (share == 0.0) {
-      reason = "the silhouette is empty";
-    } else if (share > 0.9) {
-      reason = "the silhouette covers " + std::to_string(static_cast<int>(100 * share)) +
-               " % of the image (the background taken for the object?)";
-    } else if (cv::countNonZero(mask.row(0)) > 0 && cv::countNonZero(mask.row(mask.rows - 1)) > 0 &&
-               cv::countNonZero(mask.col(0)) > 0 && cv::countNonZero(mask.col(mask.cols - 1)) > 0) {
-      reason =
-          "the silhouette touches all four image borders (the background taken for the "
-          "object?)";
-    }
+    const std::string reason = suspectReason(mask);
     if (!reason.empty()) {
       warnings.push_back(names[i] + ": " + reason + "; leave the view out or give its mask");
     }
