@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <opencv2/imgproc.hpp>
 
 #include "common/test_data.h"
 #include "sift_hull/hull/hull_pipeline.h"
@@ -64,6 +65,39 @@ TEST(HullStream, LeavesOutViewsSeenFromWhereAViewAlreadyTakenWas) {
   stream.reset();
   EXPECT_EQ(stream.redundantViews(), 0u);
   EXPECT_EQ(stream.add("after reset", camera, input.masks[0]), Outcome::kWaiting);
+}
+
+/// The ring scaled `factor` times: intrinsics and masks (nearest neighbour).
+HullInput scaled(HullInput input, double factor) {
+  for (size_t i = 0; i < input.masks.size(); ++i) {
+    Eigen::Matrix3d K = input.cameras[i].K();
+    K.topRows<2>() *= factor;
+    input.cameras[i] =
+        PinholeCamera::fromCentre(K, input.cameras[i].R(), input.cameras[i].centre());
+    cv::resize(input.masks[i], input.masks[i], cv::Size(), factor, factor, cv::INTER_NEAREST);
+  }
+  return input;
+}
+
+TEST(HullStream, SamplesTheMapsOfLargeViewsAtTheReductionTheBoxAllows) {
+  const HullInput input = scaled(ring(6), 8.0);  // 2560x1920
+  HullStreamConfig config = streamConfig(6);
+  HullStream reduced(config);
+  config.hull.distance_reduction = 1;
+  HullStream full(config);
+  for (size_t i = 0; i < input.masks.size(); ++i) {
+    reduced.add(input.names[i], input.cameras[i], input.masks[i]);
+    full.add(input.names[i], input.cameras[i], input.masks[i]);
+  }
+  ASSERT_TRUE(reduced.hasHull());
+  const std::vector<HullView>& views = reduced.hull().views();
+  ASSERT_EQ(views.size(), input.masks.size());
+  EXPECT_EQ(views.front().distanceReduction(), 1) << "it waited for the box";
+  EXPECT_GT(views.back().distanceReduction(), 1);
+  for (const HullView& view : full.hull().views()) EXPECT_EQ(view.distanceReduction(), 1);
+  const double volume = reduced.hull().stats().occupied_volume_m3;
+  const double reference = full.hull().stats().occupied_volume_m3;
+  EXPECT_NEAR(volume, reference, 0.005 * reference);  // measured: 0.03 % apart
 }
 
 TEST(HullStream, TakesEveryViewWithNoMinimumSeparation) {

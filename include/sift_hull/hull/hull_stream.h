@@ -27,7 +27,8 @@ struct HullStreamConfig {
   /// so that views that never bound a box (parallel rays, a bad calibration) cannot pile up.
   int max_waiting_views = 16;
   /// Views the hull takes at most (each keeps its distance map, about 8 bytes per pixel of its
-  /// silhouette's box); later views are refused.
+  /// silhouette's box, or per sample of a reduced map: views that come once the hull has its box
+  /// are sampled at the reduction it allows, distanceReduction); later views are refused.
   int max_views = 1000;
 };
 
@@ -88,6 +89,7 @@ class HullStream {
     uint64_t serial;
   };
 
+  HullView viewOf(const std::string& name, const PinholeCamera& camera, const cv::Mat& mask) const;
   void take(Arrival arrival);
   void wait(Arrival arrival);
   void tryToStart();

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "sift_hull/hull/hull_pipeline.h"
+#include "sift_hull/hull/reduced_distance_map.h"
 
 namespace sift_hull {
 namespace {
@@ -94,10 +95,21 @@ HullStream::Outcome HullStream::add(const std::string& name, const PinholeCamera
     ++redundant_views_;
     return Outcome::kRedundant;
   } else {
-    take({HullView(name, camera, mask, config_.hull), serial});
+    take({viewOf(name, camera, mask), serial});
   }
   if (newest_refused_) return Outcome::kRefused;
   return hull_ ? Outcome::kCarved : Outcome::kWaiting;
+}
+
+/// Once the hull has its box, a view's distance map is sampled at the reduction the box allows
+/// (distanceReduction: full resolution below kMinReducedImagePixels), as the offline hull does; a
+/// view waiting for the box keeps its full-resolution map.
+HullView HullStream::viewOf(const std::string& name, const PinholeCamera& camera,
+                            const cv::Mat& mask) const {
+  if (!hull_) return HullView(name, camera, mask, config_.hull);
+  const int reduction = distanceReduction(camera, mask.size(), hull_->cube().box(), config_.hull);
+  if (reduction == 1) return HullView(name, camera, mask, config_.hull);
+  return HullView(name, camera, RunLengthMask(mask), config_.hull, reduction);
 }
 
 void HullStream::take(Arrival arrival) {
