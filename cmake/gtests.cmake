@@ -28,6 +28,7 @@ set(SIFT_HULL_CORE_GTESTS
   test_hull_stream eval
   test_hull_stream_refusals eval
   test_hardening eval
+  test_cli_output eval
   test_mirrored_world eval
   test_distorted_scene eval
 )

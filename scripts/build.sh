@@ -5,8 +5,17 @@
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/common.sh"
 
+# The package in the workspace is a folder of links to the checkout's entries, the workspace left
+# out: a link to the whole checkout would hold the workspace inside itself, and rosrun's search
+# (find -L) would loop. Refreshed on every build, so that new top-level entries appear.
+package="$workspace/src/sift_hull"
 mkdir -p "$workspace/src"
-ln -sfn "$repo_root" "$workspace/src/sift_hull"
+[[ -L "$package" ]] && rm "$package"  # the single link of earlier builds
+mkdir -p "$package"
+find "$package" -mindepth 1 -maxdepth 1 -type l -delete
+for entry in "$repo_root"/* "$repo_root"/.clang-format; do
+  [[ -e "$entry" && "$(realpath "$entry")" != "$workspace" ]] && ln -sfn "$entry" "$package/"
+done
 cd "$workspace"
 catkin_make -DCMAKE_BUILD_TYPE="${BUILD_TYPE:-Release}" -DPYTHON_EXECUTABLE=/usr/bin/python3 \
   -DCATKIN_ENABLE_TESTING=ON -j"$(nproc)" "$@" >&2

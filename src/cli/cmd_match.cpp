@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
@@ -114,7 +115,8 @@ std::vector<std::string> chosenFilters(const ArgParser& parser, bool calibrated)
   return names;
 }
 
-std::string describe(const nlohmann::json& result) {
+/// The result as text, the filters in the order they ran (`order`: the order given).
+std::string describe(const nlohmann::json& result, const std::vector<std::string>& order) {
   std::ostringstream text;
   text << result["putative"] << " putative matches";
   if (result.contains("ground_truth")) {
@@ -123,7 +125,8 @@ std::string describe(const nlohmann::json& result) {
          << truth["unknown"] << " without ground truth)";
   }
   text << "\n";
-  for (const auto& [name, run] : result["filters"].items()) {
+  for (const std::string& name : order) {
+    const nlohmann::json& run = result["filters"][name];
     text << "  " << name << ": kept " << run["kept"] << " in " << run["time_ms"] << " ms";
     if (!run["precision"].is_null()) {
       text << ", precision " << run["precision"] << ", recall " << run["recall"] << ", F1 "
@@ -157,14 +160,19 @@ void writeHistogramFigure(const std::string& path, const PutativeMatches& input,
   writeImage(path, figure);
 }
 
-/// Runs each chosen filter; fills result["filters"] and returns the first filter's run.
+/// Runs each chosen filter in the order given; fills result["filters"] and `order` (the filters'
+/// names as run) and returns the first filter's run.
 std::optional<FilterRun> runFilters(const ArgParser& parser, const PutativeMatches& input,
                                     const FilterConfigs& configs,
-                                    const std::vector<MatchTruth>* truth, nlohmann::json* result) {
+                                    const std::vector<MatchTruth>* truth, nlohmann::json* result,
+                                    std::vector<std::string>* order) {
   std::optional<FilterRun> first;
   for (const std::string& name : chosenFilters(parser, input.F_right_left.has_value())) {
     FilterRun run = timedRun(*makeFilter(name, configs), input);
     (*result)["filters"][run.name] = filterRunJson(run, truth);
+    if (std::find(order->begin(), order->end(), run.name) == order->end()) {
+      order->push_back(run.name);
+    }
     if (!first) first = std::move(run);
   }
   return first;
@@ -206,15 +214,16 @@ int runMatch(const std::vector<std::string>& args) {
                            {"right_keypoints", input.right_keypoints.size()},
                            {"filters", nlohmann::json::object()}};
   if (truth) result["ground_truth"] = truthJson(truth->kind, judged);
+  std::vector<std::string> order;
   const std::optional<FilterRun> first =
-      runFilters(parser, input, options.filters, truth_or_null, &result);
+      runFilters(parser, input, options.filters, truth_or_null, &result, &order);
   if (parser.has("out-image") && first) {
     writeImage(parser.get("out-image"), drawMatchDecisions(left, right, input, first->result));
   }
   if (parser.has("out-histograms")) {
     writeHistogramFigure(parser.get("out-histograms"), input, options.filters, truth_or_null);
   }
-  printResult(parser.flag("json"), result, describe(result));
+  printResult(parser.flag("json"), result, describe(result, order));
   return 0;
 }
 

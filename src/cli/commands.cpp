@@ -16,8 +16,11 @@ namespace {
 
 void printUsage(const Program& program, std::ostream& out) {
   out << "usage: " << program.name << " <command> [options]\n\ncommands:\n";
+  size_t width = 0;  // the longest name and two spaces, so that no name runs into its summary
+  for (const Command& command : program.commands)
+    width = std::max(width, std::strlen(command.name));
   for (const Command& command : program.commands) {
-    out << "  " << command.name << std::string(16 - std::strlen(command.name), ' ')
+    out << "  " << command.name << std::string(width + 2 - std::strlen(command.name), ' ')
         << command.summary << '\n';
   }
   out << "\n'" << program.name << " <command> --help' describes a command.\n";

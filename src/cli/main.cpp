@@ -10,7 +10,7 @@ const Program& offlineProgram() {
   static const Program program{
       "sift_hull",
       {
-          {"dataset-info", "summarise a calibrated view set (Middlebury par or projection list)",
+          {"dataset-info", "summarise a calibrated view set (par, projection list, COLMAP, LLFF)",
            runDatasetInfo},
           {"scene", "render a synthetic scene with exact ground truth", runScene},
           {"match", "match SIFT features of two images and filter them (epipolar, gsc, ...)",

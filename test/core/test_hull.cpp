@@ -176,7 +176,9 @@ TEST_F(SphereHull, OctomapHoldsTheOccupiedCells) {
   EXPECT_LT(result_->hull.stats().occupied_volume_m3, 1.03 * sphere_m3);
 
   const std::string path = test::temporaryDirectory() + "/hull.bt";
+  testing::internal::CaptureStderr();
   writeOctomap(*tree, path);
+  EXPECT_EQ(testing::internal::GetCapturedStderr(), "") << "nothing on stderr (a --json run's)";
   octomap::OcTree read(path);
   EXPECT_EQ(read.getNumLeafNodes(), tree->getNumLeafNodes());
 }

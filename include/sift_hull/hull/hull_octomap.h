@@ -1,5 +1,6 @@
 #pragma once
 
+#include <iosfwd>
 #include <memory>
 #include <string>
 
@@ -17,7 +18,13 @@ namespace sift_hull {
 /// 2^16-voxel key range around the world origin.
 std::unique_ptr<octomap::OcTree> toOctomap(const VisualHull& hull);
 
-/// Writes OctoMap's binary .bt file. Throws std::runtime_error naming the path on failure.
+/// Writes OctoMap's binary .bt file (the header OcTree::writeBinary writes, then the binary data).
+/// Throws std::runtime_error naming the path on failure.
 void writeOctomap(const octomap::OcTree& tree, const std::string& path);
+
+/// OctoMap's binary stream of the tree (OcTree::writeBinaryData's bytes, as octomap_msgs'
+/// binaryMapToMsg puts them into a message) without the progress lines the library prints on
+/// stderr.
+void writeOctomapBinaryData(const octomap::OcTree& tree, std::ostream& out);
 
 }  // namespace sift_hull

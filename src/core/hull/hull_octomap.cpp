@@ -2,6 +2,8 @@
 
 #include <octomap/OcTree.h>
 
+#include <fstream>
+#include <ostream>
 #include <stdexcept>
 
 namespace sift_hull {
@@ -105,8 +107,20 @@ std::unique_ptr<octomap::OcTree> toOctomap(const VisualHull& hull) {
   return tree;
 }
 
+void writeOctomapBinaryData(const octomap::OcTree& tree, std::ostream& out) {
+  if (tree.getRoot() != nullptr) tree.writeBinaryNode(out, tree.getRoot());
+}
+
 void writeOctomap(const octomap::OcTree& tree, const std::string& path) {
-  if (!tree.writeBinaryConst(path)) throw std::runtime_error(path + ": cannot write the octree");
+  std::ofstream out(path, std::ios::binary);
+  // AbstractOccupancyOcTree::writeBinaryConst's header; the first line is what readers check.
+  out << "# Octomap OcTree binary file\n"
+      << "# (feel free to add / change comments, but leave the first line as it is!)\n#\n"
+      << "id " << tree.getTreeType() << "\nsize " << tree.size() << "\nres " << tree.getResolution()
+      << "\ndata\n";
+  writeOctomapBinaryData(tree, out);
+  out.close();
+  if (!out) throw std::runtime_error(path + ": cannot write the octree");
 }
 
 }  // namespace sift_hull

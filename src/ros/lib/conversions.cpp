@@ -16,6 +16,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "sift_hull/hull/hull_octomap.h"
 #include "sift_hull/hull/mesh.h"
 #include "sift_hull/limits.h"
 
@@ -237,7 +238,7 @@ sift_hull::Octomap octomapMessage(const octomap::OcTree& tree, const std_msgs::H
   message.id = tree.getTreeType();
   message.resolution = tree.getResolution();
   std::stringstream stream;
-  tree.writeBinaryData(stream);
+  writeOctomapBinaryData(tree, stream);
   const std::string bytes = stream.str();
   message.data.assign(bytes.begin(), bytes.end());
   return message;

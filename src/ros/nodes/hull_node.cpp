@@ -7,6 +7,7 @@
 #include "lib/conversions.h"
 #include "lib/node_diagnostics.h"
 #include "lib/ros_params.h"
+#include "lib/save_paths.h"
 #include "sift_hull/hull/hull_octomap.h"
 #include "sift_hull/hull/mesh.h"
 #include "sift_hull/hull/silhouette.h"
@@ -266,10 +267,11 @@ bool HullNode::save(sift_hull::Save::Request& request, sift_hull::Save::Response
     return true;
   }
   try {
-    writeOctomap(*octree_, request.path + ".bt");
-    writePly(request.path + ".ply", publishedMesh());
+    const SavePaths paths = savePaths(request.path);
+    writeOctomap(*octree_, paths.octree);
+    writePly(paths.mesh, publishedMesh());
     response.success = true;
-    response.message = "wrote " + request.path + ".bt and " + request.path + ".ply";
+    response.message = "wrote " + paths.octree + " and " + paths.mesh;
   } catch (const std::exception& e) {
     response.success = false;
     response.message = e.what();

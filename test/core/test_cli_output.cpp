@@ -1,0 +1,65 @@
+// What the offline program prints: the command list, the filters in the order given, and nothing
+// but the JSON with --json.
+
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+#include "common/test_data.h"
+
+namespace sift_hull {
+namespace {
+
+using CommandOutput = test::WrittenSceneSuite;
+
+TEST(ProgramHelp, KeepsEveryCommandApartFromItsSummary) {
+  std::string out, err;
+  ASSERT_EQ(test::runProgram("--help", &out, &err), 0) << err;
+  std::istringstream lines(out);
+  std::string line;
+  size_t listed = 0, summary_column = 0;
+  while (std::getline(lines, line)) {
+    if (line.rfind("  ", 0) != 0) continue;  // a command: two spaces, its name, its summary
+    const size_t name_end = line.find(' ', 2);
+    const size_t summary = line.find_first_not_of(' ', name_end);
+    ASSERT_NE(summary, std::string::npos) << line;
+    EXPECT_GE(summary - name_end, 2u) << "name and summary run together: " << line;
+    if (listed++ == 0) summary_column = summary;
+    EXPECT_EQ(summary, summary_column) << "summaries in one column: " << line;
+  }
+  EXPECT_GE(listed, 7u) << out;
+  EXPECT_NE(out.find("evaluate-filters  "), std::string::npos) << out;
+}
+
+TEST_F(CommandOutput, ListsTheFiltersInTheOrderGiven) {
+  const std::string pair = *scene_ + "/view_0000.png " + *scene_ + "/view_0001.png";
+  std::string out, err;
+  ASSERT_EQ(
+      test::runProgram("match " + pair + " --filter ransac --filter gsc --filter gms", &out, &err),
+      0)
+      << err;
+  const size_t ransac = out.find("  ransac:"), gsc = out.find("  gsc:"), gms = out.find("  gms:");
+  ASSERT_NE(ransac, std::string::npos) << out;
+  ASSERT_NE(gsc, std::string::npos) << out;
+  ASSERT_NE(gms, std::string::npos) << out;
+  EXPECT_LT(ransac, gsc) << out;
+  EXPECT_LT(gsc, gms) << out;
+}
+
+TEST_F(CommandOutput, PrintsOnlyJsonWithJson) {
+  const std::string dir = test::temporaryDirectory();
+  std::string out, err;
+  ASSERT_EQ(test::runProgram("hull --calib " + *scene_ + "/scene_par.txt --images " + *scene_ +
+                                 " --silhouettes " + *scene_ +
+                                 "/masks --max-depth 5 --out-octree " + dir + "/hull.bt --json",
+                             &out, &err),
+            0)
+      << err;
+  EXPECT_EQ(err, "") << "stderr of a clean --json run";
+  EXPECT_NO_THROW(static_cast<void>(nlohmann::json::parse(out))) << out;
+}
+
+}  // namespace
+}  // namespace sift_hull
