@@ -204,10 +204,12 @@ TEST(MaskFromImage, RefusesShortRowsOrDataOtherEncodingsAndEmptyOrOversizedImage
   sensor_msgs::Image message = image(5, 3, 8);
   message.data.pop_back();  // step x height - 1: the last row's padding is required too
   EXPECT_TRUE(has(maskRefusal(message), "(23 bytes, step 8) does not hold 5x3"));
-  for (const char* encoding : {"rgb8", "bgr8", "mono16", "8UC1", "32FC1", ""}) {
-    EXPECT_EQ(maskRefusal(image(5, 3, 16, encoding)),
-              "silhouette encoding is '" + std::string(encoding) + "', expected mono8");
+  for (const char* encoding : {"rgb8", "bgr8", "mono16", "8UC3", "32FC1", ""}) {
+    EXPECT_EQ(maskRefusal(image(5, 3, 16, encoding)), "silhouette encoding is '" +
+                                                          std::string(encoding) +
+                                                          "', expected mono8 (or 8UC1)");
   }
+  EXPECT_EQ(maskRefusal(image(5, 3, 16, "8UC1")), "accepted") << "cv_bridge's uint8 default";
   EXPECT_EQ(maskRefusal(image(0, 3, 0)), "silhouette: the image is empty (0x3)");
   EXPECT_EQ(maskRefusal(image(5, 0, 5)), "silhouette: the image is empty (5x0)");
   sensor_msgs::Image huge = image(0, 0, 0);  // no data: refused from the header alone

@@ -62,8 +62,9 @@ bool withinPixelLimit(const sensor_msgs::Image& image, size_t max_pixels, std::s
 }
 
 cv::Mat maskFromImage(const sensor_msgs::Image& image, std::string* why_not) {
-  if (image.encoding != "mono8") {
-    *why_not = "silhouette encoding is '" + image.encoding + "', expected mono8";
+  // 8UC1 is what cv_bridge gives a uint8 array without an encoding: the same bytes as mono8.
+  if (image.encoding != "mono8" && image.encoding != "8UC1") {
+    *why_not = "silhouette encoding is '" + image.encoding + "', expected mono8 (or 8UC1)";
     return {};
   }
   if (!holdsPixels(image, 1, why_not)) {

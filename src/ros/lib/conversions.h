@@ -40,8 +40,8 @@ bool holdsPixels(const sensor_msgs::Image& image, size_t bytes_per_pixel, std::s
 /// `why_not`, otherwise. Reads only the header fields.
 bool withinPixelLimit(const sensor_msgs::Image& image, size_t max_pixels, std::string* why_not);
 
-/// A silhouette message as a CV_8UC1 mask sharing nothing with the message. Accepts mono8 only
-/// (non-zero inside); returns an empty Mat and sets `why_not` for another encoding or pixels the
+/// A silhouette message as a CV_8UC1 mask sharing nothing with the message. Accepts mono8 and
+/// 8UC1 (cv_bridge's encoding of a uint8 array; the same bytes), non-zero inside; returns an empty Mat and sets `why_not` for another encoding or pixels the
 /// data does not hold (holdsPixels).
 cv::Mat maskFromImage(const sensor_msgs::Image& image, std::string* why_not);
 

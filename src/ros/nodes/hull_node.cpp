@@ -17,6 +17,8 @@ namespace sift_hull {
 namespace {
 
 constexpr double kThrottle_s = 5.0;
+/// Wall time inputs may arrive without pairing before /diagnostics warns.
+constexpr double kPairingPatience_s = 5.0;
 
 std::string shortNumber(double value) {
   std::ostringstream out;
@@ -46,6 +48,10 @@ HullNode::HullNode(ros::NodeHandle nh, ros::NodeHandle private_nh, HullNodeConfi
           "mesh", 1, [this](const ros::SingleSubscriberPublisher&) { publishMeshNow(); },
           ros::SubscriberStatusCallback(), ros::VoidConstPtr(), true)),
       work_(config_.queue_size, 1, [this](View& view) { integrate(view); }),
+      pairing_({config_.from_image ? "image" : "silhouette", "camera_info"}, kPairingPatience_s,
+               "a silhouette pairs with the camera_info of an equal stamp once tf has its "
+               "camera's pose in ~world_frame (a node making masks must copy its image's header: "
+               "stamp and frame_id)"),
       diagnostics_(nh_, private_nh_, "hull", config_.diagnostic_period,
                    [this](diagnostic_updater::DiagnosticStatusWrapper& status) {
                      reportDiagnostics(status);
@@ -71,6 +77,7 @@ void HullNode::subscribe() {
         onPoseMissing(image, reason);
       });
   silhouette_sub_.registerCallback(&HullNode::onArrival, this);
+  info_sub_.registerCallback(&HullNode::onInfoArrival, this);
   pose_filter_.connectInput(silhouette_sub_);
   pose_gate_.connectInput(pose_filter_);
   sync_.connectInput(pose_gate_, info_sub_);
@@ -79,7 +86,12 @@ void HullNode::subscribe() {
   silhouette_sub_.subscribe(nh_, config_.from_image ? "image" : "silhouette", config_.queue_size);
 }
 
+void HullNode::onInfoArrival(const sensor_msgs::CameraInfoConstPtr& info) {
+  pairing_.arrived(1, info->header.stamp.toSec(), PairingWatch::Clock::now());
+}
+
 void HullNode::onArrival(const sensor_msgs::ImageConstPtr& silhouette) {
+  pairing_.arrived(0, silhouette->header.stamp.toSec(), PairingWatch::Clock::now());
   pose_waits_.arrived(silhouette->header.frame_id, silhouette->header.stamp.toSec(),
                       PoseWaits::Clock::now());
 }
@@ -130,6 +142,7 @@ bool HullNode::cameraOf(const sensor_msgs::Image& silhouette, const sensor_msgs:
 
 void HullNode::onView(const sensor_msgs::ImageConstPtr& silhouette,
                       const sensor_msgs::CameraInfoConstPtr& info) {
+  pairing_.paired();
   std::string why_not;
   const cv::Mat mask = maskOf(silhouette, &why_not);
   if (mask.empty()) {
@@ -166,6 +179,11 @@ void HullNode::reportDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& st
   status.add("last view carve ms", last_carve_ms_.load());
   status.add("last view publish ms", last_publish_ms_.load());
   status.add("last view stamp", last_view_stamp_.load());
+  const std::string unpaired = pairing_.problem(PairingWatch::Clock::now());
+  if (!unpaired.empty()) {
+    status.mergeSummary(diagnostic_msgs::DiagnosticStatus::WARN, unpaired);
+    ROS_WARN_THROTTLE(kThrottle_s, "hull: %s", unpaired.c_str());
+  }
 }
 
 cv::Mat HullNode::maskOf(const sensor_msgs::ImageConstPtr& message, std::string* why_not) const {

@@ -17,6 +17,7 @@
 #include <string>
 
 #include "lib/node_diagnostics.h"
+#include "lib/pairing_watch.h"
 #include "lib/pose_gate.h"
 #include "lib/pose_waits.h"
 #include "lib/throttled_log.h"
@@ -89,6 +90,7 @@ class HullNode {
   void onPoseMissing(const sensor_msgs::ImageConstPtr& silhouette,
                      tf2_ros::filter_failure_reasons::FilterFailureReason reason);
   void onArrival(const sensor_msgs::ImageConstPtr& silhouette);
+  void onInfoArrival(const sensor_msgs::CameraInfoConstPtr& info);
   void onPoseTooLate(const sensor_msgs::ImageConstPtr& silhouette);
   void reportPoseTimeouts();
   void subscribe();
@@ -112,6 +114,7 @@ class HullNode {
   std::atomic<size_t> redundant_views_{0};
   std::atomic<size_t> refused_views_{0};
   WorkQueue<View> work_;
+  PairingWatch pairing_;  ///< silhouettes and camera_infos that arrive but do not pair
   NodeDiagnostics diagnostics_;
   PoseWaits pose_waits_;
   ros::WallTimer pose_timer_;
