@@ -81,6 +81,33 @@ TEST(HullCube, HoldsTheBoxWithAVoxelOfMarginOnTheVoxelGrid) {
   }
 }
 
+TEST(HullCube, TakesAResolutionInMetresAtTheLeastDepthThatHoldsTheBox) {
+  Box3d box;
+  box.min_W = Eigen::Vector3d(-0.3, 0.1, 2.0);
+  box.max_W = Eigen::Vector3d(0.5, 0.4, 2.2);
+  const HullCube cube = HullCube::withResolution(box, 0.01);  // 0.8 m: 83 cells, depth 7
+  EXPECT_EQ(cube.resolution_m, 0.01);
+  EXPECT_EQ(cube.depth, 7);
+  const Box3d outer = cube.box();
+  EXPECT_TRUE(((box.min_W - outer.min_W).array() >= cube.resolution_m - 1e-9).all());
+  EXPECT_TRUE(((outer.max_W - box.max_W).array() >= cube.resolution_m - 1e-9).all());
+  HullConfig config;
+  config.resolution_m = 0.01;
+  config.max_depth = 3;  // replaced
+  EXPECT_EQ(HullCube::forConfig(box, config).depth, 7);
+  EXPECT_EQ(VisualHull(box, config).cube().resolution_m, 0.01);
+  try {
+    HullCube::withResolution(box, 1e-4);  // 8000 cells: deeper than the octree goes
+    ADD_FAILURE() << "no error";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("raise resolution_m (at least 0.00078"),
+              std::string::npos)
+        << e.what();
+  }
+  config.resolution_m = -1.0;
+  EXPECT_THROW(validate(config), std::invalid_argument);
+}
+
 /// One scene carved at depth 7, with the dense reference at twice the resolution.
 class SphereHull : public ::testing::Test {
  protected:

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <opencv2/imgproc.hpp>
 
 #include "common/test_data.h"
@@ -98,6 +99,58 @@ TEST(HullStream, SamplesTheMapsOfLargeViewsAtTheReductionTheBoxAllows) {
   const double volume = reduced.hull().stats().occupied_volume_m3;
   const double reference = full.hull().stats().occupied_volume_m3;
   EXPECT_NEAR(volume, reference, 0.005 * reference);  // measured: 0.03 % apart
+}
+
+/// The largest distance between corresponding faces of two boxes.
+double faceDistance(const Box3d& a, const Box3d& b) {
+  return std::max((a.min_W - b.min_W).cwiseAbs().maxCoeff(),
+                  (a.max_W - b.max_W).cwiseAbs().maxCoeff());
+}
+
+TEST(HullStream, RefitsItsBoxAsViewsShrinkItToTheOfflineHullsBoxAndResolution) {
+  const HullInput input = test::sceneHullInput("sculpture", 12, "ring");
+  HullStreamConfig config = streamConfig(6);
+  HullStream stream(config);
+  for (size_t i = 0; i < input.masks.size(); ++i) {
+    stream.add(input.names[i], input.cameras[i], input.masks[i]);
+  }
+  ASSERT_TRUE(stream.hasHull());
+  EXPECT_GT(stream.refits(), 0u) << "the first views' box is larger than all views' box";
+  const HullResult offline = buildHull(input, config.hull);
+  const HullCube& cube = stream.hull().cube();
+  const HullCube& expected = offline.hull.cube();
+  EXPECT_EQ(cube.depth, expected.depth);
+  EXPECT_NEAR(cube.resolution_m, expected.resolution_m, 0.02 * expected.resolution_m);
+  EXPECT_LE(faceDistance(stream.box(), offline.box), expected.resolution_m);
+  EXPECT_LE(faceDistance(cube.box(), expected.box()), 2 * expected.resolution_m);
+  const double volume = stream.hull().stats().occupied_volume_m3;
+  EXPECT_NEAR(volume, offline.hull.stats().occupied_volume_m3,
+              0.05 * offline.hull.stats().occupied_volume_m3);
+  stream.reset();
+  EXPECT_EQ(stream.refits(), 0u);
+}
+
+TEST(HullStream, KeepsAGivenBoxAndTakesAResolutionInMetres) {
+  const HullInput input = test::sceneHullInput("sculpture", 12, "ring");
+  HullStreamConfig config = streamConfig(6);
+  const Box3d box = buildHull(input, config.hull).box;
+  Box3d larger = box;
+  larger.min_W -= Eigen::Vector3d::Constant(0.5);
+  larger.max_W += Eigen::Vector3d::Constant(0.5);
+  config.box = larger;
+  config.hull.resolution_m = 0.05;
+  HullStream stream(config);
+  for (size_t i = 0; i < input.masks.size(); ++i) {
+    stream.add(input.names[i], input.cameras[i], input.masks[i]);
+  }
+  ASSERT_TRUE(stream.hasHull());
+  EXPECT_EQ(stream.refits(), 0u);
+  EXPECT_EQ(faceDistance(stream.box(), larger), 0.0);
+  EXPECT_EQ(stream.hull().cube().resolution_m, 0.05) << "octomap_server's resolution, exactly";
+  const double longest_m = larger.size().maxCoeff();
+  const int depth = stream.hull().cube().depth;
+  EXPECT_GE(0.05 * ((1 << depth) - 3), longest_m) << "the cube covers the box";
+  EXPECT_LT(0.05 * ((1 << (depth - 1)) - 3), longest_m) << "the least such depth";
 }
 
 TEST(HullStream, TakesEveryViewWithNoMinimumSeparation) {

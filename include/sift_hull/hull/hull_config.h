@@ -4,8 +4,13 @@ namespace sift_hull {
 
 /// Octree carving settings.
 struct HullConfig {
-  /// Octree levels below the root cube; resolution = cube edge / 2^max_depth.
+  /// Octree levels below the root cube; resolution = cube edge / 2^max_depth, the cube the box's
+  /// longest edge plus three cells (HullCube::around).
   int max_depth = 8;
+  /// Finest cell edge in metres (octomap_server's `resolution`); > 0 replaces max_depth by the
+  /// least depth whose cube of such cells covers the box (HullCube::withResolution). 0: from
+  /// max_depth.
+  double resolution_m = 0.0;
   /// Whether a view carves what it sees outside its image. When false, a view keeps the points
   /// seen beyond a side of its image where the border cuts its silhouette (the object may go on
   /// there), and carves the rest; see SignedDistanceMap.

@@ -38,7 +38,10 @@ void validate(const HullStreamConfig& config);
 
 /// A visual hull that views refine as they arrive (the hull node's worker). Until a box exists,
 /// views wait; the first time the LP over the waiting views gives a box, the hull is carved with
-/// all of them; every later view refines it (VisualHull::addView).
+/// all of them; every later view refines it (VisualHull::addView). Without a given box, a view
+/// that shrinks the LP box of the views taken by more than a cell has the hull carved again in
+/// the smaller box (refits()), so that box and resolution follow `sift_hull hull` on the same
+/// views.
 ///
 /// Bad views are refused with a reason (kRefused, whyRefused()) and leave the stream as if they
 /// never came:
@@ -79,6 +82,11 @@ class HullStream {
   /// Requires hasHull().
   const VisualHull& hull() const { return *hull_; }
   size_t waitingViews() const { return waiting_.size(); }
+  /// The box the hull is carved in: the given one, or the LP box of the views taken, refitted
+  /// when a view shrinks it by more than a cell (the hull then carved again). Requires hasHull().
+  const Box3d& box() const { return box_; }
+  /// How often the hull was carved again in a smaller box since the start or the last reset.
+  size_t refits() const { return refits_; }
   /// Why the waiting views give no box yet (empty when there is a hull).
   const std::string& whyNoBox() const { return why_no_box_; }
 
@@ -97,6 +105,7 @@ class HullStream {
   void dropViewMissingTheOthers();
   void replay(std::vector<Arrival> arrivals);
   void addToHull(Arrival arrival);
+  void refitBox();
   void refuse(const std::string& name, uint64_t serial, const std::string& reason);
   bool isRedundant(const PinholeCamera& camera) const;
 
@@ -108,6 +117,8 @@ class HullStream {
   bool newest_refused_ = false;  ///< whether the newest view was refused
   std::vector<Arrival> waiting_;
   std::unique_ptr<VisualHull> hull_;
+  Box3d box_;  ///< the hull's
+  size_t refits_ = 0;
   std::string why_no_box_ = "no view yet";
 };
 

@@ -26,7 +26,15 @@ struct HullCube {
   double resolution_m = 1.0;                                ///< finest cell edge
   int depth = 1;
 
+  /// 2^depth cells over the box's longest edge plus three cells. Throws std::invalid_argument
+  /// for an empty or non-finite box, or one too far from the origin at that resolution.
   static HullCube around(const Box3d& box, int depth);
+  /// Cells of exactly `resolution_m` (octomap_server's `resolution`), the least depth whose cube
+  /// covers the box as `around` does; throws std::invalid_argument when that is deeper than
+  /// limits::kMaxHullDepth, saying the least resolution that fits.
+  static HullCube withResolution(const Box3d& box, double resolution_m);
+  /// withResolution for config.resolution_m > 0, else around(box, config.max_depth).
+  static HullCube forConfig(const Box3d& box, const HullConfig& config);
   Eigen::Vector3d origin_W() const { return origin_voxels.cast<double>() * resolution_m; }
   double edge_m() const { return resolution_m * (1 << depth); }
   Box3d box() const;

@@ -39,7 +39,7 @@ void validate(const HullStreamConfig& config) {
   }
   if (config.max_waiting_views < 2) throw std::invalid_argument("max_waiting_views must be >= 2");
   if (config.max_views < 1) throw std::invalid_argument("max_views must be >= 1");
-  if (config.box) HullCube::around(*config.box, config.hull.max_depth);  // throws for a bad box
+  if (config.box) HullCube::forConfig(*config.box, config.hull);  // throws for a bad box
 }
 
 HullStream::HullStream(HullStreamConfig config) : config_(std::move(config)) { validate(config_); }
@@ -147,8 +147,35 @@ void HullStream::addToHull(Arrival arrival) {
   hull_->addView(std::move(arrival.view));
   if (hull_->isEmpty()) {
     hull_->dropLastView();  // rare: a full re-carve beats copying the tree for every view
-    refuse(name, arrival.serial, "it would carve the hull to nothing");
+    return refuse(name, arrival.serial, "it would carve the hull to nothing");
   }
+  refitBox();
+}
+
+/// The LP box of every view taken shrinks as views come (each adds constraints). When it lies
+/// more than a cell (of its own cube) inside the hull's box on some face, the hull is carved again
+/// in it, so that the box and the resolution are those `sift_hull hull` gives for the same views;
+/// shrinking mostly happens while few views are in, when carving again is cheap. Never with a
+/// given box.
+void HullStream::refitBox() {
+  if (config_.box) return;
+  Box3d tighter;
+  try {
+    tighter = boundingBoxOf(hull_->views());
+  } catch (const std::exception&) {
+    return;  // the LP over the taken views failed: keep the box it had
+  }
+  const double cell_m = HullCube::forConfig(tighter, config_.hull).resolution_m;
+  if ((tighter.min_W - box_.min_W).maxCoeff() <= cell_m &&
+      (box_.max_W - tighter.max_W).maxCoeff() <= cell_m) {
+    return;
+  }
+  auto refitted = std::make_unique<VisualHull>(tighter, config_.hull);
+  refitted->addViews(hull_->views());
+  if (refitted->isEmpty()) return;
+  hull_ = std::move(refitted);
+  box_ = tighter;
+  ++refits_;
 }
 
 void HullStream::tryToStart() {
@@ -203,6 +230,7 @@ void HullStream::dropViewMissingTheOthers() {
 /// it to nothing, they are added again one by one (addToHull) to refuse the ones that do.
 void HullStream::startHull(const Box3d& box) {
   hull_ = std::make_unique<VisualHull>(box, config_.hull);
+  box_ = box;
   std::vector<Arrival> joining;
   for (Arrival& arrival : waiting_) {
     try {
@@ -230,6 +258,7 @@ void HullStream::startHull(const Box3d& box) {
 
 void HullStream::reset() {
   redundant_views_ = 0;
+  refits_ = 0;
   refused_views_ = 0;
   refusals_.clear();
   waiting_.clear();

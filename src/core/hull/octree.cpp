@@ -253,7 +253,7 @@ void collectSurfaceLeaves(const OctreeNode& node, const CellIndex& cell,
 }  // namespace
 
 VisualHull::VisualHull(const Box3d& box, const HullConfig& config)
-    : cube_(HullCube::around(box, config.max_depth)),
+    : cube_(HullCube::forConfig(box, config)),
       config_(config),
       frame_origin_W_(frameOrigin(cube_)),
       frame_scale_(frameScale(cube_)),
@@ -397,6 +397,10 @@ std::vector<VoxelBlock> occupiedBlocks(const VisualHull& hull) {
 
 void validate(const HullConfig& config) {
   limits::requireInRange("HullConfig::max_depth", config.max_depth, 2, limits::kMaxHullDepth);
+  if (!(config.resolution_m >= 0.0) || !std::isfinite(config.resolution_m)) {
+    throw std::invalid_argument(
+        "HullConfig::resolution_m must be finite and >= 0 (0: from max_depth)");
+  }
   if (!(config.distance_slack_px >= 0.0) || !std::isfinite(config.distance_slack_px)) {
     throw std::invalid_argument("HullConfig::distance_slack_px must be finite and >= 0");
   }
@@ -404,35 +408,6 @@ void validate(const HullConfig& config) {
   limits::requireInRange("HullConfig::threads", config.threads, 1, limits::kMaxThreads);
   limits::requireInRange("HullConfig::distance_reduction", config.distance_reduction, 0,
                          kMaxDistanceReduction);
-}
-
-HullCube HullCube::around(const Box3d& box, int depth) {
-  const double longest_m = box.size().maxCoeff();
-  if (!(longest_m > 0.0) || !std::isfinite(longest_m)) {
-    throw std::invalid_argument("hull box must have a positive, finite size");
-  }
-  HullCube cube;
-  cube.depth = depth;
-  // 2^depth voxels = longest edge + 3: snapping the corner down costs up to one voxel, and at
-  // least one voxel of margin remains on every side.
-  cube.resolution_m = longest_m / ((1 << depth) - 3);
-  const Eigen::Vector3d corner = box.min_W / cube.resolution_m - Eigen::Vector3d::Ones();
-  // Voxel indices of the cube's cells must fit an int (and its far corner too).
-  constexpr double kMaxVoxelIndex = 1 << 30;
-  if (!(corner.cwiseAbs().maxCoeff() < kMaxVoxelIndex) || !box.min_W.allFinite()) {
-    throw std::invalid_argument(
-        "the hull box lies more than 2^30 voxels from the world origin at this resolution: "
-        "express the poses in a frame nearer the object, or lower the depth");
-  }
-  cube.origin_voxels = corner.array().floor().cast<int>();
-  return cube;
-}
-
-Box3d HullCube::box() const {
-  Box3d result;
-  result.min_W = origin_W();
-  result.max_W = result.min_W + Eigen::Vector3d::Constant(edge_m());
-  return result;
 }
 
 }  // namespace sift_hull

@@ -250,7 +250,7 @@ int distanceReduction(const PinholeCamera& camera, cv::Size image_size, const Bo
                       const HullConfig& config) {
   if (config.distance_reduction > 0) return config.distance_reduction;
   if (image_size.area() < kMinReducedImagePixels) return 1;
-  const double voxel_m = HullCube::around(box, config.max_depth).resolution_m;
+  const double voxel_m = HullCube::forConfig(box, config).resolution_m;
   double farthest_m = 0.0;
   for (int corner = 0; corner < 8; ++corner) {
     const Eigen::Vector3d X_W((corner & 1) ? box.max_W.x() : box.min_W.x(),
