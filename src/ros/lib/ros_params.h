@@ -36,7 +36,9 @@ double descriptorDistanceParam(double distance);
 SilhouetteConfig readSilhouetteConfig(const ros::NodeHandle& private_nh);
 
 /// ~max_depth, ~carve_outside_image, ~distance_slack_px, ~threads, ~distance_reduction.
-/// Deprecated: ~depth (~max_depth), ~slack_px (~distance_slack_px).
+/// Deprecated: ~depth (~max_depth), ~slack_px (~distance_slack_px). octomap_server's ~resolution
+/// is refused (std::invalid_argument naming ~max_depth): the voxel edge follows from the box and
+/// ~max_depth.
 HullConfig readHullConfig(const ros::NodeHandle& private_nh);
 
 /// The hull config, ~box ([xmin, ymin, zmin, xmax, ymax, zmax] in the world frame, metres; empty
@@ -81,7 +83,8 @@ MatcherNodeConfig readMatcherNodeConfig(const ros::NodeHandle& private_nh);
 MatcherSettings readMatcherSettings(const ros::NodeHandle& private_nh);
 
 /// ~world_frame, ~queue_size, ~pose_timeout_s, ~from_image, ~diagnostic_period and the
-/// silhouette recipe.
+/// silhouette recipe. octomap_server's ~frame_id is read as ~world_frame; set with a different
+/// ~world_frame, it is an error (std::invalid_argument naming both).
 HullNodeConfig readHullNodeConfig(const ros::NodeHandle& private_nh);
 
 /// ~bag, ~out_dir (both required: throws std::invalid_argument without them),
