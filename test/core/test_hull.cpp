@@ -190,13 +190,17 @@ TEST_F(SphereHull, OctomapHoldsTheOccupiedAndTheCarvedCells) {
   EXPECT_NEAR(volumeOf(*tree, 1), hull_m3, 1e-9 * hull_m3);
   const double cube_m3 = std::pow(cube.edge_m(), 3);  // the whole cube is known
   EXPECT_NEAR(volumeOf(*tree, -1), cube_m3, 1e-9 * cube_m3);
-  // Free space as coarse leaves: no more free leaves than the hull has out cells.
+  // Free space as coarse leaves, pruned: far fewer leaves than free voxels.
   size_t free_leaves = 0;
   for (auto leaf = tree->begin_leafs(); leaf != tree->end_leafs(); ++leaf) {
     free_leaves += !tree->isNodeOccupied(*leaf);
   }
+  const double free_voxels = (cube_m3 - hull_m3) / voxel_m3;
   EXPECT_GT(free_leaves, 0u);
-  EXPECT_LE(free_leaves, result_->hull.stats().out_leaves);
+  EXPECT_LT(free_leaves, free_voxels / 8) << free_voxels << " free voxels";
+  const size_t leaves = tree->getNumLeafNodes();
+  tree->prune();
+  EXPECT_EQ(tree->getNumLeafNodes(), leaves) << "not pruned";
   // The hull's own volume (surface cells by their centre) lies close above the sphere's.
   const double sphere_m3 = 4.0 / 3.0 * M_PI * std::pow(0.8, 3);
   EXPECT_GT(result_->hull.stats().occupied_volume_m3, sphere_m3);

@@ -118,12 +118,16 @@ std::vector<VoxelBlock> carvedBlocks(const VisualHull& hull) {
 }
 
 /// Sets the known voxels of `box` below `node` (at `level`, its first key `min_key`) free,
-/// splitting leaves that the box cuts.
+/// splitting leaves that the box cuts (prune merges them again).
 void clearNode(octomap::OcTree* tree, octomap::OcTreeNode* node, int level,
                const Eigen::Vector3i& min_key, const KeyBox& box) {
   const int edge = 1 << (kKeyDepth - level);
-  if (within(min_key, edge, box)) return makeLeaf(tree, node, tree->getClampingThresMinLog());
-  if (!tree->nodeHasChildren(node)) tree->expandNode(node);
+  const bool inside = within(min_key, edge, box);
+  if (!tree->nodeHasChildren(node)) {
+    if (inside) return node->setLogOdds(tree->getClampingThresMinLog());
+    tree->expandNode(node);
+  }
+  // A node with children has unknown space where a child is missing: only its children change.
   for (unsigned int c = 0; c < 8; ++c) {
     const Eigen::Vector3i child_key = childKey(min_key, edge, c);
     if (!tree->nodeChildExists(node, c) || !overlaps(child_key, edge / 2, box)) continue;
