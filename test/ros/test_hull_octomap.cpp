@@ -1,12 +1,14 @@
 // The hull node's octomap_server interface: the octomap_binary and octomap_full services read back
 // with OctoMap's own readers agree with the published topic, carved space is free and the object
-// occupied, ~clear_bbx frees its box (and refuses bad boxes), the centres cloud and the free
-// markers, and Debian's octomap-tools read the map the service gives. Every wait has a deadline.
+// occupied, ~clear_bbx frees its box (and refuses bad boxes), octomap_full, the centres cloud and
+// the free markers carry the same map, and Debian's octomap-tools read the map the service gives.
+// Every wait has a deadline.
 
 #include <gtest/gtest.h>
 #include <octomap/AbstractOcTree.h>
 #include <octomap/OcTree.h>
 #include <ros/ros.h>
+#include <sensor_msgs/PointCloud2.h>
 #include <std_srvs/Empty.h>
 #include <visualization_msgs/MarkerArray.h>
 
@@ -133,6 +135,58 @@ TEST_F(HullOctomapTest, ServicesGiveThePublishedMapWithFreeSpaceAndOctomapToolsR
       0)
       << out << err;
   EXPECT_NE(out.find("KLD: 0\n"), std::string::npos) << out;  // the maps agree
+}
+
+/// Leaves of the tree: occupied ones, and the free volume (cubic metres).
+struct LeafCount {
+  size_t occupied = 0;
+  double free_m3 = 0.0;
+};
+LeafCount countLeaves(const octomap::OcTree& tree) {
+  LeafCount count;
+  for (auto leaf = tree.begin_leafs(); leaf != tree.end_leafs(); ++leaf) {
+    if (tree.isNodeOccupied(*leaf)) {
+      ++count.occupied;
+    } else {
+      count.free_m3 += std::pow(leaf.getSize(), 3);
+    }
+  }
+  return count;
+}
+
+TEST_F(HullOctomapTest, TheOtherTopicsCarryTheSameMap) {
+  ASSERT_NO_FATAL_FAILURE(carveSphere());
+  sift_hull::OctomapConstPtr full;
+  sensor_msgs::PointCloud2ConstPtr centres;
+  visualization_msgs::MarkerArrayConstPtr free;
+  // Subscribed now: octomap_full and the free markers are built for a new subscriber at once.
+  ros::Subscriber full_sub = nh_.subscribe<sift_hull::Octomap>(
+      "octomap_full", 2, [&](const sift_hull::OctomapConstPtr& m) { full = m; });
+  ros::Subscriber centres_sub = nh_.subscribe<sensor_msgs::PointCloud2>(
+      "octomap_point_cloud_centers", 2,
+      [&](const sensor_msgs::PointCloud2ConstPtr& m) { centres = m; });
+  ros::Subscriber free_sub = nh_.subscribe<visualization_msgs::MarkerArray>(
+      "free_cells_vis_array", 2,
+      [&](const visualization_msgs::MarkerArrayConstPtr& m) { free = m; });
+  const ros::Time stamp = last_octomap_->header.stamp;
+  ASSERT_TRUE(waitFor([&] {
+    return full && full->header.stamp == stamp && centres && centres->header.stamp == stamp &&
+           free && !free->markers.empty() && free->markers[0].header.stamp == stamp;
+  })) << "octomap_full, octomap_point_cloud_centers or free_cells_vis_array missing";
+  sift_hull::Octomap served;
+  ASSERT_NE(callMap("/octomap_full", &served), nullptr);
+  EXPECT_EQ(full->data, served.data);
+  EXPECT_FALSE(full->binary);
+  const LeafCount leaves = countLeaves(*readMap(*last_octomap_));
+  EXPECT_GT(leaves.occupied, 100u);
+  EXPECT_EQ(static_cast<size_t>(centres->width) * centres->height, leaves.occupied);
+  double free_m3 = 0.0;
+  for (const visualization_msgs::Marker& m : free->markers) {
+    EXPECT_EQ(m.ns, "free_cells");
+    free_m3 += m.points.size() * std::pow(m.scale.x, 3);
+  }
+  EXPECT_GT(leaves.free_m3, 1.0);  // the cube's edge is about 1.7 m, the sphere's volume 2.1 m^3
+  EXPECT_NEAR(free_m3, leaves.free_m3, 1e-6 * leaves.free_m3);
 }
 
 TEST_F(HullOctomapTest, ClearBbxFreesTheBoxUntilResetAndRefusesBadBoxes) {

@@ -36,7 +36,9 @@ HullNode::HullNode(ros::NodeHandle nh, ros::NodeHandle private_nh, HullNodeConfi
       config_(std::move(node_config)),
       stream_(std::move(hull_config)),
       octomap_pub_(nh_.advertise<sift_hull::Octomap>("octomap_binary", 1, true)),
-      octomap_full_pub_(nh_.advertise<sift_hull::Octomap>("octomap_full", 1, true)),
+      octomap_full_pub_(nh_.advertise<sift_hull::Octomap>(
+          "octomap_full", 1, [this](const ros::SingleSubscriberPublisher&) { publishFullNow(); },
+          ros::SubscriberStatusCallback(), ros::VoidConstPtr(), true)),
       cloud_pub_(nh_.advertise<sensor_msgs::PointCloud2>("occupied_cells", 1, true)),
       centers_pub_(nh_.advertise<sensor_msgs::PointCloud2>("octomap_point_cloud_centers", 1, true)),
       markers_pub_(nh_.advertise<visualization_msgs::MarkerArray>(

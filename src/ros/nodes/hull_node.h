@@ -88,7 +88,9 @@ class HullNode {
   void publish(const ros::Time& stamp);
   /// octree_ on the map topics (and the markers while subscribed), stamped header_.
   void publishMaps();
-  /// Markers and mesh for a new subscriber (they are built only while someone looks).
+  /// octomap_full, markers and mesh for a new subscriber (they are built only while someone
+  /// looks).
+  void publishFullNow();
   void publishMarkersNow();
   void publishFreeMarkersNow();
   void publishMeshNow();

@@ -58,7 +58,9 @@ void HullNode::publish(const ros::Time& stamp) {
 
 void HullNode::publishMaps() {
   octomap_pub_.publish(ros_conversions::octomapMessage(*octree_, header_));
-  octomap_full_pub_.publish(ros_conversions::octomapFullMessage(*octree_, header_));
+  if (octomap_full_pub_.getNumSubscribers() > 0) {  // its data is about 10 times the binary's
+    octomap_full_pub_.publish(ros_conversions::octomapFullMessage(*octree_, header_));
+  }
   const sensor_msgs::PointCloud2 centres = ros_conversions::occupiedCellsCloud(*octree_, header_);
   cloud_pub_.publish(centres);
   centers_pub_.publish(centres);
@@ -78,6 +80,11 @@ const TriangleMesh& HullNode::publishedMesh() {
 void HullNode::publishMarkersNow() {
   std::lock_guard<std::mutex> lock(hull_mutex_);
   if (octree_) markers_pub_.publish(ros_conversions::occupiedCellsMarkers(*octree_, header_));
+}
+
+void HullNode::publishFullNow() {
+  std::lock_guard<std::mutex> lock(hull_mutex_);
+  if (octree_) octomap_full_pub_.publish(ros_conversions::octomapFullMessage(*octree_, header_));
 }
 
 void HullNode::publishFreeMarkersNow() {
