@@ -8,6 +8,8 @@
 // every one). The one exception is RobustFitConfig, held twice in FilterConfigs: its fields are
 // ~ransac_<field> and ~magsac_<field>. Renamed parameters are still read under their old names,
 // with a deprecation warning naming the new one; when both are set, the new name wins.
+// octomap_server's names for the hull node's settings are understood too: ~frame_id as
+// ~world_frame, and ~resolution refused with the setting to use instead (~max_depth).
 
 #include <ros/node_handle.h>
 
