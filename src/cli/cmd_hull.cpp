@@ -32,6 +32,15 @@ void writeOutputs(const ArgParser& parser, const HullResult& result,
   }
 }
 
+/// The tree's occupied leaves (its free leaves, the carved space, aside).
+size_t occupiedLeaves(const octomap::OcTree& octree) {
+  size_t occupied = 0;
+  for (auto leaf = octree.begin_leafs(); leaf != octree.end_leafs(); ++leaf) {
+    occupied += octree.isNodeOccupied(*leaf);
+  }
+  return occupied;
+}
+
 /// A result that cannot be right: an error, or with --allow-poor a warning on stderr and in the
 /// JSON's `warnings`.
 class PoorResults {
@@ -141,7 +150,7 @@ int runHull(const std::vector<std::string>& args) {
   }
   checkResult(result, iou, &poor);
   writeOutputs(parser, result, *octree);
-  nlohmann::json json = hullJson(result, octree->getNumLeafNodes(), iou);
+  nlohmann::json json = hullJson(result, occupiedLeaves(*octree), iou);
   json["warnings"] = poor.warnings();
   json["peak_memory_mib"] = {{"through_hull", hull_peak_mib}, {"total", peakMemoryMiB()}};
   printResult(parser.flag("json"), json, hullText(json));

@@ -181,22 +181,53 @@ TEST(VisualHull, SampledFieldIsTheMaximumOverEveryView) {
   EXPECT_EQ(differing, 0u) << "of " << points.size();
 }
 
-TEST_F(SphereHull, OctomapHoldsTheOccupiedCells) {
-  const std::unique_ptr<octomap::OcTree> tree = toOctomap(result_->hull);
-  EXPECT_DOUBLE_EQ(tree->getResolution(), result_->hull.cube().resolution_m);
-  const octomap::OcTreeNode* centre = tree->search(0.0, 0.0, 0.0);
-  ASSERT_NE(centre, nullptr);
-  EXPECT_TRUE(tree->isNodeOccupied(centre));
-  EXPECT_EQ(tree->search(0.0, 0.0, 0.95), nullptr);  // outside the sphere: unknown
-  double octomap_m3 = 0.0, hull_m3 = 0.0;
-  for (auto leaf = tree->begin_leafs(); leaf != tree->end_leafs(); ++leaf) {
-    octomap_m3 += std::pow(leaf.getSize(), 3);
+double volumeOf(const octomap::OcTree& tree, int occupied) {  // occupied 1, free 0, either -1
+  double m3 = 0.0;
+  for (auto leaf = tree.begin_leafs(); leaf != tree.end_leafs(); ++leaf) {
+    if (occupied < 0 || tree.isNodeOccupied(*leaf) == (occupied == 1)) {
+      m3 += std::pow(leaf.getSize(), 3);
+    }
   }
-  const double voxel_m3 = std::pow(result_->hull.cube().resolution_m, 3);
+  return m3;
+}
+
+/// 1 occupied, 0 free, -1 unknown.
+int stateAt(const octomap::OcTree& tree, const Eigen::Vector3d& X_W) {
+  const octomap::OcTreeNode* node = tree.search(X_W.x(), X_W.y(), X_W.z());
+  return node == nullptr ? -1 : tree.isNodeOccupied(node);
+}
+
+TEST_F(SphereHull, OctomapHoldsTheOccupiedAndTheCarvedCells) {
+  const std::unique_ptr<octomap::OcTree> tree = toOctomap(result_->hull);
+  const HullCube& cube = result_->hull.cube();
+  EXPECT_DOUBLE_EQ(tree->getResolution(), cube.resolution_m);
+  EXPECT_EQ(stateAt(*tree, Eigen::Vector3d::Zero()), 1);  // the sphere's centre
+  // A voxel in the cube's corner lies 1.3 m from the centre of the sphere (radius 0.8): carved.
+  const Eigen::Vector3d corner =
+      cube.origin_W() + Eigen::Vector3d::Constant(1.5 * cube.resolution_m);
+  ASSERT_GT(corner.norm(), 1.2);
+  EXPECT_EQ(stateAt(*tree, corner), 0);
+  EXPECT_EQ(stateAt(*tree, cube.origin_W() - Eigen::Vector3d::Constant(0.5 * cube.resolution_m)),
+            -1);  // outside the cube: never decided
+  double hull_m3 = 0.0;
+  const double voxel_m3 = std::pow(cube.resolution_m, 3);
   result_->hull.forEachLeaf([&](const HullCell& cell) {
     if (cell.state != CellState::kOut) hull_m3 += voxel_m3 * std::pow(8, 7 - cell.depth);
   });
-  EXPECT_NEAR(octomap_m3, hull_m3, 1e-9 * hull_m3);
+  EXPECT_NEAR(volumeOf(*tree, 1), hull_m3, 1e-9 * hull_m3);
+  const double cube_m3 = std::pow(cube.edge_m(), 3);  // the whole cube is known
+  EXPECT_NEAR(volumeOf(*tree, -1), cube_m3, 1e-9 * cube_m3);
+  // Free space as coarse leaves, pruned: far fewer leaves than free voxels.
+  size_t free_leaves = 0;
+  for (auto leaf = tree->begin_leafs(); leaf != tree->end_leafs(); ++leaf) {
+    free_leaves += !tree->isNodeOccupied(*leaf);
+  }
+  const double free_voxels = (cube_m3 - hull_m3) / voxel_m3;
+  EXPECT_GT(free_leaves, 0u);
+  EXPECT_LT(free_leaves, free_voxels / 8) << free_voxels << " free voxels";
+  const size_t leaves = tree->getNumLeafNodes();
+  tree->prune();
+  EXPECT_EQ(tree->getNumLeafNodes(), leaves) << "not pruned";
   // The hull's own volume (surface cells by their centre) lies close above the sphere's.
   const double sphere_m3 = 4.0 / 3.0 * M_PI * std::pow(0.8, 3);
   EXPECT_GT(result_->hull.stats().occupied_volume_m3, sphere_m3);
@@ -208,6 +239,39 @@ TEST_F(SphereHull, OctomapHoldsTheOccupiedCells) {
   EXPECT_EQ(testing::internal::GetCapturedStderr(), "") << "nothing on stderr (a --json run's)";
   octomap::OcTree read(path);
   EXPECT_EQ(read.getNumLeafNodes(), tree->getNumLeafNodes());
+}
+
+TEST_F(SphereHull, ClearingABoxFreesTheVoxelsItTouchesAndNothingElse) {
+  const std::unique_ptr<octomap::OcTree> tree = toOctomap(result_->hull);
+  const double res = tree->getResolution();
+  const double before_m3 = volumeOf(*tree, 1), known_m3 = volumeOf(*tree, -1);
+  // Deep inside the sphere, not on voxel boundaries: the voxels touched are all occupied.
+  const Box3d box{Eigen::Vector3d(-0.1, -0.07, 0.02), Eigen::Vector3d(0.13, 0.05, 0.21)};
+  clearBox(box, tree.get());
+  double touched = 1.0;
+  for (int a = 0; a < 3; ++a) {
+    touched *= std::floor(box.max_W[a] / res) - std::floor(box.min_W[a] / res) + 1;
+  }
+  EXPECT_NEAR(volumeOf(*tree, 1), before_m3 - touched * std::pow(res, 3), 1e-9 * before_m3);
+  EXPECT_NEAR(volumeOf(*tree, -1), known_m3, 1e-9 * known_m3);  // unknown stays unknown
+  EXPECT_EQ(stateAt(*tree, box.centre()), 0);
+  EXPECT_EQ(stateAt(*tree, box.max_W + Eigen::Vector3d::Constant(1.01 * res)), 1);
+  EXPECT_EQ(stateAt(*tree, Eigen::Vector3d(0.0, 0.0, -0.3)), 1);
+  // A box reaching past the cube clears the cube's part only.
+  const HullCube& cube = result_->hull.cube();
+  const Eigen::Vector3d outside = cube.origin_W() - Eigen::Vector3d::Constant(0.5 * res);
+  clearBox({outside - Eigen::Vector3d::Constant(res), outside + Eigen::Vector3d::Constant(2 * res)},
+           tree.get());
+  EXPECT_EQ(stateAt(*tree, outside), -1);
+  EXPECT_NEAR(volumeOf(*tree, -1), known_m3, 1e-9 * known_m3);
+  // Bad boxes are refused before anything changes.
+  Box3d inverted = box;
+  std::swap(inverted.min_W.x(), inverted.max_W.x());
+  EXPECT_FALSE(isValidClearBox(inverted));
+  EXPECT_THROW(clearBox(inverted, tree.get()), std::invalid_argument);
+  EXPECT_THROW(clearBox({Eigen::Vector3d(std::nan(""), 0, 0), Eigen::Vector3d::Ones()}, tree.get()),
+               std::invalid_argument);
+  EXPECT_TRUE(isValidClearBox({Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()}));
 }
 
 std::vector<HullCell> leavesOf(const VisualHull& hull) {

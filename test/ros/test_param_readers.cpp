@@ -303,6 +303,35 @@ TEST(ParameterReaders, TheNewNameWinsOverTheOldOne) {
   EXPECT_EQ(same_log.warnings, std::vector<std::string>{"~depth is deprecated, use ~max_depth"});
 }
 
+/// The message of the std::invalid_argument that `read` throws ("" when it throws none).
+std::string refusal(const std::function<void()>& read) {
+  try {
+    read();
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(ParameterReaders, OctomapServersNamesAreReadOrRefusedNamingOurs) {
+  ros::NodeHandle frame_id("/octomap_frame_id");
+  frame_id.setParam("frame_id", "map");
+  ReadLog log;
+  EXPECT_EQ(readHullNodeConfig(frame_id).world_frame, "map");  // ~frame_id alone: the world
+  EXPECT_EQ(log.names.count("frame_id"), 0u);  // not a name the parameter files need to state
+  frame_id.setParam("world_frame", "map");
+  EXPECT_EQ(readHullNodeConfig(frame_id).world_frame, "map");  // both, agreeing
+  frame_id.setParam("world_frame", "odom");
+  const std::string differ = refusal([&] { readHullNodeConfig(frame_id); });
+  EXPECT_NE(differ.find("~frame_id ('map'"), std::string::npos) << differ;
+  EXPECT_NE(differ.find("~world_frame ('odom')"), std::string::npos) << differ;
+  ros::NodeHandle resolution("/octomap_resolution");
+  resolution.setParam("resolution", 0.05);
+  const std::string refused = refusal([&] { readHullStreamConfig(resolution); });
+  EXPECT_NE(refused.find("~resolution"), std::string::npos) << refused;
+  EXPECT_NE(refused.find("set ~max_depth instead"), std::string::npos) << refused;
+}
+
 }  // namespace
 }  // namespace sift_hull
 

@@ -4,6 +4,7 @@
 #include <memory>
 #include <string>
 
+#include "sift_hull/hull/bounding_box.h"
 #include "sift_hull/hull/octree.h"
 
 namespace octomap {
@@ -12,11 +13,21 @@ class OcTree;
 
 namespace sift_hull {
 
-/// The hull as an OctoMap at the hull's resolution: in cells and finest surface cells occupied
-/// (log-odds at the clamping maximum), everything else unknown, pruned. The hull's voxels line up
-/// with the OctoMap's (HullCube). Throws std::out_of_range when the cube lies beyond the OctoMap's
-/// 2^16-voxel key range around the world origin.
+/// The hull as an OctoMap at the hull's resolution, pruned: in cells and finest surface cells
+/// occupied (log-odds at the clamping maximum), carved (out) cells free (log-odds at the clamping
+/// minimum) at their own octree level, so the whole cube is known and only space outside it is
+/// unknown. The hull's voxels line up with the OctoMap's (HullCube). Throws std::out_of_range
+/// when the cube lies beyond the OctoMap's 2^16-voxel key range around the world origin.
 std::unique_ptr<octomap::OcTree> toOctomap(const VisualHull& hull);
+
+/// Whether a box (metres) can be cleared: finite, min <= max on each axis.
+bool isValidClearBox(const Box3d& box_W);
+
+/// Sets every known voxel the box touches free (log-odds at the clamping minimum), as
+/// octomap_server's ~clear_bbx does, but to the voxel: a coarser leaf the box cuts is split, so
+/// only its part in the box changes. Unknown space stays unknown. The tree is pruned again.
+/// Throws std::invalid_argument for a box that is not isValidClearBox.
+void clearBox(const Box3d& box_W, octomap::OcTree* tree);
 
 /// Writes OctoMap's binary .bt file (the header OcTree::writeBinary writes, then the binary data).
 /// Throws std::runtime_error naming the path on failure.

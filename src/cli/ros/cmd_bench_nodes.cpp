@@ -80,7 +80,8 @@ std::string markdownReport(const std::vector<MatcherRun>& matcher,
   }
   out << "\nHull node, one view at a time (the next sent once /diagnostics counts the view "
       << "processed). Medians over the views that refine an existing hull: carving (`HullStream` "
-      << "add), publishing (OctoMap conversion, octomap_binary and occupied_cells), and the "
+      << "add), publishing (OctoMap conversion, octomap_binary and the centres cloud; octomap_full "
+         "and the markers only when subscribed), and the "
       << "latency from sending a view to receiving its octomap. Then the same views again and "
       << "again at 100 Hz for 5 s (`~queue_size` 10): processed counts the views the worker took, "
       << "redundant those of them left out because a view was already taken from there "

@@ -2,6 +2,8 @@
 
 #include <octomap/OcTree.h>
 
+#include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <ostream>
 #include <stdexcept>
@@ -12,21 +14,34 @@ namespace {
 constexpr int kKeyDepth = 16;
 constexpr int kKeyOffset = 1 << (kKeyDepth - 1);  // OctoMap's key of the world origin's voxel
 
-struct KeyBlock {
+/// OctoMap keys [min_key, end_key) on each axis.
+struct KeyBox {
   Eigen::Vector3i min_key;
-  int edge;
+  Eigen::Vector3i end_key;
 };
 
-bool overlaps(const Eigen::Vector3i& min_key, int edge, const KeyBlock& block) {
-  return ((min_key.array() < (block.min_key.array() + block.edge)) &&
-          (block.min_key.array() < (min_key.array() + edge)))
+bool overlaps(const Eigen::Vector3i& min_key, int edge, const KeyBox& box) {
+  return ((min_key.array() < box.end_key.array()) &&
+          (box.min_key.array() < (min_key.array() + edge)))
       .all();
 }
 
-bool within(const Eigen::Vector3i& min_key, int edge, const KeyBlock& block) {
-  return ((min_key.array() >= block.min_key.array()) &&
-          (min_key.array() + edge <= block.min_key.array() + block.edge))
+bool within(const Eigen::Vector3i& min_key, int edge, const KeyBox& box) {
+  return ((min_key.array() >= box.min_key.array()) &&
+          (min_key.array() + edge <= box.end_key.array()))
       .all();
+}
+
+Eigen::Vector3i childKey(const Eigen::Vector3i& min_key, int edge, unsigned int c) {
+  return min_key + Eigen::Vector3i(c & 1, (c >> 1) & 1, (c >> 2) & 1) * (edge / 2);
+}
+
+/// The node becomes a leaf of the given log-odds.
+void makeLeaf(octomap::OcTree* tree, octomap::OcTreeNode* node, float log_odds) {
+  for (unsigned int c = 0; c < 8; ++c) {
+    if (tree->nodeChildExists(node, c)) tree->deleteNodeChild(node, c);
+  }
+  node->setLogOdds(log_odds);
 }
 
 /// An OcTree that takes whole blocks of voxels, setting the largest aligned nodes inside a block
@@ -35,64 +50,103 @@ class BlockOcTree : public octomap::OcTree {
  public:
   using octomap::OcTree::OcTree;
 
-  void insertOccupied(const KeyBlock& block) {
+  /// A cubic block (the hull's cells) whose voxels all take `log_odds`.
+  void insertBlock(const KeyBox& block, float log_odds) {
     if (root == nullptr) {
       root = new octomap::OcTreeNode();
       ++tree_size;
     }
-    if (isAligned(block)) return insertAligned(block);
-    insert(root, 0, Eigen::Vector3i::Zero(), block);
+    if (isAligned(block)) return insertAligned(block, log_odds);
+    insert(root, 0, Eigen::Vector3i::Zero(), block, log_odds);
   }
 
  private:
-  static bool isAligned(const KeyBlock& block) {
+  static bool isAligned(const KeyBox& block) {
+    const int edge = block.end_key.x() - block.min_key.x();
     const Eigen::Vector3i& key = block.min_key;
-    return key.x() % block.edge == 0 && key.y() % block.edge == 0 && key.z() % block.edge == 0;
+    return key.x() % edge == 0 && key.y() % edge == 0 && key.z() % edge == 0;
   }
 
   /// A block that is one octree node (most of them: the hull's cells are octree cells): the path
   /// to it is read off its key bits, with no overlap tests.
-  void insertAligned(const KeyBlock& block) {
+  void insertAligned(const KeyBox& block, float log_odds) {
+    const int edge = block.end_key.x() - block.min_key.x();
     octomap::OcTreeNode* node = root;
-    for (int level = 0; (1 << (kKeyDepth - level)) > block.edge; ++level) {
+    for (int level = 0; (1 << (kKeyDepth - level)) > edge; ++level) {
       const int bit = kKeyDepth - 1 - level;
       const unsigned int c = ((block.min_key.x() >> bit) & 1) |
                              (((block.min_key.y() >> bit) & 1) << 1) |
                              (((block.min_key.z() >> bit) & 1) << 2);
       node = nodeChildExists(node, c) ? getNodeChild(node, c) : createNodeChild(node, c);
     }
-    makeOccupiedLeaf(node);
+    makeLeaf(this, node, log_odds);
   }
 
   void insert(octomap::OcTreeNode* node, int level, const Eigen::Vector3i& min_key,
-              const KeyBlock& block) {
+              const KeyBox& block, float log_odds) {
     const int edge = 1 << (kKeyDepth - level);
-    if (within(min_key, edge, block)) return makeOccupiedLeaf(node);
+    if (within(min_key, edge, block)) return makeLeaf(this, node, log_odds);
     for (unsigned int c = 0; c < 8; ++c) {
-      const Eigen::Vector3i child_key =
-          min_key + Eigen::Vector3i(c & 1, (c >> 1) & 1, (c >> 2) & 1) * (edge / 2);
+      const Eigen::Vector3i child_key = childKey(min_key, edge, c);
       if (!overlaps(child_key, edge / 2, block)) continue;
       octomap::OcTreeNode* child =
           nodeChildExists(node, c) ? getNodeChild(node, c) : createNodeChild(node, c);
-      insert(child, level + 1, child_key, block);
+      insert(child, level + 1, child_key, block, log_odds);
     }
-  }
-
-  void makeOccupiedLeaf(octomap::OcTreeNode* node) {
-    for (unsigned int c = 0; c < 8; ++c) {
-      if (nodeChildExists(node, c)) deleteNodeChild(node, c);
-    }
-    node->setLogOdds(getClampingThresMaxLog());
   }
 };
 
-KeyBlock toKeys(const VoxelBlock& block) {
-  const KeyBlock keys{block.min_voxels + Eigen::Vector3i::Constant(kKeyOffset), block.edge_voxels};
-  if ((keys.min_key.array() < 0).any() ||
-      (keys.min_key.array() + keys.edge > 2 * kKeyOffset).any()) {
+KeyBox toKeys(const VoxelBlock& block) {
+  const Eigen::Vector3i min_key = block.min_voxels + Eigen::Vector3i::Constant(kKeyOffset);
+  const KeyBox keys{min_key, min_key + Eigen::Vector3i::Constant(block.edge_voxels)};
+  if ((keys.min_key.array() < 0).any() || (keys.end_key.array() > 2 * kKeyOffset).any()) {
     throw std::out_of_range(
         "the hull lies beyond OctoMap's key range (2^16 voxels around the world origin) at this "
         "resolution");
+  }
+  return keys;
+}
+
+/// The carved cells: out cells of any size, as blocks like occupiedBlocks'.
+std::vector<VoxelBlock> carvedBlocks(const VisualHull& hull) {
+  std::vector<VoxelBlock> blocks;
+  const HullCube& cube = hull.cube();
+  hull.forEachLeaf([&](const HullCell& cell) {
+    if (cell.state != CellState::kOut) return;
+    const int edge = 1 << (cube.depth - cell.depth);
+    blocks.push_back({cube.origin_voxels + cell.index * edge, edge});
+  });
+  return blocks;
+}
+
+/// Sets the known voxels of `box` below `node` (at `level`, its first key `min_key`) free,
+/// splitting leaves that the box cuts (prune merges them again).
+void clearNode(octomap::OcTree* tree, octomap::OcTreeNode* node, int level,
+               const Eigen::Vector3i& min_key, const KeyBox& box) {
+  const int edge = 1 << (kKeyDepth - level);
+  const bool inside = within(min_key, edge, box);
+  if (!tree->nodeHasChildren(node)) {
+    if (inside) return node->setLogOdds(tree->getClampingThresMinLog());
+    tree->expandNode(node);
+  }
+  // A node with children has unknown space where a child is missing: only its children change.
+  for (unsigned int c = 0; c < 8; ++c) {
+    const Eigen::Vector3i child_key = childKey(min_key, edge, c);
+    if (!tree->nodeChildExists(node, c) || !overlaps(child_key, edge / 2, box)) continue;
+    clearNode(tree, tree->getNodeChild(node, c), level + 1, child_key, box);
+  }
+}
+
+/// The keys of the voxels a metric box touches, clipped to OctoMap's key range.
+KeyBox touchedKeys(const octomap::OcTree& tree, const Box3d& box_W) {
+  const auto key = [&](double coordinate_m) {
+    const double k = std::floor(coordinate_m / tree.getResolution()) + kKeyOffset;
+    return static_cast<int>(std::clamp(k, -1.0, 2.0 * kKeyOffset));
+  };
+  KeyBox keys;
+  for (int axis = 0; axis < 3; ++axis) {
+    keys.min_key[axis] = std::max(key(box_W.min_W[axis]), 0);
+    keys.end_key[axis] = std::min(key(box_W.max_W[axis]) + 1, 2 * kKeyOffset);
   }
   return keys;
 }
@@ -101,7 +155,9 @@ KeyBlock toKeys(const VoxelBlock& block) {
 
 std::unique_ptr<octomap::OcTree> toOctomap(const VisualHull& hull) {
   auto tree = std::make_unique<BlockOcTree>(hull.cube().resolution_m);
-  for (const VoxelBlock& block : occupiedBlocks(hull)) tree->insertOccupied(toKeys(block));
+  const float occupied = tree->getClampingThresMaxLog(), free = tree->getClampingThresMinLog();
+  for (const VoxelBlock& block : occupiedBlocks(hull)) tree->insertBlock(toKeys(block), occupied);
+  for (const VoxelBlock& block : carvedBlocks(hull)) tree->insertBlock(toKeys(block), free);
   tree->updateInnerOccupancy();
   tree->prune();
   return tree;
@@ -109,6 +165,22 @@ std::unique_ptr<octomap::OcTree> toOctomap(const VisualHull& hull) {
 
 void writeOctomapBinaryData(const octomap::OcTree& tree, std::ostream& out) {
   if (tree.getRoot() != nullptr) tree.writeBinaryNode(out, tree.getRoot());
+}
+
+bool isValidClearBox(const Box3d& box_W) {
+  return box_W.min_W.allFinite() && box_W.max_W.allFinite() &&
+         (box_W.min_W.array() <= box_W.max_W.array()).all();
+}
+
+void clearBox(const Box3d& box_W, octomap::OcTree* tree) {
+  if (!isValidClearBox(box_W)) {
+    throw std::invalid_argument("the box to clear must be finite with min <= max on each axis");
+  }
+  const KeyBox keys = touchedKeys(*tree, box_W);
+  if (tree->getRoot() == nullptr || !(keys.min_key.array() < keys.end_key.array()).all()) return;
+  clearNode(tree, tree->getRoot(), 0, Eigen::Vector3i::Zero(), keys);
+  tree->updateInnerOccupancy();
+  tree->prune();
 }
 
 void writeOctomap(const octomap::OcTree& tree, const std::string& path) {

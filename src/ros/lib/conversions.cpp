@@ -1,17 +1,12 @@
 #include "lib/conversions.h"
 
 #include <cv_bridge/cv_bridge.h>
-#include <octomap/OcTree.h>
-#include <pcl/point_cloud.h>
-#include <pcl/point_types.h>
-#include <pcl_conversions/pcl_conversions.h>
 #include <sensor_msgs/image_encodings.h>
 #include <tf2_eigen/tf2_eigen.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <stdexcept>
@@ -230,82 +225,6 @@ geometry_msgs::TransformStamped cameraPoseMessage(const PinholeCamera& camera,
   pose.header.frame_id = world_frame;
   pose.child_frame_id = camera_frame;
   return pose;
-}
-
-sift_hull::Octomap octomapMessage(const octomap::OcTree& tree, const std_msgs::Header& header) {
-  sift_hull::Octomap message;
-  message.header = header;
-  message.binary = true;
-  message.id = tree.getTreeType();
-  message.resolution = tree.getResolution();
-  std::stringstream stream;
-  writeOctomapBinaryData(tree, stream);
-  const std::string bytes = stream.str();
-  message.data.assign(bytes.begin(), bytes.end());
-  return message;
-}
-
-sensor_msgs::PointCloud2 pointCloudMessage(const std::vector<Eigen::Vector3d>& points,
-                                           const std_msgs::Header& header) {
-  pcl::PointCloud<pcl::PointXYZ> cloud;
-  for (const Eigen::Vector3d& point : points) {
-    cloud.push_back(pcl::PointXYZ(point.x(), point.y(), point.z()));
-  }
-  sensor_msgs::PointCloud2 message;
-  pcl::toROSMsg(cloud, message);
-  message.header = header;
-  return message;
-}
-
-sensor_msgs::PointCloud2 occupiedCellsCloud(const octomap::OcTree& tree,
-                                            const std_msgs::Header& header) {
-  std::vector<Eigen::Vector3d> centres;
-  for (auto leaf = tree.begin_leafs(); leaf != tree.end_leafs(); ++leaf) {
-    if (tree.isNodeOccupied(*leaf)) centres.emplace_back(leaf.getX(), leaf.getY(), leaf.getZ());
-  }
-  return pointCloudMessage(centres, header);
-}
-
-namespace {
-
-std_msgs::ColorRGBA heightColour(double fraction) {
-  std_msgs::ColorRGBA colour;
-  colour.r = static_cast<float>(std::clamp(1.5 - std::abs(4.0 * fraction - 3.0), 0.0, 1.0));
-  colour.g = static_cast<float>(std::clamp(1.5 - std::abs(4.0 * fraction - 2.0), 0.0, 1.0));
-  colour.b = static_cast<float>(std::clamp(1.5 - std::abs(4.0 * fraction - 1.0), 0.0, 1.0));
-  colour.a = 1.0f;
-  return colour;
-}
-
-}  // namespace
-
-visualization_msgs::MarkerArray occupiedCellsMarkers(const octomap::OcTree& tree,
-                                                     const std_msgs::Header& header) {
-  double min_x, min_y, min_z, max_x, max_y, max_z;
-  tree.getMetricMin(min_x, min_y, min_z);
-  tree.getMetricMax(max_x, max_y, max_z);
-  const double height = std::max(max_z - min_z, 1e-9);
-  std::map<unsigned, visualization_msgs::Marker> by_depth;
-  for (auto leaf = tree.begin_leafs(); leaf != tree.end_leafs(); ++leaf) {
-    if (!tree.isNodeOccupied(*leaf)) continue;
-    visualization_msgs::Marker& marker = by_depth[leaf.getDepth()];
-    geometry_msgs::Point centre;
-    centre.x = leaf.getX(), centre.y = leaf.getY(), centre.z = leaf.getZ();
-    marker.points.push_back(centre);
-    marker.colors.push_back(heightColour((centre.z - min_z) / height));
-    marker.scale.x = marker.scale.y = marker.scale.z = leaf.getSize();
-  }
-  visualization_msgs::MarkerArray array;
-  for (auto& [depth, marker] : by_depth) {
-    marker.header = header;
-    marker.ns = "occupied_cells";
-    marker.id = static_cast<int>(depth);
-    marker.type = visualization_msgs::Marker::CUBE_LIST;
-    marker.action = visualization_msgs::Marker::ADD;
-    marker.pose.orientation.w = 1.0;
-    array.markers.push_back(marker);
-  }
-  return array;
 }
 
 visualization_msgs::Marker meshMarker(const TriangleMesh& mesh, const std_msgs::Header& header) {

@@ -2,6 +2,7 @@
 
 // Every conversion between sift_hull's core types and ROS messages.
 
+#include <geometry_msgs/Point.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
@@ -10,6 +11,7 @@
 #include <visualization_msgs/MarkerArray.h>
 
 #include <Eigen/Geometry>
+#include <memory>
 #include <opencv2/core.hpp>
 #include <string>
 #include <vector>
@@ -20,6 +22,7 @@
 #include "sift_hull/features/matching.h"
 #include "sift_hull/filters/filter.h"
 #include "sift_hull/geometry/camera.h"
+#include "sift_hull/hull/bounding_box.h"
 #include "sift_hull/hull/mesh.h"
 
 namespace octomap {
@@ -76,8 +79,20 @@ geometry_msgs::TransformStamped cameraPoseMessage(const PinholeCamera& camera,
                                                   const std::string& camera_frame,
                                                   const ros::Time& stamp);
 
-/// The tree as an Octomap message (binary stream, as octomap_msgs::binaryMapToMsg writes it).
+/// The tree as an Octomap message (binary stream, as octomap_msgs::binaryMapToMsg writes it):
+/// binary true, id "OcTree", resolution in metres, data holding occupied / free per leaf only.
 sift_hull::Octomap octomapMessage(const octomap::OcTree& tree, const std_msgs::Header& header);
+
+/// The tree as a full Octomap message (as octomap_msgs::fullMapToMsg writes it): binary false, id
+/// "OcTree", resolution in metres, data as OcTree::writeData writes it, with each node's
+/// log-odds occupancy.
+sift_hull::Octomap octomapFullMessage(const octomap::OcTree& tree, const std_msgs::Header& header);
+
+/// The tree a binary or full Octomap message holds, read as octomap_msgs::msgToMap reads it
+/// (OcTree::readBinaryData or OcTree::readData); empty data is an empty tree. Throws
+/// std::invalid_argument for an id other than "OcTree", a resolution that is not a positive
+/// number, or data cut short.
+std::unique_ptr<octomap::OcTree> octreeFromMessage(const sift_hull::Octomap& message);
 
 /// Points (metres, in the header's frame) as an XYZ PointCloud2 (via pcl_conversions).
 sensor_msgs::PointCloud2 pointCloudMessage(const std::vector<Eigen::Vector3d>& points,
@@ -91,6 +106,15 @@ sensor_msgs::PointCloud2 occupiedCellsCloud(const octomap::OcTree& tree,
 /// occupied_cells_vis_array), coloured by height.
 visualization_msgs::MarkerArray occupiedCellsMarkers(const octomap::OcTree& tree,
                                                      const std_msgs::Header& header);
+
+/// The box between two corners (a BoundingBoxQuery request's min and max, metres), as given:
+/// not checked (isValidClearBox checks it).
+Box3d boxFromCorners(const geometry_msgs::Point& min, const geometry_msgs::Point& max);
+
+/// Free leaves as CUBE_LIST markers, one per leaf size (octomap_server's free_cells_vis_array),
+/// blue, in namespace "free_cells".
+visualization_msgs::MarkerArray freeCellsMarkers(const octomap::OcTree& tree,
+                                                 const std_msgs::Header& header);
 
 /// The mesh as a TRIANGLE_LIST marker in the header's frame, metres.
 visualization_msgs::Marker meshMarker(const TriangleMesh& mesh, const std_msgs::Header& header);

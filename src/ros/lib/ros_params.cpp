@@ -119,6 +119,11 @@ SilhouetteConfig readSilhouetteConfig(const ros::NodeHandle& private_nh) {
 
 HullConfig readHullConfig(const ros::NodeHandle& private_nh) {
   HullConfig config;
+  if (private_nh.hasParam("resolution")) {  // octomap_server's voxel edge
+    throw std::invalid_argument(
+        "~resolution (octomap_server's voxel edge) is not a hull_node parameter: the voxel edge is "
+        "the box's longest edge / (2^max_depth - 3); set ~max_depth instead");
+  }
   readRenamed(private_nh, "max_depth", "depth", &config.max_depth);
   read(private_nh, "carve_outside_image", &config.carve_outside_image);
   readRenamed(private_nh, "distance_slack_px", "slack_px", &config.distance_slack_px);
@@ -261,9 +266,26 @@ MatcherSettings readMatcherSettings(const ros::NodeHandle& private_nh) {
   return settings;
 }
 
+namespace {
+
+/// ~world_frame, or octomap_server's ~frame_id for it; both set and different: an error.
+std::string readWorldFrame(const ros::NodeHandle& private_nh, std::string world_frame) {
+  read(private_nh, "world_frame", &world_frame);
+  std::string frame_id;
+  if (!get(private_nh, "frame_id", &frame_id)) return world_frame;
+  if (private_nh.hasParam("world_frame") && frame_id != world_frame) {
+    throw std::invalid_argument("~frame_id ('" + frame_id + "', octomap_server's map frame) and " +
+                                "~world_frame ('" + world_frame +
+                                "') differ: set ~world_frame only");
+  }
+  return frame_id;
+}
+
+}  // namespace
+
 HullNodeConfig readHullNodeConfig(const ros::NodeHandle& private_nh) {
   HullNodeConfig config;
-  read(private_nh, "world_frame", &config.world_frame);
+  config.world_frame = readWorldFrame(private_nh, config.world_frame);
   read(private_nh, "queue_size", &config.queue_size);
   read(private_nh, "pose_timeout_s", &config.pose_timeout_s);
   read(private_nh, "from_image", &config.from_image);

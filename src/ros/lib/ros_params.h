@@ -8,6 +8,8 @@
 // every one). The one exception is RobustFitConfig, held twice in FilterConfigs: its fields are
 // ~ransac_<field> and ~magsac_<field>. Renamed parameters are still read under their old names,
 // with a deprecation warning naming the new one; when both are set, the new name wins.
+// octomap_server's names for the hull node's settings are understood too: ~frame_id as
+// ~world_frame, and ~resolution refused with the setting to use instead (~max_depth).
 
 #include <ros/node_handle.h>
 
@@ -36,7 +38,9 @@ double descriptorDistanceParam(double distance);
 SilhouetteConfig readSilhouetteConfig(const ros::NodeHandle& private_nh);
 
 /// ~max_depth, ~carve_outside_image, ~distance_slack_px, ~threads, ~distance_reduction.
-/// Deprecated: ~depth (~max_depth), ~slack_px (~distance_slack_px).
+/// Deprecated: ~depth (~max_depth), ~slack_px (~distance_slack_px). octomap_server's ~resolution
+/// is refused (std::invalid_argument naming ~max_depth): the voxel edge follows from the box and
+/// ~max_depth.
 HullConfig readHullConfig(const ros::NodeHandle& private_nh);
 
 /// The hull config, ~box ([xmin, ymin, zmin, xmax, ymax, zmax] in the world frame, metres; empty
@@ -81,7 +85,8 @@ MatcherNodeConfig readMatcherNodeConfig(const ros::NodeHandle& private_nh);
 MatcherSettings readMatcherSettings(const ros::NodeHandle& private_nh);
 
 /// ~world_frame, ~queue_size, ~pose_timeout_s, ~from_image, ~diagnostic_period and the
-/// silhouette recipe.
+/// silhouette recipe. octomap_server's ~frame_id is read as ~world_frame; set with a different
+/// ~world_frame, it is an error (std::invalid_argument naming both).
 HullNodeConfig readHullNodeConfig(const ros::NodeHandle& private_nh);
 
 /// ~bag, ~out_dir (both required: throws std::invalid_argument without them),

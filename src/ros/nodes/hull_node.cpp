@@ -39,10 +39,18 @@ HullNode::HullNode(ros::NodeHandle nh, ros::NodeHandle private_nh, HullNodeConfi
       config_(std::move(node_config)),
       stream_(std::move(hull_config)),
       octomap_pub_(nh_.advertise<sift_hull::Octomap>("octomap_binary", 1, true)),
+      octomap_full_pub_(nh_.advertise<sift_hull::Octomap>(
+          "octomap_full", 1, [this](const ros::SingleSubscriberPublisher&) { publishFullNow(); },
+          ros::SubscriberStatusCallback(), ros::VoidConstPtr(), true)),
       cloud_pub_(nh_.advertise<sensor_msgs::PointCloud2>("occupied_cells", 1, true)),
+      centers_pub_(nh_.advertise<sensor_msgs::PointCloud2>("octomap_point_cloud_centers", 1, true)),
       markers_pub_(nh_.advertise<visualization_msgs::MarkerArray>(
           "occupied_cells_vis_array", 1,
           [this](const ros::SingleSubscriberPublisher&) { publishMarkersNow(); },
+          ros::SubscriberStatusCallback(), ros::VoidConstPtr(), true)),
+      free_markers_pub_(nh_.advertise<visualization_msgs::MarkerArray>(
+          "free_cells_vis_array", 1,
+          [this](const ros::SingleSubscriberPublisher&) { publishFreeMarkersNow(); },
           ros::SubscriberStatusCallback(), ros::VoidConstPtr(), true)),
       mesh_pub_(nh_.advertise<visualization_msgs::Marker>(
           "mesh", 1, [this](const ros::SingleSubscriberPublisher&) { publishMeshNow(); },
@@ -64,8 +72,7 @@ HullNode::HullNode(ros::NodeHandle nh, ros::NodeHandle private_nh, HullNodeConfi
       sync_(config_.queue_size) {
   pose_timer_ = nh_.createWallTimer(ros::WallDuration(0.2),
                                     [this](const ros::WallTimerEvent&) { reportPoseTimeouts(); });
-  reset_srv_ = private_nh_.advertiseService("reset", &HullNode::reset, this);
-  save_srv_ = private_nh_.advertiseService("save", &HullNode::save, this);
+  advertiseServices();
   subscribe();
 }
 
@@ -218,57 +225,12 @@ bool HullNode::carve(const View& view) {
   }
 }
 
-void HullNode::publish(const ros::Time& stamp) {
-  header_.stamp = stamp;
-  header_.frame_id = config_.world_frame;
-  octree_ = toOctomap(stream_.hull());
-  mesh_.reset();
-  octomap_pub_.publish(ros_conversions::octomapMessage(*octree_, header_));
-  cloud_pub_.publish(ros_conversions::occupiedCellsCloud(*octree_, header_));
-  if (markers_pub_.getNumSubscribers() > 0) {
-    markers_pub_.publish(ros_conversions::occupiedCellsMarkers(*octree_, header_));
-  }
-  if (mesh_pub_.getNumSubscribers() > 0) {
-    mesh_pub_.publish(ros_conversions::meshMarker(publishedMesh(), header_));
-  }
-}
-
-const TriangleMesh& HullNode::publishedMesh() {
-  if (!mesh_) mesh_ = std::make_unique<TriangleMesh>(stream_.hull().mesh());
-  return *mesh_;
-}
-
-void HullNode::publishMarkersNow() {
-  std::lock_guard<std::mutex> lock(hull_mutex_);
-  if (octree_) markers_pub_.publish(ros_conversions::occupiedCellsMarkers(*octree_, header_));
-}
-
-void HullNode::publishMeshNow() {
-  std::lock_guard<std::mutex> lock(hull_mutex_);
-  if (octree_) mesh_pub_.publish(ros_conversions::meshMarker(publishedMesh(), header_));
-}
-
-/// An empty map at the last resolution, and markers deleted.
-void HullNode::publishEmpty() {
-  header_.stamp = ros::Time::now();
-  header_.frame_id = config_.world_frame;
-  const octomap::OcTree empty(octree_ ? octree_->getResolution() : 0.1);
-  octomap_pub_.publish(ros_conversions::octomapMessage(empty, header_));
-  cloud_pub_.publish(ros_conversions::occupiedCellsCloud(empty, header_));
-  visualization_msgs::Marker delete_all;
-  delete_all.header = header_;
-  delete_all.action = visualization_msgs::Marker::DELETEALL;
-  visualization_msgs::MarkerArray markers;
-  markers.markers.push_back(delete_all);
-  markers_pub_.publish(markers);
-  mesh_pub_.publish(delete_all);
-}
-
 bool HullNode::reset(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
   std::lock_guard<std::mutex> lock(hull_mutex_);
   ++generation_;
   const size_t discarded = work_.clear();  // views from before the reset
   stream_.reset();
+  cleared_boxes_.clear();
   refused_views_ = 0;
   publishEmpty();
   octree_.reset();

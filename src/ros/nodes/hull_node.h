@@ -15,6 +15,7 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <vector>
 
 #include "lib/node_diagnostics.h"
 #include "lib/pairing_watch.h"
@@ -22,7 +23,10 @@
 #include "lib/pose_waits.h"
 #include "lib/throttled_log.h"
 #include "lib/work_queue.h"
+#include "sift_hull/BoundingBoxQuery.h"
+#include "sift_hull/GetOctomap.h"
 #include "sift_hull/Save.h"
+#include "sift_hull/hull/bounding_box.h"
 #include "sift_hull/hull/hull_stream.h"
 #include "sift_hull/hull/mesh.h"
 #include "sift_hull/hull/silhouette.h"
@@ -50,6 +54,9 @@ struct HullNodeConfig {
 
 /// The hull node: silhouettes (mono8) with their camera_info, once tf knows the camera's pose in
 /// the world frame, refine a visual hull; the results are published latched after every view.
+/// Its OctoMap interface is octomap_server's: the topics octomap_binary, octomap_full,
+/// octomap_point_cloud_centers, occupied_cells_vis_array and free_cells_vis_array, the services
+/// octomap_binary and octomap_full (GetOctomap), ~clear_bbx (BoundingBoxQuery) and ~reset.
 class HullNode {
  public:
   /// Reads the private parameters (ros_params.h) and subscribes.
@@ -78,9 +85,15 @@ class HullNode {
   void integrate(View& view);
   /// Whether the view changed the hull.
   bool carve(const View& view);
+  /// The hull as octree_ (carved space free, the cleared boxes applied) on every output.
   void publish(const ros::Time& stamp);
-  /// Markers and mesh for a new subscriber (they are built only while someone looks).
+  /// octree_ on the map topics (and the markers while subscribed), stamped header_.
+  void publishMaps();
+  /// octomap_full, markers and mesh for a new subscriber (they are built only while someone
+  /// looks).
+  void publishFullNow();
   void publishMarkersNow();
+  void publishFreeMarkersNow();
   void publishMeshNow();
   void publishEmpty();
   /// The published hull's mesh (marching cubes once per hull, shared by `mesh`, new subscribers
@@ -96,20 +109,28 @@ class HullNode {
   void subscribe();
   bool reset(std_srvs::Empty::Request& request, std_srvs::Empty::Response& response);
   bool save(sift_hull::Save::Request& request, sift_hull::Save::Response& response);
+  /// octomap_binary / octomap_full: the map as last published; false before the first hull.
+  bool getMap(bool binary, sift_hull::GetOctomap::Response* response);
+  /// ~clear_bbx: the box's known voxels free, now and in every later map until ~reset.
+  bool clearBbx(sift_hull::BoundingBoxQuery::Request& request,
+                sift_hull::BoundingBoxQuery::Response& response);
+  void advertiseServices();
 
   // Destroyed bottom up: subscriptions and services first, then the worker, then what it uses.
   ros::NodeHandle nh_, private_nh_;
   HullNodeConfig config_;
-  /// Guards stream_, octree_, mesh_, header_ and generation_ (the worker, ~reset, ~save, new
-  /// subscribers).
+  /// Guards stream_, octree_, mesh_, header_, cleared_boxes_ and generation_ (the worker, ~reset,
+  /// ~save, new subscribers).
   std::mutex hull_mutex_;
   HullStream stream_;
   std::unique_ptr<octomap::OcTree> octree_;  ///< the hull as last published
   std::unique_ptr<TriangleMesh> mesh_;       ///< its mesh, made when first asked for
   std_msgs::Header header_;                  ///< of the last publication
+  std::vector<Box3d> cleared_boxes_;         ///< by ~clear_bbx since the start or ~reset
   std::atomic<uint64_t> generation_{0};
   ThrottledLog log_;
-  ros::Publisher octomap_pub_, cloud_pub_, markers_pub_, mesh_pub_;
+  ros::Publisher octomap_pub_, octomap_full_pub_, cloud_pub_, centers_pub_, markers_pub_,
+      free_markers_pub_, mesh_pub_;
   std::atomic<double> last_carve_ms_{0.0}, last_publish_ms_{0.0}, last_view_stamp_{0.0};
   std::atomic<size_t> redundant_views_{0};
   std::atomic<size_t> refused_views_{0};
@@ -126,7 +147,7 @@ class HullNode {
   tf2_ros::MessageFilter<sensor_msgs::Image> pose_filter_;
   PoseGate pose_gate_;
   Sync sync_;
-  ros::ServiceServer reset_srv_, save_srv_;
+  ros::ServiceServer reset_srv_, save_srv_, binary_srv_, full_srv_, clear_bbx_srv_;
 };
 
 }  // namespace sift_hull

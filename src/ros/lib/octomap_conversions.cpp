@@ -1,0 +1,156 @@
+// The conversions of conversions.h between OctoMap trees and messages.
+
+#include <octomap/OcTree.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+#include <pcl_conversions/pcl_conversions.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+#include "lib/conversions.h"
+#include "sift_hull/hull/hull_octomap.h"
+
+namespace sift_hull {
+namespace ros_conversions {
+
+sift_hull::Octomap octomapMessage(const octomap::OcTree& tree, const std_msgs::Header& header) {
+  sift_hull::Octomap message;
+  message.header = header;
+  message.binary = true;
+  message.id = tree.getTreeType();
+  message.resolution = tree.getResolution();
+  std::stringstream stream;
+  writeOctomapBinaryData(tree, stream);
+  const std::string bytes = stream.str();
+  message.data.assign(bytes.begin(), bytes.end());
+  return message;
+}
+
+sift_hull::Octomap octomapFullMessage(const octomap::OcTree& tree, const std_msgs::Header& header) {
+  sift_hull::Octomap message;
+  message.header = header;
+  message.binary = false;
+  message.id = tree.getTreeType();
+  message.resolution = tree.getResolution();
+  std::stringstream stream;
+  tree.writeData(stream);
+  const std::string bytes = stream.str();
+  message.data.assign(bytes.begin(), bytes.end());
+  return message;
+}
+
+std::unique_ptr<octomap::OcTree> octreeFromMessage(const sift_hull::Octomap& message) {
+  if (message.id != "OcTree") {
+    throw std::invalid_argument("an Octomap message of id '" + message.id + "', not 'OcTree'");
+  }
+  if (!(message.resolution > 0.0) || !std::isfinite(message.resolution)) {
+    throw std::invalid_argument("an Octomap message of resolution " +
+                                std::to_string(message.resolution) + " m");
+  }
+  auto tree = std::make_unique<octomap::OcTree>(message.resolution);
+  if (message.data.empty()) return tree;  // an empty tree writes no data
+  std::stringstream data(std::string(message.data.begin(), message.data.end()));
+  if (message.binary) {
+    tree->readBinaryData(data);
+  } else {
+    tree->readData(data);
+  }
+  if (data.fail()) throw std::invalid_argument("an Octomap message whose data is cut short");
+  return tree;
+}
+
+sensor_msgs::PointCloud2 pointCloudMessage(const std::vector<Eigen::Vector3d>& points,
+                                           const std_msgs::Header& header) {
+  pcl::PointCloud<pcl::PointXYZ> cloud;
+  for (const Eigen::Vector3d& point : points) {
+    cloud.push_back(pcl::PointXYZ(point.x(), point.y(), point.z()));
+  }
+  sensor_msgs::PointCloud2 message;
+  pcl::toROSMsg(cloud, message);
+  message.header = header;
+  return message;
+}
+
+sensor_msgs::PointCloud2 occupiedCellsCloud(const octomap::OcTree& tree,
+                                            const std_msgs::Header& header) {
+  std::vector<Eigen::Vector3d> centres;
+  for (auto leaf = tree.begin_leafs(); leaf != tree.end_leafs(); ++leaf) {
+    if (tree.isNodeOccupied(*leaf)) centres.emplace_back(leaf.getX(), leaf.getY(), leaf.getZ());
+  }
+  return pointCloudMessage(centres, header);
+}
+
+namespace {
+
+/// octomap_server's colour of free cells: blue, opaque.
+std_msgs::ColorRGBA freeColour() {
+  std_msgs::ColorRGBA colour;
+  colour.b = 1.0f, colour.a = 1.0f;
+  return colour;
+}
+
+std_msgs::ColorRGBA heightColour(double fraction) {
+  std_msgs::ColorRGBA colour;
+  colour.r = static_cast<float>(std::clamp(1.5 - std::abs(4.0 * fraction - 3.0), 0.0, 1.0));
+  colour.g = static_cast<float>(std::clamp(1.5 - std::abs(4.0 * fraction - 2.0), 0.0, 1.0));
+  colour.b = static_cast<float>(std::clamp(1.5 - std::abs(4.0 * fraction - 1.0), 0.0, 1.0));
+  colour.a = 1.0f;
+  return colour;
+}
+
+/// One CUBE_LIST per leaf size of the occupied (or free) leaves, in namespace `ns`; occupied
+/// ones coloured by height, free ones all `free_colour`.
+visualization_msgs::MarkerArray cellsMarkers(const octomap::OcTree& tree,
+                                             const std_msgs::Header& header, bool occupied,
+                                             const std::string& ns) {
+  double min_x, min_y, min_z, max_x, max_y, max_z;
+  tree.getMetricMin(min_x, min_y, min_z);
+  tree.getMetricMax(max_x, max_y, max_z);
+  const double height = std::max(max_z - min_z, 1e-9);
+  std::map<unsigned, visualization_msgs::Marker> by_depth;
+  for (auto leaf = tree.begin_leafs(); leaf != tree.end_leafs(); ++leaf) {
+    if (tree.isNodeOccupied(*leaf) != occupied) continue;
+    visualization_msgs::Marker& marker = by_depth[leaf.getDepth()];
+    geometry_msgs::Point centre;
+    centre.x = leaf.getX(), centre.y = leaf.getY(), centre.z = leaf.getZ();
+    marker.points.push_back(centre);
+    if (occupied) marker.colors.push_back(heightColour((centre.z - min_z) / height));
+    marker.scale.x = marker.scale.y = marker.scale.z = leaf.getSize();
+  }
+  visualization_msgs::MarkerArray array;
+  for (auto& [depth, marker] : by_depth) {
+    marker.header = header;
+    marker.ns = ns;
+    marker.id = static_cast<int>(depth);
+    marker.type = visualization_msgs::Marker::CUBE_LIST;
+    marker.action = visualization_msgs::Marker::ADD;
+    marker.pose.orientation.w = 1.0;
+    if (!occupied) marker.color = freeColour();
+    array.markers.push_back(marker);
+  }
+  return array;
+}
+
+}  // namespace
+
+visualization_msgs::MarkerArray occupiedCellsMarkers(const octomap::OcTree& tree,
+                                                     const std_msgs::Header& header) {
+  return cellsMarkers(tree, header, true, "occupied_cells");
+}
+
+visualization_msgs::MarkerArray freeCellsMarkers(const octomap::OcTree& tree,
+                                                 const std_msgs::Header& header) {
+  return cellsMarkers(tree, header, false, "free_cells");
+}
+
+Box3d boxFromCorners(const geometry_msgs::Point& min, const geometry_msgs::Point& max) {
+  return {Eigen::Vector3d(min.x, min.y, min.z), Eigen::Vector3d(max.x, max.y, max.z)};
+}
+
+}  // namespace ros_conversions
+}  // namespace sift_hull

@@ -1,0 +1,139 @@
+// The OctoMap conversions of octomap_server's interface without a ROS master: the full map's round
+// trip with its occupancies, reading messages back (and refusing bad ones), the free cells'
+// markers, the clear box's corners, and the services' md5sums, which must be octomap_msgs'.
+
+#include <gtest/gtest.h>
+#include <octomap/OcTree.h>
+
+#include <cmath>
+#include <memory>
+#include <string>
+
+#include "lib/conversions.h"
+#include "sift_hull/BoundingBoxQuery.h"
+#include "sift_hull/GetOctomap.h"
+#include "sift_hull/hull/hull_octomap.h"
+
+namespace sift_hull {
+namespace {
+
+namespace rc = ros_conversions;
+
+constexpr double kRes = 0.1;
+
+std_msgs::Header mapHeader() {
+  std_msgs::Header header;
+  header.frame_id = "map";
+  header.stamp = ros::Time(12, 345);
+  return header;
+}
+
+/// Free voxels on the x axis, occupied ones on y, and one voxel updated once (an occupancy between
+/// the clamping values, which only the full map keeps).
+struct MixedTree {
+  octomap::OcTree tree{kRes};
+  MixedTree() {
+    for (int i = 1; i <= 6; ++i) {
+      tree.setNodeValue(i * kRes + 0.05, 0.05, 0.05, tree.getClampingThresMinLog());
+      tree.setNodeValue(0.05, i * kRes + 0.05, 0.05, tree.getClampingThresMaxLog());
+    }
+    tree.updateNode(-0.55, -0.55, -0.55, true);  // log-odds 0.85, below the maximum 3.5
+  }
+};
+
+TEST(OctomapFullMessage, RoundTripKeepsEveryLeafAndItsOccupancy) {
+  const MixedTree mixed;
+  const sift_hull::Octomap message = rc::octomapFullMessage(mixed.tree, mapHeader());
+  EXPECT_FALSE(message.binary);
+  EXPECT_EQ(message.id, "OcTree");
+  EXPECT_EQ(message.resolution, kRes);
+  EXPECT_EQ(message.header.frame_id, "map");
+  EXPECT_EQ(message.header.stamp, ros::Time(12, 345));
+  const std::unique_ptr<octomap::OcTree> read = rc::octreeFromMessage(message);
+  ASSERT_EQ(read->getNumLeafNodes(), mixed.tree.getNumLeafNodes());
+  for (auto leaf = mixed.tree.begin_leafs(); leaf != mixed.tree.end_leafs(); ++leaf) {
+    const octomap::OcTreeNode* node = read->search(leaf.getKey(), leaf.getDepth());
+    ASSERT_NE(node, nullptr);
+    EXPECT_FLOAT_EQ(node->getLogOdds(), leaf->getLogOdds());
+  }
+  EXPECT_NEAR(read->search(-0.55, -0.55, -0.55)->getLogOdds(), 0.847298, 1e-5);
+  // The binary map keeps occupied / free only: the once-updated voxel at the clamping maximum.
+  const std::unique_ptr<octomap::OcTree> binary =
+      rc::octreeFromMessage(rc::octomapMessage(mixed.tree, mapHeader()));
+  EXPECT_EQ(binary->getNumLeafNodes(), mixed.tree.getNumLeafNodes());
+  EXPECT_FLOAT_EQ(binary->search(-0.55, -0.55, -0.55)->getLogOdds(),
+                  binary->getClampingThresMaxLog());
+  EXPECT_FALSE(binary->isNodeOccupied(binary->search(0.35, 0.05, 0.05)));
+  EXPECT_TRUE(binary->isNodeOccupied(binary->search(0.05, 0.35, 0.05)));
+  // An empty tree writes no data and reads back empty.
+  const sift_hull::Octomap empty = rc::octomapFullMessage(octomap::OcTree(0.2), mapHeader());
+  EXPECT_TRUE(empty.data.empty());
+  EXPECT_EQ(rc::octreeFromMessage(empty)->getNumLeafNodes(), 0u);
+}
+
+TEST(OctreeFromMessage, RefusesOtherTreesBadResolutionsAndCutData) {
+  const MixedTree mixed;
+  sift_hull::Octomap message = rc::octomapFullMessage(mixed.tree, mapHeader());
+  sift_hull::Octomap color = message, zero = message, nan = message, cut = message;
+  color.id = "ColorOcTree";
+  zero.resolution = 0.0;
+  nan.resolution = std::nan("");
+  cut.data.resize(cut.data.size() / 2);
+  EXPECT_THROW(rc::octreeFromMessage(color), std::invalid_argument);
+  EXPECT_THROW(rc::octreeFromMessage(zero), std::invalid_argument);
+  EXPECT_THROW(rc::octreeFromMessage(nan), std::invalid_argument);
+  EXPECT_THROW(rc::octreeFromMessage(cut), std::invalid_argument);
+}
+
+TEST(FreeCellsMarkers, OneCubeListPerLeafSizeOfTheFreeLeavesOnly) {
+  MixedTree mixed;
+  // An aligned 2x2x2 block of free voxels at x, y, z in [-0.4, -0.2): one leaf of twice the size.
+  for (int c = 0; c < 8; ++c) {
+    mixed.tree.setNodeValue(-0.35 + kRes * (c & 1), -0.35 + kRes * (c >> 1 & 1),
+                            -0.35 + kRes * (c >> 2 & 1), mixed.tree.getClampingThresMinLog());
+  }
+  mixed.tree.prune();
+  const visualization_msgs::MarkerArray markers = rc::freeCellsMarkers(mixed.tree, mapHeader());
+  ASSERT_EQ(markers.markers.size(), 2u);
+  double volume_m3 = 0.0;
+  for (const visualization_msgs::Marker& m : markers.markers) {
+    EXPECT_TRUE(m.ns == "free_cells" && m.type == visualization_msgs::Marker::CUBE_LIST);
+    EXPECT_EQ(m.header.frame_id, "map");
+    EXPECT_EQ(m.points.size(), m.scale.x > 1.5 * kRes ? 1u : 6u);
+    EXPECT_TRUE(m.color.b == 1.0f && m.color.a == 1.0f && m.color.r == 0.0f);
+    for (const geometry_msgs::Point& p : m.points) {
+      EXPECT_FALSE(mixed.tree.isNodeOccupied(mixed.tree.search(p.x, p.y, p.z)));
+    }
+    volume_m3 += m.points.size() * std::pow(m.scale.x, 3);
+  }
+  EXPECT_NEAR(volume_m3, 14 * std::pow(kRes, 3), 1e-12);
+  EXPECT_EQ(rc::occupiedCellsMarkers(mixed.tree, mapHeader()).markers.front().ns, "occupied_cells");
+}
+
+TEST(BoxFromCorners, GivesTheCornersAsTheyAreForIsValidClearBoxToCheck) {
+  geometry_msgs::Point min, max;
+  min.x = -1.0, min.y = 2.0, min.z = 0.5;
+  max.x = 1.5, max.y = 2.0, max.z = 0.25;
+  const Box3d box = rc::boxFromCorners(min, max);
+  EXPECT_EQ(box.min_W, Eigen::Vector3d(-1.0, 2.0, 0.5));
+  EXPECT_EQ(box.max_W, Eigen::Vector3d(1.5, 2.0, 0.25));
+  EXPECT_FALSE(isValidClearBox(box));  // z: min > max
+  max.z = 0.5;
+  EXPECT_TRUE(isValidClearBox(rc::boxFromCorners(min, max)));  // a flat box is a box
+}
+
+TEST(OctomapServices, HaveOctomapMsgsMd5sums) {
+  // genmsg's md5 of octomap_msgs/GetOctomap.srv and BoundingBoxQuery.srv, computed from
+  // octomap_msgs' own text with genmsg.gentools.compute_md5 (md5 of "9a45536b45c5e409cd49f04bb2d
+  // 9999f map" and of "4a842b65f413084dc2b10fb484ea7f17 min\n4a842b65f413084dc2b10fb484ea7f17
+  // max"): a client built against octomap_msgs can call the node's services.
+  EXPECT_STREQ(ros::service_traits::md5sum<sift_hull::GetOctomap>(),
+               "be9d2869d24fe40d6bc21ac21f6bb2c5");
+  EXPECT_STREQ(ros::service_traits::md5sum<sift_hull::BoundingBoxQuery>(),
+               "93aa3d73b866f04880927745f4aab303");
+  EXPECT_STREQ(ros::message_traits::md5sum<sift_hull::Octomap>(),
+               "9a45536b45c5e409cd49f04bb2d9999f");
+}
+
+}  // namespace
+}  // namespace sift_hull
