@@ -107,7 +107,7 @@ void checkResult(const HullResult& result, const ReprojectionIoU& iou, PoorResul
 std::string hullText(const nlohmann::json& result) {
   std::ostringstream text;
   text << result["views"] << " views, depth " << result["max_depth"] << " (voxel "
-       << result["resolution"] << "), box " << result["bbox"]["min"] << " .. "
+       << result["resolution_m"] << "), box " << result["bbox"]["min"] << " .. "
        << result["bbox"]["max"] << "\noccupied leaves " << result["occupied_leaves"] << ", mesh "
        << result["mesh"]["vertices"] << " vertices, " << result["mesh"]["faces"]
        << " faces, watertight " << result["mesh"]["watertight"] << "\ntime (ms) "

@@ -72,6 +72,11 @@ void addHullOptions(ArgParser* parser) {
   parser->addOption("max-depth", "L", "octree depth: resolution = cube edge / 2^L",
                     std::to_string(defaults.max_depth));
   parser->addDeprecatedAlias("depth", {"max-depth"});
+  parser->addOption("resolution-m", "M",
+                    "finest cell edge in metres instead of --max-depth (octomap_server's "
+                    "resolution): the least depth whose cube of such cells holds the box; 0 = "
+                    "from --max-depth",
+                    "0");
   parser->addFlag("carve-outside-image", "views carve what they see outside their image");
   parser->addOption("distance-slack-px", "PX",
                     "margin added to a cell's projected radius, in pixels", slack.str());
@@ -89,6 +94,7 @@ void addHullOptions(ArgParser* parser) {
 HullConfig hullConfigFromArgs(const ArgParser& parser) {
   HullConfig config;
   config.max_depth = parser.getInt("max-depth");
+  config.resolution_m = parser.getDouble("resolution-m");
   config.carve_outside_image = parser.flag("carve-outside-image");
   config.distance_slack_px = parser.getDouble("distance-slack-px");
   config.threads = parser.getInt("threads");
@@ -136,7 +142,7 @@ nlohmann::json hullJson(const HullResult& result, size_t occupied_leaves,
           {"bbox", {{"min", vectorJson(result.box.min_W)}, {"max", vectorJson(result.box.max_W)}}},
           {"max_depth", result.hull.cube().depth},
           {"distance_reduction", distanceReductionsJson(result.hull.views())},
-          {"resolution", result.hull.cube().resolution_m},
+          {"resolution_m", result.hull.cube().resolution_m},
           {"occupied_leaves", occupied_leaves},
           {"mesh",
            {{"vertices", result.mesh.vertices_W.size()},

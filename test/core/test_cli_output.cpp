@@ -61,5 +61,19 @@ TEST_F(CommandOutput, PrintsOnlyJsonWithJson) {
   EXPECT_NO_THROW(static_cast<void>(nlohmann::json::parse(out))) << out;
 }
 
+TEST_F(CommandOutput, TakesTheResolutionInMetresInsteadOfTheDepth) {
+  const std::string hull = "hull --calib " + *scene_ + "/scene_par.txt --images " + *scene_ +
+                           " --silhouettes " + *scene_ + "/masks --json --resolution-m ";
+  std::string out, err;
+  ASSERT_EQ(test::runProgram(hull + "0.05", &out, &err), 0) << err;
+  const nlohmann::json result = nlohmann::json::parse(out);
+  EXPECT_EQ(result["resolution_m"].get<double>(), 0.05);
+  EXPECT_EQ(result["max_depth"].get<int>(), 6);  // a box of about 2 m: 2^6 - 3 cells of 5 cm
+  EXPECT_EQ(test::runProgram(hull + "-1", &out, &err), 2);
+  EXPECT_NE(err.find("resolution_m must be finite and >= 0"), std::string::npos) << err;
+  EXPECT_EQ(test::runProgram(hull + "0.00001", &out, &err), 1);
+  EXPECT_NE(err.find("raise resolution_m (at least"), std::string::npos) << err;
+}
+
 }  // namespace
 }  // namespace sift_hull

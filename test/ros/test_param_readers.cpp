@@ -329,7 +329,12 @@ TEST(ParameterReaders, OctomapServersNamesAreReadOrRefusedNamingOurs) {
   resolution.setParam("resolution", 0.05);
   const std::string refused = refusal([&] { readHullStreamConfig(resolution); });
   EXPECT_NE(refused.find("~resolution"), std::string::npos) << refused;
-  EXPECT_NE(refused.find("set ~max_depth instead"), std::string::npos) << refused;
+  EXPECT_NE(refused.find("set ~resolution_m"), std::string::npos) << refused;
+  ros::NodeHandle metres("/hull_resolution_m");
+  metres.setParam("resolution_m", 0.004);
+  EXPECT_EQ(readHullStreamConfig(metres).hull.resolution_m, 0.004);
+  metres.setParam("resolution_m", -1.0);
+  EXPECT_NE(refusal([&] { readHullStreamConfig(metres); }).find("resolution_m"), std::string::npos);
 }
 
 }  // namespace

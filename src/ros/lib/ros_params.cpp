@@ -121,10 +121,11 @@ HullConfig readHullConfig(const ros::NodeHandle& private_nh) {
   HullConfig config;
   if (private_nh.hasParam("resolution")) {  // octomap_server's voxel edge
     throw std::invalid_argument(
-        "~resolution (octomap_server's voxel edge) is not a hull_node parameter: the voxel edge is "
-        "the box's longest edge / (2^max_depth - 3); set ~max_depth instead");
+        "~resolution (octomap_server's voxel edge) is not a hull_node parameter: set "
+        "~resolution_m (metres, the same meaning) or ~max_depth");
   }
   readRenamed(private_nh, "max_depth", "depth", &config.max_depth);
+  read(private_nh, "resolution_m", &config.resolution_m);
   read(private_nh, "carve_outside_image", &config.carve_outside_image);
   readRenamed(private_nh, "distance_slack_px", "slack_px", &config.distance_slack_px);
   read(private_nh, "threads", &config.threads);
