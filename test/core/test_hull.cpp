@@ -5,6 +5,7 @@
 #include <octomap/OcTree.h>
 
 #include <cmath>
+#include <sstream>
 
 #include "common/test_data.h"
 #include "sift_hull/eval/hull_evaluation.h"
@@ -100,8 +101,7 @@ TEST(HullCube, TakesAResolutionInMetresAtTheLeastDepthThatHoldsTheBox) {
     HullCube::withResolution(box, 1e-4);  // 8000 cells: deeper than the octree goes
     ADD_FAILURE() << "no error";
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("raise resolution_m (at least 0.00078"),
-              std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("raise resolution_m (at least 0.00078"), std::string::npos)
         << e.what();
   }
   config.resolution_m = -1.0;
@@ -272,6 +272,19 @@ TEST_F(SphereHull, ClearingABoxFreesTheVoxelsItTouchesAndNothingElse) {
   EXPECT_THROW(clearBox({Eigen::Vector3d(std::nan(""), 0, 0), Eigen::Vector3d::Ones()}, tree.get()),
                std::invalid_argument);
   EXPECT_TRUE(isValidClearBox({Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()}));
+}
+
+TEST_F(SphereHull, WritesOctoMapsBinaryStreamByteForByte) {
+  const std::unique_ptr<octomap::OcTree> tree = toOctomap(result_->hull);
+  std::stringstream ours, octomaps;
+  writeOctomapBinaryData(*tree, ours);
+  tree->writeBinaryNode(octomaps, tree->getRoot());
+  ASSERT_GT(octomaps.str().size(), 1000u);
+  EXPECT_EQ(ours.str(), octomaps.str());
+  const octomap::OcTree empty(0.1);
+  std::stringstream nothing;
+  writeOctomapBinaryData(empty, nothing);
+  EXPECT_EQ(nothing.str(), "");
 }
 
 std::vector<HullCell> leavesOf(const VisualHull& hull) {

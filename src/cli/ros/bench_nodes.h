@@ -7,9 +7,11 @@
 #include <ros/ros.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
+#include <std_srvs/Empty.h>
 #include <tf2_ros/transform_broadcaster.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
@@ -92,15 +94,22 @@ class ArrivalLog {
     return arrivals_.size();
   }
   bool connected() const { return sub_.getNumPublishers() > 0; }
+  /// The newest message, or null.
+  boost::shared_ptr<const Message> last() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return last_;
+  }
 
  private:
   void onMessage(const boost::shared_ptr<const Message>& message) {
     std::lock_guard<std::mutex> lock(mutex_);
     arrivals_.emplace(message->header.stamp, ros::WallTime::now());
+    last_ = message;
   }
 
   mutable std::mutex mutex_;
   std::map<ros::Time, ros::WallTime> arrivals_;
+  boost::shared_ptr<const Message> last_;
   ros::Subscriber sub_;
 };
 
@@ -133,6 +142,11 @@ struct HullRun {
   std::string name;
   int views = 0, depth = 0, incremental_views = 0;
   double carve_ms = 0.0, publish_ms = 0.0, latency_ms = 0.0;  ///< medians, incremental views
+  /// The node's finest cell edge (its last octomap's) and `sift_hull hull`'s on the same views.
+  double resolution_m = 0.0, cli_resolution_m = 0.0;
+  // At 10 Hz: the views once each after a ~reset, latency median over those that refined a hull.
+  int rate_published = 0;
+  double rate_dropped = 0.0, rate_latency_ms = 0.0;
   // Overload: the views again and again, faster than they are carved.
   double overload_hz = 0.0;
   int overload_published = 0;
@@ -140,7 +154,8 @@ struct HullRun {
   double rss_first_mib = 0.0, rss_last_mib = 0.0;
 };
 
-/// hull_node at `depth` fed the views one at a time, then again and again at 100 Hz.
+/// hull_node at `depth` fed the views one at a time, then once each at 10 Hz after a ~reset,
+/// then again and again at 100 Hz.
 HullRun runHull(RosHarness& harness, const std::string& name, const HullInput& input, int depth);
 
 /// runHull on the synthetic scene, and on dino when `data_root` holds it.

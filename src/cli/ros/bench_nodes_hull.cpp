@@ -68,6 +68,43 @@ void measureViews(HullFeed& feed, const ArrivalLog<sift_hull::Octomap>& octomaps
   run->latency_ms = median(latency);
 }
 
+/// The views once each at 10 Hz from an empty hull (~reset): views dropped, and the latency from
+/// sending a view to receiving its octomap for the views that refine the hull.
+void atTenHertz(HullFeed& feed, const ArrivalLog<sift_hull::Octomap>& octomaps,
+                const DiagnosticsListener& diagnostics, HullRun* run) {
+  std_srvs::Empty reset;
+  if (!ros::service::call("/hull/reset", reset)) {
+    throw std::runtime_error("bench-nodes: hull_node's ~reset failed");
+  }
+  ros::WallDuration(0.5).sleep();  // the reset's empty map first
+  const double dropped_before = diagnostics.value("views dropped");
+  const double processed_before = diagnostics.value("views processed");
+  std::vector<std::pair<ros::WallTime, ros::Time>> sent;
+  const ros::WallTime start = ros::WallTime::now();
+  for (int i = 0; i < run->views; ++i) {
+    const ros::WallTime due = start + ros::WallDuration(i / 10.0);
+    if (ros::WallTime::now() < due) (due - ros::WallTime::now()).sleep();
+    sent.emplace_back(ros::WallTime::now(), feed.publish(i));
+  }
+  run->rate_published = run->views;
+  waitUntil(
+      [&] {
+        return diagnostics.value("views processed") + diagnostics.value("views dropped") >=
+               processed_before + dropped_before + run->views;
+      },
+      30.0);
+  waitUntil([&] { return octomaps.arrival(sent.back().second).has_value(); }, 2.0);
+  run->rate_dropped = diagnostics.value("views dropped") - dropped_before;
+  std::vector<double> latency;
+  bool had_hull = false;
+  for (const auto& [wall, stamp] : sent) {
+    const std::optional<ros::WallTime> arrival = octomaps.arrival(stamp);
+    if (had_hull && arrival) latency.push_back((*arrival - wall).toSec() * 1e3);
+    had_hull = had_hull || arrival.has_value();
+  }
+  run->rate_latency_ms = median(latency);
+}
+
 void overload(HullFeed& feed, const DiagnosticsListener& diagnostics, pid_t pid, HullRun* run) {
   run->overload_hz = 100.0;
   const double processed_before = diagnostics.value("views processed");
@@ -108,6 +145,11 @@ HullRun runHull(RosHarness& harness, const std::string& name, const HullInput& i
   ros::WallDuration(0.5).sleep();  // tf listener of the node
   HullRun run{name, static_cast<int>(input.masks.size()), depth};
   measureViews(feed, octomaps, diagnostics, &run);
+  run.resolution_m = octomaps.last() ? octomaps.last()->resolution : 0.0;
+  HullConfig config;
+  config.max_depth = depth;
+  run.cli_resolution_m = buildHull(input, config).hull.cube().resolution_m;
+  atTenHertz(feed, octomaps, diagnostics, &run);
   overload(feed, diagnostics, pid, &run);
   harness.stopNode(pid);
   return run;

@@ -38,12 +38,19 @@ HullNode::HullNode(ros::NodeHandle nh, ros::NodeHandle private_nh, HullNodeConfi
       private_nh_(private_nh),
       config_(std::move(node_config)),
       stream_(std::move(hull_config)),
-      octomap_pub_(nh_.advertise<sift_hull::Octomap>("octomap_binary", 1, true)),
+      octomap_pub_(nh_.advertise<sift_hull::Octomap>(
+          "octomap_binary", 1, [this](const ros::SingleSubscriberPublisher&) { publishMapsNow(); },
+          ros::SubscriberStatusCallback(), ros::VoidConstPtr(), true)),
       octomap_full_pub_(nh_.advertise<sift_hull::Octomap>(
           "octomap_full", 1, [this](const ros::SingleSubscriberPublisher&) { publishFullNow(); },
           ros::SubscriberStatusCallback(), ros::VoidConstPtr(), true)),
-      cloud_pub_(nh_.advertise<sensor_msgs::PointCloud2>("occupied_cells", 1, true)),
-      centers_pub_(nh_.advertise<sensor_msgs::PointCloud2>("octomap_point_cloud_centers", 1, true)),
+      cloud_pub_(nh_.advertise<sensor_msgs::PointCloud2>(
+          "occupied_cells", 1, [this](const ros::SingleSubscriberPublisher&) { publishMapsNow(); },
+          ros::SubscriberStatusCallback(), ros::VoidConstPtr(), true)),
+      centers_pub_(nh_.advertise<sensor_msgs::PointCloud2>(
+          "octomap_point_cloud_centers", 1,
+          [this](const ros::SingleSubscriberPublisher&) { publishMapsNow(); },
+          ros::SubscriberStatusCallback(), ros::VoidConstPtr(), true)),
       markers_pub_(nh_.advertise<visualization_msgs::MarkerArray>(
           "occupied_cells_vis_array", 1,
           [this](const ros::SingleSubscriberPublisher&) { publishMarkersNow(); },
@@ -170,12 +177,17 @@ void HullNode::integrate(View& view) {
   last_carve_ms_ = (carved - start).toSec() * 1e3;
   redundant_views_ = stream_.redundantViews();
   last_view_stamp_ = view.stamp.toSec();
-  if (!changed) return;  // waiting, skipped or redundant: the published hull stands
+  if (changed) unpublished_stamp_ = view.stamp;
+  // Waiting, skipped or redundant: the published hull stands. Views queued behind this one refine
+  // the hull at once: each state would cost a whole conversion the next view replaces, so the
+  // hull is published when the queue has drained, stamped with the newest view that changed it.
+  if (unpublished_stamp_.isZero() || work_.counts().waiting > 0) return;
   try {
-    publish(view.stamp);
+    publish(unpublished_stamp_);
   } catch (const std::exception& e) {  // e.g. a hull beyond OctoMap's key range
     log_.error("hull: cannot publish the hull: ", e.what());
   }
+  unpublished_stamp_ = ros::Time();
   last_publish_ms_ = (ros::WallTime::now() - carved).toSec() * 1e3;
 }
 
@@ -230,10 +242,12 @@ bool HullNode::reset(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
   ++generation_;
   const size_t discarded = work_.clear();  // views from before the reset
   stream_.reset();
+  unpublished_stamp_ = ros::Time();
   cleared_boxes_.clear();
   refused_views_ = 0;
   publishEmpty();
   octree_.reset();
+  published_ = false;
   mesh_.reset();
   ROS_INFO("hull: reset (%zu view(s) waiting to be carved discarded)", discarded);
   return true;
@@ -241,14 +255,14 @@ bool HullNode::reset(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
 
 bool HullNode::save(sift_hull::Save::Request& request, sift_hull::Save::Response& response) {
   std::lock_guard<std::mutex> lock(hull_mutex_);
-  if (!stream_.hasHull() || !octree_) {
+  if (!stream_.hasHull() || !published_) {
     response.success = false;
     response.message = "no hull yet";
     return true;
   }
   try {
     const SavePaths paths = savePaths(request.path);
-    writeOctomap(*octree_, paths.octree);
+    writeOctomap(publishedTree(), paths.octree);
     writePly(paths.mesh, publishedMesh());
     response.success = true;
     response.message = "wrote " + paths.octree + " and " + paths.mesh;

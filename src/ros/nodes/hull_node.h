@@ -85,10 +85,18 @@ class HullNode {
   void integrate(View& view);
   /// Whether the view changed the hull.
   bool carve(const View& view);
-  /// The hull as octree_ (carved space free, the cleared boxes applied) on every output.
+  /// The hull, stamped `stamp`, on every output someone subscribes; the OctoMap is built then, or
+  /// when first asked for (publishedTree).
   void publish(const ros::Time& stamp);
-  /// octree_ on the map topics (and the markers while subscribed), stamped header_.
+  /// The published hull as an OctoMap (carved space free, the cleared boxes applied), built from
+  /// the stream when stale. Requires published_ and hull_mutex_.
+  const octomap::OcTree& publishedTree();
+  /// Subscribers of the map topics, the markers included.
+  uint32_t mapSubscribers() const;
+  /// publishedTree on the map topics someone subscribes, stamped header_.
   void publishMaps();
+  /// publishMaps for a new subscriber of octomap_binary, occupied_cells or the centres.
+  void publishMapsNow();
   /// octomap_full, markers and mesh for a new subscriber (they are built only while someone
   /// looks).
   void publishFullNow();
@@ -97,7 +105,7 @@ class HullNode {
   void publishMeshNow();
   void publishEmpty();
   /// The published hull's mesh (marching cubes once per hull, shared by `mesh`, new subscribers
-  /// and ~save). Requires octree_.
+  /// and ~save). Requires published_.
   const TriangleMesh& publishedMesh();
   void reportDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& status);
   void onPoseMissing(const sensor_msgs::ImageConstPtr& silhouette,
@@ -123,10 +131,13 @@ class HullNode {
   /// ~save, new subscribers).
   std::mutex hull_mutex_;
   HullStream stream_;
-  std::unique_ptr<octomap::OcTree> octree_;  ///< the hull as last published
+  std::unique_ptr<octomap::OcTree> octree_;  ///< the hull as last published (publishedTree)
+  bool published_ = false;                   ///< a hull was published since the start or ~reset
+  bool tree_stale_ = false;                  ///< octree_ is older than the published hull
   std::unique_ptr<TriangleMesh> mesh_;       ///< its mesh, made when first asked for
   std_msgs::Header header_;                  ///< of the last publication
-  std::vector<Box3d> cleared_boxes_;         ///< by ~clear_bbx since the start or ~reset
+  ros::Time unpublished_stamp_;       ///< newest view that changed the hull since then (zero: none)
+  std::vector<Box3d> cleared_boxes_;  ///< by ~clear_bbx since the start or ~reset
   std::atomic<uint64_t> generation_{0};
   ThrottledLog log_;
   ros::Publisher octomap_pub_, octomap_full_pub_, cloud_pub_, centers_pub_, markers_pub_,

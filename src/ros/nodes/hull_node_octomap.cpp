@@ -47,29 +47,56 @@ void HullNode::advertiseServices() {
 void HullNode::publish(const ros::Time& stamp) {
   header_.stamp = stamp;
   header_.frame_id = config_.world_frame;
-  octree_ = toOctomap(stream_.hull());
-  for (const Box3d& box : cleared_boxes_) clearBox(box, octree_.get());
+  published_ = true;
+  tree_stale_ = true;  // built when first needed (publishedTree)
   mesh_.reset();
-  publishMaps();
+  if (mapSubscribers() > 0) publishMaps();
   if (mesh_pub_.getNumSubscribers() > 0) {
     mesh_pub_.publish(ros_conversions::meshMarker(publishedMesh(), header_));
   }
 }
 
-void HullNode::publishMaps() {
-  octomap_pub_.publish(ros_conversions::octomapMessage(*octree_, header_));
-  if (octomap_full_pub_.getNumSubscribers() > 0) {  // its data is about 10 times the binary's
-    octomap_full_pub_.publish(ros_conversions::octomapFullMessage(*octree_, header_));
+uint32_t HullNode::mapSubscribers() const {
+  return octomap_pub_.getNumSubscribers() + octomap_full_pub_.getNumSubscribers() +
+         cloud_pub_.getNumSubscribers() + centers_pub_.getNumSubscribers() +
+         markers_pub_.getNumSubscribers() + free_markers_pub_.getNumSubscribers();
+}
+
+const octomap::OcTree& HullNode::publishedTree() {
+  if (!octree_ || tree_stale_) {
+    octree_ = toOctomap(stream_.hull());
+    for (const Box3d& box : cleared_boxes_) clearBox(box, octree_.get());
+    tree_stale_ = false;
   }
-  const sensor_msgs::PointCloud2 centres = ros_conversions::occupiedCellsCloud(*octree_, header_);
-  cloud_pub_.publish(centres);
-  centers_pub_.publish(centres);
+  return *octree_;
+}
+
+/// Each map topic someone subscribes (a latched topic nobody listens to costs no conversion; its
+/// first subscriber gets the map at once: publishMapsNow).
+void HullNode::publishMaps() {
+  const octomap::OcTree& tree = publishedTree();
+  if (octomap_pub_.getNumSubscribers() > 0) {
+    octomap_pub_.publish(ros_conversions::octomapMessage(tree, header_));
+  }
+  if (octomap_full_pub_.getNumSubscribers() > 0) {  // its data is about 10 times the binary's
+    octomap_full_pub_.publish(ros_conversions::octomapFullMessage(tree, header_));
+  }
+  if (cloud_pub_.getNumSubscribers() + centers_pub_.getNumSubscribers() > 0) {
+    const sensor_msgs::PointCloud2 centres = ros_conversions::occupiedCellsCloud(tree, header_);
+    cloud_pub_.publish(centres);
+    centers_pub_.publish(centres);
+  }
   if (markers_pub_.getNumSubscribers() > 0) {
-    markers_pub_.publish(ros_conversions::occupiedCellsMarkers(*octree_, header_));
+    markers_pub_.publish(ros_conversions::occupiedCellsMarkers(tree, header_));
   }
   if (free_markers_pub_.getNumSubscribers() > 0) {
-    free_markers_pub_.publish(ros_conversions::freeCellsMarkers(*octree_, header_));
+    free_markers_pub_.publish(ros_conversions::freeCellsMarkers(tree, header_));
   }
+}
+
+void HullNode::publishMapsNow() {
+  std::lock_guard<std::mutex> lock(hull_mutex_);
+  if (published_) publishMaps();
 }
 
 const TriangleMesh& HullNode::publishedMesh() {
@@ -79,22 +106,28 @@ const TriangleMesh& HullNode::publishedMesh() {
 
 void HullNode::publishMarkersNow() {
   std::lock_guard<std::mutex> lock(hull_mutex_);
-  if (octree_) markers_pub_.publish(ros_conversions::occupiedCellsMarkers(*octree_, header_));
+  if (published_) {
+    markers_pub_.publish(ros_conversions::occupiedCellsMarkers(publishedTree(), header_));
+  }
 }
 
 void HullNode::publishFullNow() {
   std::lock_guard<std::mutex> lock(hull_mutex_);
-  if (octree_) octomap_full_pub_.publish(ros_conversions::octomapFullMessage(*octree_, header_));
+  if (published_) {
+    octomap_full_pub_.publish(ros_conversions::octomapFullMessage(publishedTree(), header_));
+  }
 }
 
 void HullNode::publishFreeMarkersNow() {
   std::lock_guard<std::mutex> lock(hull_mutex_);
-  if (octree_) free_markers_pub_.publish(ros_conversions::freeCellsMarkers(*octree_, header_));
+  if (published_) {
+    free_markers_pub_.publish(ros_conversions::freeCellsMarkers(publishedTree(), header_));
+  }
 }
 
 void HullNode::publishMeshNow() {
   std::lock_guard<std::mutex> lock(hull_mutex_);
-  if (octree_) mesh_pub_.publish(ros_conversions::meshMarker(publishedMesh(), header_));
+  if (published_) mesh_pub_.publish(ros_conversions::meshMarker(publishedMesh(), header_));
 }
 
 /// An empty map at the last resolution, and markers deleted.
@@ -115,13 +148,13 @@ void HullNode::publishEmpty() {
 
 bool HullNode::getMap(bool binary, sift_hull::GetOctomap::Response* response) {
   std::lock_guard<std::mutex> lock(hull_mutex_);
-  if (!octree_) {
+  if (!published_) {
     log_.error(binary ? "hull: octomap_binary refused: " : "hull: octomap_full refused: ",
                "no map yet (no view carved since the start or ~reset)");
     return false;
   }
-  response->map = binary ? ros_conversions::octomapMessage(*octree_, header_)
-                         : ros_conversions::octomapFullMessage(*octree_, header_);
+  response->map = binary ? ros_conversions::octomapMessage(publishedTree(), header_)
+                         : ros_conversions::octomapFullMessage(publishedTree(), header_);
   return true;
 }
 
@@ -136,10 +169,11 @@ bool HullNode::clearBbx(sift_hull::BoundingBoxQuery::Request& request,
   }
   std::lock_guard<std::mutex> lock(hull_mutex_);
   cleared_boxes_.push_back(box);  // applied to every later map too, until ~reset
-  if (!octree_) {
+  if (!published_) {
     ROS_INFO("hull: ~clear_bbx: no map yet; the box will be cleared in the first one");
     return true;
   }
+  publishedTree();  // built with every cleared box, or brought up to date here
   clearBox(box, octree_.get());
   header_.stamp = ros::Time::now();
   publishMaps();
