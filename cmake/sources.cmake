@@ -28,6 +28,7 @@ set(SIFT_HULL_CORE_SOURCES
   src/core/hull/hull_view.cpp
   src/core/hull/marching_cubes.cpp
   src/core/hull/mesh.cpp
+  src/core/hull/compact_octomap.cpp
   src/core/hull/hull_cube.cpp
   src/core/hull/octree.cpp
   src/core/hull/reduced_distance_map.cpp

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 #include <octomap/OcTree.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <sstream>
 
@@ -285,6 +287,41 @@ TEST_F(SphereHull, WritesOctoMapsBinaryStreamByteForByte) {
   std::stringstream nothing;
   writeOctomapBinaryData(empty, nothing);
   EXPECT_EQ(nothing.str(), "");
+}
+
+/// The occupied leaves' centres of an OctoMap, sorted.
+std::vector<std::array<double, 3>> sortedCentres(const std::vector<Eigen::Vector3d>& centres) {
+  std::vector<std::array<double, 3>> sorted;
+  for (const Eigen::Vector3d& c : centres) sorted.push_back({c.x(), c.y(), c.z()});
+  std::sort(sorted.begin(), sorted.end());
+  return sorted;
+}
+
+TEST(CompactOctomap, IsToOctomapsMapByteForByteAndLeafForLeaf) {
+  for (const auto& [shape, depth_levels] :
+       {std::pair<const char*, int>{"sphere", 5}, {"sculpture", 6}, {"sculpture", 7}}) {
+    const HullResult result =
+        buildHull(test::sceneHullInput(shape, 8, "ring"), depth(depth_levels));
+    const std::unique_ptr<octomap::OcTree> tree = toOctomap(result.hull);
+    std::stringstream reference;
+    writeOctomapBinaryData(*tree, reference);
+    const CompactOctomap compact = compactOctomap(result.hull);
+    EXPECT_EQ(compact.resolution_m, tree->getResolution());
+    ASSERT_GT(reference.str().size(), 100u);
+    EXPECT_TRUE(compact.binary_data == reference.str())
+        << shape << " depth " << depth_levels << ": " << compact.binary_data.size()
+        << " bytes against " << reference.str().size();
+    std::vector<Eigen::Vector3d> centres;
+    for (auto leaf = tree->begin_leafs(); leaf != tree->end_leafs(); ++leaf) {
+      if (tree->isNodeOccupied(*leaf)) centres.emplace_back(leaf.getX(), leaf.getY(), leaf.getZ());
+    }
+    const auto expected = sortedCentres(centres),
+               actual = sortedCentres(compact.occupied_centres_W);
+    ASSERT_EQ(actual.size(), expected.size());
+    for (size_t i = 0; i < actual.size(); ++i) {
+      for (int a = 0; a < 3; ++a) ASSERT_NEAR(actual[i][a], expected[i][a], 1e-9) << i;
+    }
+  }
 }
 
 std::vector<HullCell> leavesOf(const VisualHull& hull) {

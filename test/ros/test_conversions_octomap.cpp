@@ -9,10 +9,12 @@
 #include <memory>
 #include <string>
 
+#include "common/test_data.h"
 #include "lib/conversions.h"
 #include "sift_hull/BoundingBoxQuery.h"
 #include "sift_hull/GetOctomap.h"
 #include "sift_hull/hull/hull_octomap.h"
+#include "sift_hull/hull/hull_pipeline.h"
 
 namespace sift_hull {
 namespace {
@@ -69,6 +71,24 @@ TEST(OctomapFullMessage, RoundTripKeepsEveryLeafAndItsOccupancy) {
   const sift_hull::Octomap empty = rc::octomapFullMessage(octomap::OcTree(0.2), mapHeader());
   EXPECT_TRUE(empty.data.empty());
   EXPECT_EQ(rc::octreeFromMessage(empty)->getNumLeafNodes(), 0u);
+}
+
+TEST(OctomapMessage, FromTheCompactMapIsTheTreesMessageAndReadsBack) {
+  const HullResult result = buildHull(test::sceneHullInput("sculpture", 8, "ring"), [] {
+    HullConfig config;
+    config.max_depth = 6;
+    return config;
+  }());
+  const std::unique_ptr<octomap::OcTree> tree = toOctomap(result.hull);
+  const sift_hull::Octomap compact = rc::octomapMessage(compactOctomap(result.hull), mapHeader());
+  const sift_hull::Octomap reference = rc::octomapMessage(*tree, mapHeader());
+  EXPECT_EQ(compact.binary, reference.binary);
+  EXPECT_EQ(compact.id, reference.id);
+  EXPECT_EQ(compact.resolution, reference.resolution);
+  EXPECT_EQ(compact.header.stamp, reference.header.stamp);
+  EXPECT_TRUE(compact.data == reference.data)
+      << compact.data.size() << " against " << reference.data.size() << " bytes";
+  EXPECT_EQ(rc::octreeFromMessage(compact)->getNumLeafNodes(), tree->getNumLeafNodes());
 }
 
 TEST(OctreeFromMessage, RefusesOtherTreesBadResolutionsAndCutData) {

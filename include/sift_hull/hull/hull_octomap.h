@@ -3,6 +3,7 @@
 #include <iosfwd>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "sift_hull/hull/bounding_box.h"
 #include "sift_hull/hull/octree.h"
@@ -19,6 +20,17 @@ namespace sift_hull {
 /// unknown. The hull's voxels line up with the OctoMap's (HullCube). Throws std::out_of_range
 /// when the cube lies beyond the OctoMap's 2^16-voxel key range around the world origin.
 std::unique_ptr<octomap::OcTree> toOctomap(const VisualHull& hull);
+
+/// toOctomap's map without OctoMap's nodes, for what is published per view: the same pruned tree
+/// built in an array of its own (several times faster). `binary_data` equals
+/// writeOctomapBinaryData(*toOctomap(hull)) byte for byte; `occupied_centres_W` are that tree's
+/// occupied leaves' centres (any order). Throws as toOctomap.
+struct CompactOctomap {
+  double resolution_m = 0.0;
+  std::string binary_data;
+  std::vector<Eigen::Vector3d> occupied_centres_W;
+};
+CompactOctomap compactOctomap(const VisualHull& hull);
 
 /// Whether a box (metres) can be cleared: finite, min <= max on each axis.
 bool isValidClearBox(const Box3d& box_W);

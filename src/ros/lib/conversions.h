@@ -23,6 +23,7 @@
 #include "sift_hull/filters/filter.h"
 #include "sift_hull/geometry/camera.h"
 #include "sift_hull/hull/bounding_box.h"
+#include "sift_hull/hull/hull_octomap.h"
 #include "sift_hull/hull/mesh.h"
 
 namespace octomap {
@@ -44,8 +45,8 @@ bool holdsPixels(const sensor_msgs::Image& image, size_t bytes_per_pixel, std::s
 bool withinPixelLimit(const sensor_msgs::Image& image, size_t max_pixels, std::string* why_not);
 
 /// A silhouette message as a CV_8UC1 mask sharing nothing with the message. Accepts mono8 and
-/// 8UC1 (cv_bridge's encoding of a uint8 array; the same bytes), non-zero inside; returns an empty Mat and sets `why_not` for another encoding or pixels the
-/// data does not hold (holdsPixels).
+/// 8UC1 (cv_bridge's encoding of a uint8 array; the same bytes), non-zero inside; returns an empty
+/// Mat and sets `why_not` for another encoding or pixels the data does not hold (holdsPixels).
 cv::Mat maskFromImage(const sensor_msgs::Image& image, std::string* why_not);
 
 /// An 8-bit colour or mono image as BGR or grey, sharing the message's pixels (keep the message
@@ -82,6 +83,8 @@ geometry_msgs::TransformStamped cameraPoseMessage(const PinholeCamera& camera,
 /// The tree as an Octomap message (binary stream, as octomap_msgs::binaryMapToMsg writes it):
 /// binary true, id "OcTree", resolution in metres, data holding occupied / free per leaf only.
 sift_hull::Octomap octomapMessage(const octomap::OcTree& tree, const std_msgs::Header& header);
+/// The same message from compactOctomap's map (its binary_data, the same bytes).
+sift_hull::Octomap octomapMessage(const CompactOctomap& map, const std_msgs::Header& header);
 
 /// The tree as a full Octomap message (as octomap_msgs::fullMapToMsg writes it): binary false, id
 /// "OcTree", resolution in metres, data as OcTree::writeData writes it, with each node's

@@ -31,6 +31,16 @@ sift_hull::Octomap octomapMessage(const octomap::OcTree& tree, const std_msgs::H
   return message;
 }
 
+sift_hull::Octomap octomapMessage(const CompactOctomap& map, const std_msgs::Header& header) {
+  sift_hull::Octomap message;
+  message.header = header;
+  message.binary = true;
+  message.id = "OcTree";
+  message.resolution = map.resolution_m;
+  message.data.assign(map.binary_data.begin(), map.binary_data.end());
+  return message;
+}
+
 sift_hull::Octomap octomapFullMessage(const octomap::OcTree& tree, const std_msgs::Header& header) {
   sift_hull::Octomap message;
   message.header = header;

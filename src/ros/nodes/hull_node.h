@@ -6,6 +6,7 @@
 #include <ros/ros.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
+#include <sensor_msgs/PointCloud2.h>
 #include <std_srvs/Empty.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/message_filter.h>
@@ -95,6 +96,8 @@ class HullNode {
   uint32_t mapSubscribers() const;
   /// publishedTree on the map topics someone subscribes, stamped header_.
   void publishMaps();
+  /// The occupied cells' centres on occupied_cells and octomap_point_cloud_centers.
+  void publishCentres(const sensor_msgs::PointCloud2& centres);
   /// publishMaps for a new subscriber of octomap_binary, occupied_cells or the centres.
   void publishMapsNow();
   /// octomap_full, markers and mesh for a new subscriber (they are built only while someone

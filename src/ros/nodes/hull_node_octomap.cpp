@@ -74,24 +74,34 @@ const octomap::OcTree& HullNode::publishedTree() {
 /// Each map topic someone subscribes (a latched topic nobody listens to costs no conversion; its
 /// first subscriber gets the map at once: publishMapsNow).
 void HullNode::publishMaps() {
-  const octomap::OcTree& tree = publishedTree();
-  if (octomap_pub_.getNumSubscribers() > 0) {
-    octomap_pub_.publish(ros_conversions::octomapMessage(tree, header_));
+  const bool binary = octomap_pub_.getNumSubscribers() > 0;
+  const bool centres = cloud_pub_.getNumSubscribers() + centers_pub_.getNumSubscribers() > 0;
+  if ((binary || centres) && cleared_boxes_.empty()) {
+    // What every view publishes, from the compact map (no OctoMap nodes); OctoMap's own tree
+    // only for what needs it (the full map, markers, cleared boxes, services, ~save).
+    const CompactOctomap map = compactOctomap(stream_.hull());
+    if (binary) octomap_pub_.publish(ros_conversions::octomapMessage(map, header_));
+    if (centres)
+      publishCentres(ros_conversions::pointCloudMessage(map.occupied_centres_W, header_));
+  } else if (binary || centres) {
+    const octomap::OcTree& tree = publishedTree();
+    if (binary) octomap_pub_.publish(ros_conversions::octomapMessage(tree, header_));
+    if (centres) publishCentres(ros_conversions::occupiedCellsCloud(tree, header_));
   }
   if (octomap_full_pub_.getNumSubscribers() > 0) {  // its data is about 10 times the binary's
-    octomap_full_pub_.publish(ros_conversions::octomapFullMessage(tree, header_));
-  }
-  if (cloud_pub_.getNumSubscribers() + centers_pub_.getNumSubscribers() > 0) {
-    const sensor_msgs::PointCloud2 centres = ros_conversions::occupiedCellsCloud(tree, header_);
-    cloud_pub_.publish(centres);
-    centers_pub_.publish(centres);
+    octomap_full_pub_.publish(ros_conversions::octomapFullMessage(publishedTree(), header_));
   }
   if (markers_pub_.getNumSubscribers() > 0) {
-    markers_pub_.publish(ros_conversions::occupiedCellsMarkers(tree, header_));
+    markers_pub_.publish(ros_conversions::occupiedCellsMarkers(publishedTree(), header_));
   }
   if (free_markers_pub_.getNumSubscribers() > 0) {
-    free_markers_pub_.publish(ros_conversions::freeCellsMarkers(tree, header_));
+    free_markers_pub_.publish(ros_conversions::freeCellsMarkers(publishedTree(), header_));
   }
+}
+
+void HullNode::publishCentres(const sensor_msgs::PointCloud2& centres) {
+  cloud_pub_.publish(centres);
+  centers_pub_.publish(centres);
 }
 
 void HullNode::publishMapsNow() {
