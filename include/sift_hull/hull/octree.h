@@ -104,6 +104,9 @@ class VisualHull {
   /// f_iso at many points, on config.threads threads.
   void sampleField(const std::vector<Eigen::Vector3d>& points_W, std::vector<float>* values) const;
 
+  /// The tree's root, for the walks of src/core/hull (compactOctomap).
+  const detail::OctreeNode& rootNode() const { return *root_; }
+
   /// The finest surface cells, for marching cubes.
   SurfaceCells surfaceCells() const;
   /// Marching cubes on f_iso over the surface cells.

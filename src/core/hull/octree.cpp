@@ -10,6 +10,7 @@
 
 #include "common/parallel.h"
 #include "hull/field_sampling.h"
+#include "hull/octree_node.h"
 #include "sift_hull/hull/reduced_distance_map.h"
 #include "sift_hull/limits.h"
 
@@ -18,15 +19,6 @@ namespace {
 /// The edge, in finest voxels, of the tiles sampleField culls views in.
 constexpr double kFieldTileVoxels = 8.0;
 }  // namespace
-namespace detail {
-
-struct OctreeNode {
-  CellState state = CellState::kIn;
-  float centre_value = -HullView::kFarOutside_px;
-  std::unique_ptr<OctreeNode[]> children;  ///< eight, or none for a leaf
-};
-
-}  // namespace detail
 
 namespace {
 
