@@ -162,7 +162,7 @@ TEST_F(ColmapModel, EmptyPointLinesAndEveryModelRead) {
   writeFile("cameras.txt",
             "1 SIMPLE_PINHOLE 640 480 500 320 240\n2 SIMPLE_RADIAL 640 480 500 320 240 0.1\n"
             "3 RADIAL 640 480 500 320 240 0.1 0.2\n"
-            "4 FULL_OPENCV 640 480 500 501 320 240 0.1 0.2 0.3 0.4 0.5 0 0 0\n");
+            "4 FULL_OPENCV 640 480 500 501 320 240 0.1 0.2 0.3 0.4 0.5 0.06 0.07 0.08\n");
   writeFile("images.txt",
             "1 1 0 0 0 0 0 2 1 w.png\n\n2 1 0 0 0 0 0 2 2 x.png\n\n3 1 0 0 0 0 0 2 3 y.png\n\n"
             "4 2 0 0 0 0 0 2 4 z.png\n");
@@ -172,6 +172,8 @@ TEST_F(ColmapModel, EmptyPointLinesAndEveryModelRead) {
   EXPECT_DOUBLE_EQ(views[1].camera.distortion().k1, 0.1);
   EXPECT_DOUBLE_EQ(views[2].camera.distortion().k2, 0.2);
   EXPECT_DOUBLE_EQ(views[3].camera.distortion().k3, 0.5);
+  EXPECT_DOUBLE_EQ(views[3].camera.distortion().k4, 0.06);  // rational: OpenCV's k4, k5, k6
+  EXPECT_DOUBLE_EQ(views[3].camera.distortion().k6, 0.08);
   EXPECT_DOUBLE_EQ(views[3].camera.K()(1, 1), 501.0);
   EXPECT_TRUE(views[3].camera.R().isApprox(Eigen::Matrix3d::Identity()));  // q normalised
 }
@@ -194,10 +196,6 @@ TEST_F(ColmapModel, TextErrorsNameFileAndLine) {
   EXPECT_EQ(errorOf(), cameras + ":1: 'nan' is not finite");
   writeText("1 PINHOLE 640 480 500 500 320 240\n1 PINHOLE 640 480 500 500 320 240\n");
   EXPECT_EQ(errorOf(), cameras + ":2: camera 1 given twice");
-  writeText("1 FULL_OPENCV 640 480 500 500 320 240 0 0 0 0 0 0.1 0 0\n");
-  EXPECT_EQ(errorOf(), cameras +
-                           ":1: FULL_OPENCV with rational coefficients k4, k5, k6 (not all zero) "
-                           "is not supported");
   writeText("1 PINHOLE 640 480 500 500 320 240\n");  // images use camera 2
   EXPECT_EQ(errorOf(), images +
                            ":4: image 'a.png' names camera 2, which the cameras file does "

@@ -6,8 +6,20 @@
 
 namespace sift_hull {
 
+double radialFactor(const LensDistortion& d, double r2, double* slope) {
+  const double numerator = 1.0 + r2 * (d.k1 + r2 * (d.k2 + r2 * d.k3));
+  const double denominator = 1.0 + r2 * (d.k4 + r2 * (d.k5 + r2 * d.k6));
+  if (slope != nullptr) {
+    const double numerator_slope = d.k1 + r2 * (2.0 * d.k2 + 3.0 * r2 * d.k3);
+    const double denominator_slope = d.k4 + r2 * (2.0 * d.k5 + 3.0 * r2 * d.k6);
+    *slope = (numerator_slope * denominator - numerator * denominator_slope) /
+             (denominator * denominator);
+  }
+  return numerator / denominator;
+}
+
 void validate(const LensDistortion& d) {
-  const double coefficients[] = {d.k1, d.k2, d.p1, d.p2, d.k3};
+  const double coefficients[] = {d.k1, d.k2, d.p1, d.p2, d.k3, d.k4, d.k5, d.k6};
   for (double c : coefficients) {
     if (!std::isfinite(c))
       throw std::invalid_argument("a lens distortion coefficient is not finite");
@@ -17,7 +29,7 @@ void validate(const LensDistortion& d) {
 Eigen::Vector2d distortNormalised(const LensDistortion& d, const Eigen::Vector2d& ideal) {
   const double x = ideal.x(), y = ideal.y();
   const double r2 = x * x + y * y;
-  const double radial = 1.0 + r2 * (d.k1 + r2 * (d.k2 + r2 * d.k3));
+  const double radial = radialFactor(d, r2);
   return {x * radial + 2.0 * d.p1 * x * y + d.p2 * (r2 + 2.0 * x * x),
           y * radial + d.p1 * (r2 + 2.0 * y * y) + 2.0 * d.p2 * x * y};
 }
@@ -25,8 +37,8 @@ Eigen::Vector2d distortNormalised(const LensDistortion& d, const Eigen::Vector2d
 Eigen::Matrix2d distortionJacobian(const LensDistortion& d, const Eigen::Vector2d& ideal) {
   const double x = ideal.x(), y = ideal.y();
   const double r2 = x * x + y * y;
-  const double radial = 1.0 + r2 * (d.k1 + r2 * (d.k2 + r2 * d.k3));
-  const double slope = d.k1 + r2 * (2.0 * d.k2 + 3.0 * r2 * d.k3);  // d radial / d r^2
+  double slope = 0.0;  // d radial / d r^2
+  const double radial = radialFactor(d, r2, &slope);
   const double cross = 2.0 * x * y * slope + 2.0 * d.p1 * x + 2.0 * d.p2 * y;
   Eigen::Matrix2d J;
   J << radial + 2.0 * x * x * slope + 2.0 * d.p1 * y + 6.0 * d.p2 * x, cross, cross,
@@ -48,8 +60,7 @@ std::optional<Eigen::Vector2d> undistortNormalised(const LensDistortion& d,
     // A root where the model folds over (det <= 0), or one turned through the centre (radial
     // factor <= 0, as r (1 + k1 r^2) has beyond its maximum), is not the point the lens imaged.
     if (residual.norm() <= tolerance) {
-      const double r2 = ideal.squaredNorm();
-      const double radial = 1.0 + r2 * (d.k1 + r2 * (d.k2 + r2 * d.k3));
+      const double radial = radialFactor(d, ideal.squaredNorm());
       return det > 0.0 && radial > 0.0 ? std::optional(ideal) : std::nullopt;
     }
     if (!(std::abs(det) > 1e-12)) return std::nullopt;

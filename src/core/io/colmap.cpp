@@ -109,11 +109,9 @@ ColmapCamera makeCamera(const ModelInfo& model, uint64_t width, uint64_t height,
   }
   if (name == "FULL_OPENCV") {
     d.k3 = p[8];
-    if (p[9] != 0.0 || p[10] != 0.0 || p[11] != 0.0) {
-      throw ParseError(file, line,
-                       "FULL_OPENCV with rational coefficients k4, k5, k6 (not all zero) is not "
-                       "supported");
-    }
+    d.k4 = p[9];
+    d.k5 = p[10];
+    d.k6 = p[11];
   }
   return camera;
 }
