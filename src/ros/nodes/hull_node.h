@@ -47,7 +47,8 @@ struct HullNodeConfig {
   double diagnostic_period = 1.0;
 };
 
-/// The hull node: silhouettes (mono8) with their camera_info, once tf knows the camera's pose in
+/// The hull node: silhouettes (mono8) with the camera_info beside them (the silhouette topic's
+/// namespace + camera_info, image_transport's convention), once tf knows the camera's pose in
 /// the world frame, refine a visual hull; the results are published latched after every view.
 class HullNode {
  public:
