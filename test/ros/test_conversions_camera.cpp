@@ -198,6 +198,10 @@ PairScore scorePair(const RenderedView& a, const RenderedView& b, const PinholeC
     on_surface += std::abs(a.depth.at<float>(v, u) - left.depth(X)) < 0.02 * left.depth(X);
   }
   score.on_surface = static_cast<double>(on_surface) / std::max<size_t>(score.points, 1);
+  ::testing::Test::RecordProperty("correct_matches_kept", std::to_string(kept_correct) + " of " +
+                                                              std::to_string(score.correct));
+  ::testing::Test::RecordProperty("points_within_2_percent", std::to_string(on_surface) + " of " +
+                                                                 std::to_string(score.points));
   return score;
 }
 
