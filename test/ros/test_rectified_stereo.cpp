@@ -29,7 +29,7 @@ class RectifiedStereoTest : public ::testing::Test {
   void SetUp() override {
     SceneConfig config;
     config.width_px = 320, config.height_px = 240;
-    config.distortion = {-0.12, 0.03, 0.0005, -0.0003, 0.0};
+    config.distortion = {-0.3, 0.1, 0.001, -0.002, 0.0};
     left_ = renderSceneView(config, 0);
     right_ = renderSceneView(config, 1);
     left_image_pub_ = nh_.advertise<sensor_msgs::Image>("/stereo/left/image_raw", 5);
