@@ -147,6 +147,31 @@ TEST(Distortion, RationalJacobianMatchesFiniteDifferences) {
   EXPECT_FALSE((LensDistortion{0, 0, 0, 0, 0, 0, 0.1, 0}).isZero());
 }
 
+TEST(Distortion, FisheyeJacobianMatchesFiniteDifferencesAndZeroIsNotAPinhole) {
+  LensDistortion fisheye{0.05, -0.01, 0.0, 0.0, 0.002, -0.0004};
+  fisheye.fisheye = true;
+  for (const Eigen::Vector2d& x :
+       {Eigen::Vector2d(0.31, -0.22), Eigen::Vector2d(1.2, 0.7), Eigen::Vector2d(1e-9, 0.0)}) {
+    const Eigen::Matrix2d J = distortionJacobian(fisheye, x);
+    const double h = 1e-6;
+    for (int axis = 0; axis < 2; ++axis) {
+      const Eigen::Vector2d step = Eigen::Vector2d::Unit(axis) * h;
+      const Eigen::Vector2d numeric =
+          (distortNormalised(fisheye, x + step) - distortNormalised(fisheye, x - step)) / (2 * h);
+      EXPECT_LT((J.col(axis) - numeric).norm(), 1e-6) << x.transpose();
+    }
+    EXPECT_LT((undistortNormalised(fisheye, distortNormalised(fisheye, x)).value() - x).norm(),
+              1e-10);
+  }
+  LensDistortion equidistant;
+  equidistant.fisheye = true;  // theta_d = theta: the equidistant projection
+  EXPECT_FALSE(equidistant.isZero());
+  EXPECT_NEAR(distortNormalised(equidistant, {1.0, 0.0}).x(), M_PI / 4.0, 1e-15);
+  LensDistortion tangential = fisheye;
+  tangential.p1 = 0.001;
+  EXPECT_THROW(validate(tangential), std::invalid_argument);
+}
+
 TEST(Distortion, NonFiniteCoefficientsAreRefused) {
   EXPECT_THROW(camera640({0.0, 0.0, 0.0, 0.0, 0.0, 0.0, NAN, 0.0}), std::invalid_argument);
   EXPECT_THROW(camera640({NAN, 0.0, 0.0, 0.0, 0.0}), std::invalid_argument);

@@ -136,7 +136,7 @@ TEST(CameraFromInfo, KeepsThePlumbBobDistortionBothWays) {
   const Eigen::Vector3d X_W = pose() * Eigen::Vector3d(0.4, -0.3, 1.5);
   EXPECT_LT((camera.project(X_W) - distorted.project(X_W)).norm(), 1e-9);
   EXPECT_GT((camera.project(X_W) - camera.projectIdeal(X_W)).norm(), 1.0);
-  // rational_polynomial without its rational terms is the same lens; fisheye is refused by name.
+  // rational_polynomial without its rational terms is the same lens; equidistant needs 4.
   sensor_msgs::CameraInfo rational = message;
   rational.distortion_model = "rational_polynomial";
   rational.D = {-0.3, 0.1, 0.002, -0.001, 0.01, 0.0, 0.0, 0.0};
@@ -145,8 +145,8 @@ TEST(CameraFromInfo, KeepsThePlumbBobDistortionBothWays) {
   EXPECT_TRUE(has(refusal(rational), "distortion model 'rational_polynomial' with 5"));
   sensor_msgs::CameraInfo fisheye = message;
   fisheye.distortion_model = "equidistant";
-  fisheye.D = {0.1, 0.0, 0.0, 0.0};
-  EXPECT_TRUE(has(refusal(fisheye), "distortion model 'equidistant' (fisheye) is not supported"));
+  fisheye.D = {0.1, 0.0, 0.0, 0.0, 0.0};
+  EXPECT_TRUE(has(refusal(fisheye), "distortion model 'equidistant' with 5 coefficients"));
   fisheye.distortion_model = "plumb_bob";
   fisheye.D = {0.1, std::nan(""), 0.0, 0.0, 0.0};
   EXPECT_EQ(refusal(fisheye), "refused: camera_info D holds a value that is not finite");

@@ -74,6 +74,33 @@ TEST(CameraInfoGeometry, RationalDistortionRoundTrips) {
   EXPECT_EQ(back.distortion().k6, 0.04);
 }
 
+TEST(CameraInfoGeometry, FisheyeDistortionRoundTripsAndMatchesOpenCvFisheye) {
+  LensDistortion lens{0.05, -0.01, 0.0, 0.0, 0.002, -0.0004};
+  lens.fisheye = true;
+  const PinholeCamera camera =
+      PinholeCamera(kK, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero()).withDistortion(lens);
+  const sensor_msgs::CameraInfo message = rc::cameraInfoMessage(camera, {320, 240}, {});
+  EXPECT_EQ(message.distortion_model, "equidistant");
+  EXPECT_EQ(message.D, (std::vector<double>{0.05, -0.01, 0.002, -0.0004}));
+  PinholeCamera back;
+  std::string why_not;
+  ASSERT_TRUE(
+      rc::cameraFromInfo(message, Eigen::Isometry3d::Identity(), {320, 240}, &back, &why_not))
+      << why_not;
+  const std::vector<cv::Point3d> points = {{0.3, -0.2, 1.0}, {-0.9, 0.6, 1.0}, {0.0, 0.0, 2.0}};
+  cv::Mat K_cv, rvec = cv::Mat::zeros(3, 1, CV_64F), tvec = cv::Mat::zeros(3, 1, CV_64F);
+  cv::eigen2cv(kK, K_cv);
+  const cv::Mat D = (cv::Mat_<double>(1, 4) << 0.05, -0.01, 0.002, -0.0004);
+  std::vector<cv::Point2d> expected;
+  cv::fisheye::projectPoints(points, expected, rvec, tvec, K_cv, D);
+  for (size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector3d X(points[i].x, points[i].y, points[i].z);
+    const Eigen::Vector2d pixel = back.project(X);
+    EXPECT_LT((pixel - Eigen::Vector2d(expected[i].x, expected[i].y)).norm(), 1e-9) << i;
+    EXPECT_LT((back.undistortPixel(pixel).value() - back.projectIdeal(X)).norm(), 1e-8) << i;
+  }
+}
+
 TEST(CameraInfoGeometry, NoDistortionWithARectifyingRAndPIsTheRectifiedCameraOfP) {
   const sensor_msgs::CameraInfo message =
       info(kK, {0, 0, 0, 0, 0}, kRect, projection(kKRect, Eigen::Vector3d::Zero()));
@@ -110,12 +137,16 @@ TEST(CameraInfoGeometry, RectifiedFlagUsesPWhateverDSays) {
   EXPECT_TRUE(rectified.rectified);
   EXPECT_TRUE(rectified.K.isApprox(kKRect));
   EXPECT_TRUE(rectified.distortion.isZero());
-  // A fisheye raw image is refused by name, its rectified image is not.
+  // A fisheye raw image is OpenCV's fisheye lens; its rectified image has no lens.
   sensor_msgs::CameraInfo fisheye = message;
   fisheye.distortion_model = "equidistant";
-  fisheye.D = {0.1, 0.01, 0.0, 0.0};
-  EXPECT_NE(refusal(fisheye).find("'equidistant' (fisheye) is not supported"), std::string::npos);
-  EXPECT_EQ(refusal(fisheye, true), "");
+  fisheye.D = {0.1, 0.01, -0.002, 0.0005};
+  ASSERT_TRUE(rc::cameraInfoGeometry(fisheye, false, &raw, &why_not)) << why_not;
+  EXPECT_TRUE(raw.distortion.fisheye);
+  EXPECT_EQ(raw.distortion.k3, -0.002);
+  EXPECT_EQ(raw.distortion.k4, 0.0005);
+  ASSERT_TRUE(rc::cameraInfoGeometry(fisheye, true, &rectified, &why_not));
+  EXPECT_TRUE(rectified.distortion.isZero());
 }
 
 TEST(CameraInfoGeometry, RefusesAnInconsistentPOrR) {

@@ -6,7 +6,30 @@
 
 namespace sift_hull {
 
+namespace {
+
+/// theta_d / r of the fisheye model and its derivative by r^2 (by series near the centre).
+double fisheyeFactor(const LensDistortion& d, double r2, double* slope) {
+  if (r2 < 1e-16) {
+    if (slope != nullptr) *slope = d.k1 - 1.0 / 3.0;
+    return 1.0;
+  }
+  const double r = std::sqrt(r2), theta = std::atan(r), t2 = theta * theta;
+  const double poly = 1.0 + t2 * (d.k1 + t2 * (d.k2 + t2 * (d.k3 + t2 * d.k4)));
+  const double theta_d = theta * poly;
+  if (slope != nullptr) {
+    const double dtheta_d =
+        1.0 + t2 * (3.0 * d.k1 + t2 * (5.0 * d.k2 + t2 * (7.0 * d.k3 + t2 * 9.0 * d.k4)));
+    const double ds_dr = (dtheta_d / (1.0 + r2) * r - theta_d) / r2;
+    *slope = ds_dr / (2.0 * r);
+  }
+  return theta_d / r;
+}
+
+}  // namespace
+
 double radialFactor(const LensDistortion& d, double r2, double* slope) {
+  if (d.fisheye) return fisheyeFactor(d, r2, slope);
   const double numerator = 1.0 + r2 * (d.k1 + r2 * (d.k2 + r2 * d.k3));
   const double denominator = 1.0 + r2 * (d.k4 + r2 * (d.k5 + r2 * d.k6));
   if (slope != nullptr) {
@@ -23,6 +46,9 @@ void validate(const LensDistortion& d) {
   for (double c : coefficients) {
     if (!std::isfinite(c))
       throw std::invalid_argument("a lens distortion coefficient is not finite");
+  }
+  if (d.fisheye && (d.p1 != 0.0 || d.p2 != 0.0 || d.k5 != 0.0 || d.k6 != 0.0)) {
+    throw std::invalid_argument("a fisheye lens has k1..k4 only (p1, p2, k5, k6 must be 0)");
   }
 }
 

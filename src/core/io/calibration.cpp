@@ -276,6 +276,7 @@ std::string describeDistortion(const LensDistortion& d) {
                                                          {"p2", d.p2}, {"k3", d.k3}, {"k4", d.k4},
                                                          {"k5", d.k5}, {"k6", d.k6}};
   const char* separator = "";
+  if (d.fisheye) text << "fisheye", separator = " ";
   for (const auto& [name, value] : coefficients) {
     if (value == 0.0) continue;
     text << separator << name << "=" << value;

@@ -37,7 +37,8 @@ bool intrinsicsValid(Eigen::Matrix3d* K, const std::string& name, std::string* w
 }
 
 /// D as LensDistortion: plumb_bob (or an empty model) with 5 coefficients, rational_polynomial
-/// with 8; all zero (or none) is no distortion whatever the model.
+/// with 8, equidistant (OpenCV's fisheye) with 4; all zero (or none) is no distortion whatever the
+/// model, as image_geometry has it.
 bool distortionFromCoefficients(const std::string& model, const std::vector<double>& D,
                                 LensDistortion* distortion, std::string* why_not) {
   if (!std::all_of(D.begin(), D.end(), [](double d) { return std::isfinite(d); })) {
@@ -45,17 +46,17 @@ bool distortionFromCoefficients(const std::string& model, const std::vector<doub
     return false;
   }
   if (std::all_of(D.begin(), D.end(), [](double d) { return d == 0.0; })) return true;
-  if (model == "equidistant") {
-    *why_not =
-        "camera_info distortion model 'equidistant' (fisheye) is not supported: rectify the "
-        "images first (image_proc's rectify) and give image_rect with ~rectified: true";
-    return false;
+  if (model == "equidistant" && D.size() == 4) {
+    *distortion = {D[0], D[1], 0.0, 0.0, D[2], D[3]};
+    distortion->fisheye = true;
+    return true;
   }
   const bool plumb_bob = (model == "plumb_bob" || model.empty()) && D.size() == 5;
   const bool rational = model == "rational_polynomial" && D.size() == 8;
   if (!plumb_bob && !rational) {
     *why_not = "camera_info distortion model '" + model + "' with " + std::to_string(D.size()) +
-               " coefficients is not supported (plumb_bob with 5, rational_polynomial with 8)";
+               " coefficients is not supported (plumb_bob with 5, rational_polynomial with 8, "
+               "equidistant with 4)";
     return false;
   }
   *distortion = {D[0], D[1], D[2], D[3], D[4]};

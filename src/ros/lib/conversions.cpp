@@ -120,9 +120,12 @@ sensor_msgs::CameraInfo cameraInfoMessage(const PinholeCamera& camera, cv::Size 
   info.width = size.width;
   info.height = size.height;
   const LensDistortion& d = camera.distortion();
-  info.distortion_model = d.rational() ? "rational_polynomial" : "plumb_bob";
+  info.distortion_model = d.fisheye      ? "equidistant"
+                          : d.rational() ? "rational_polynomial"
+                                         : "plumb_bob";
   info.D = {d.k1, d.k2, d.p1, d.p2, d.k3};
   if (d.rational()) info.D.insert(info.D.end(), {d.k4, d.k5, d.k6});
+  if (d.fisheye) info.D = {d.k1, d.k2, d.k3, d.k4};
   for (int i = 0; i < 9; ++i) {
     info.K[i] = camera.K()(i / 3, i % 3);
     info.R[i] = i % 4 == 0 ? 1.0 : 0.0;

@@ -68,13 +68,13 @@ struct CameraInfoGeometry {
 };
 
 /// Which matrices of `info` describe its image. Raw (the default): K and D (plumb_bob with 5
-/// coefficients, rational_polynomial with 8; equidistant is refused), R and P only kept for
-/// stereo. Rectified when `rectified` is set (image_proc's image_rect: its camera_info is the raw
-/// image's, D included) or when D is all zero (or empty) and R is not I or P[:3, :3] is not K: then
-/// the camera is K' = P[:3, :3] looking along R. An all-zero R or P counts as I or K [I | 0].
-/// Returns false and sets `why_not` for a K or P that is zero, not finite or not upper triangular
-/// with positive focal lengths, a P with Tz (P[11]) not 0, an R that is not a rotation, another
-/// distortion model or a non-finite coefficient, binning or a region of interest.
+/// coefficients, rational_polynomial with 8, equidistant, OpenCV's fisheye, with 4), R and P only
+/// kept for stereo. Rectified when `rectified` is set (image_proc's image_rect: its camera_info is
+/// the raw image's, D included) or when D is all zero (or empty) and R is not I or P[:3, :3] is not
+/// K: then the camera is K' = P[:3, :3] looking along R. An all-zero R or P counts as I or K [I |
+/// 0]. Returns false and sets `why_not` for a K or P that is zero, not finite or not upper
+/// triangular with positive focal lengths, a P with Tz (P[11]) not 0, an R that is not a rotation,
+/// another distortion model or a non-finite coefficient, binning or a region of interest.
 bool cameraInfoGeometry(const sensor_msgs::CameraInfo& info, bool rectified,
                         CameraInfoGeometry* geometry, std::string* why_not);
 
@@ -103,8 +103,8 @@ bool sharedFrameStereo(const sensor_msgs::CameraInfo& left_info,
 sensor_msgs::Image imageMessage(const cv::Mat& image, const std_msgs::Header& header);
 
 /// camera_info of a camera of the given image size: K, P = K [I | 0], R = I, and its lens
-/// distortion as plumb_bob (k1, k2, p1, p2, k3; zero for an ideal lens), or as
-/// rational_polynomial (8 coefficients) when k4, k5 or k6 is not zero.
+/// distortion as plumb_bob (k1, k2, p1, p2, k3; zero for an ideal lens), as rational_polynomial
+/// (8 coefficients) when k4, k5 or k6 is not zero, or as equidistant (k1..k4) for a fisheye lens.
 sensor_msgs::CameraInfo cameraInfoMessage(const PinholeCamera& camera, cv::Size size,
                                           const std_msgs::Header& header);
 
