@@ -169,7 +169,7 @@ TEST_F(ColmapModel, EmptyPointLinesAndEveryModelRead) {
             "4 2 0 0 0 0 0 2 4 z.png\n\n5 5 0 0 0 0 0 2 5 zz.png\n");
   const auto views = readColmapModel(dir_);
   ASSERT_EQ(views.size(), 5u);
-  EXPECT_EQ(views[4].name, "zz.png");  // views come sorted by name
+  EXPECT_EQ(views[4].name, "zz.png");                 // views come sorted by name
   EXPECT_TRUE(views[4].camera.distortion().fisheye);  // OpenCV's fisheye: k1..k4
   EXPECT_DOUBLE_EQ(views[4].camera.distortion().k4, -0.0004);
   EXPECT_DOUBLE_EQ(views[0].camera.K()(1, 1), 500.0);
