@@ -52,7 +52,8 @@ nlohmann::json commonPointJson(const std::vector<CalibratedView>& views, cv::Siz
 }
 
 nlohmann::json distortionJson(const LensDistortion& d) {
-  return {{"k1", d.k1}, {"k2", d.k2}, {"p1", d.p1}, {"p2", d.p2}, {"k3", d.k3}};
+  return {{"k1", d.k1}, {"k2", d.k2}, {"p1", d.p1}, {"p2", d.p2},
+          {"k3", d.k3}, {"k4", d.k4}, {"k5", d.k5}, {"k6", d.k6}};
 }
 
 /// "PINHOLE, no distortion" for each distinct model and distortion, joined by "; ".

@@ -162,16 +162,22 @@ TEST_F(ColmapModel, EmptyPointLinesAndEveryModelRead) {
   writeFile("cameras.txt",
             "1 SIMPLE_PINHOLE 640 480 500 320 240\n2 SIMPLE_RADIAL 640 480 500 320 240 0.1\n"
             "3 RADIAL 640 480 500 320 240 0.1 0.2\n"
-            "4 FULL_OPENCV 640 480 500 501 320 240 0.1 0.2 0.3 0.4 0.5 0 0 0\n");
+            "4 FULL_OPENCV 640 480 500 501 320 240 0.1 0.2 0.3 0.4 0.5 0.06 0.07 0.08\n"
+            "5 OPENCV_FISHEYE 640 480 500 500 320 240 0.05 -0.01 0.002 -0.0004\n");
   writeFile("images.txt",
             "1 1 0 0 0 0 0 2 1 w.png\n\n2 1 0 0 0 0 0 2 2 x.png\n\n3 1 0 0 0 0 0 2 3 y.png\n\n"
-            "4 2 0 0 0 0 0 2 4 z.png\n");
+            "4 2 0 0 0 0 0 2 4 z.png\n\n5 5 0 0 0 0 0 2 5 zz.png\n");
   const auto views = readColmapModel(dir_);
-  ASSERT_EQ(views.size(), 4u);
+  ASSERT_EQ(views.size(), 5u);
+  EXPECT_EQ(views[4].name, "zz.png");                 // views come sorted by name
+  EXPECT_TRUE(views[4].camera.distortion().fisheye);  // OpenCV's fisheye: k1..k4
+  EXPECT_DOUBLE_EQ(views[4].camera.distortion().k4, -0.0004);
   EXPECT_DOUBLE_EQ(views[0].camera.K()(1, 1), 500.0);
   EXPECT_DOUBLE_EQ(views[1].camera.distortion().k1, 0.1);
   EXPECT_DOUBLE_EQ(views[2].camera.distortion().k2, 0.2);
   EXPECT_DOUBLE_EQ(views[3].camera.distortion().k3, 0.5);
+  EXPECT_DOUBLE_EQ(views[3].camera.distortion().k4, 0.06);  // rational: OpenCV's k4, k5, k6
+  EXPECT_DOUBLE_EQ(views[3].camera.distortion().k6, 0.08);
   EXPECT_DOUBLE_EQ(views[3].camera.K()(1, 1), 501.0);
   EXPECT_TRUE(views[3].camera.R().isApprox(Eigen::Matrix3d::Identity()));  // q normalised
 }
@@ -182,10 +188,11 @@ TEST_F(ColmapModel, TextErrorsNameFileAndLine) {
   EXPECT_EQ(errorOf(), dir_ +
                            ": not a COLMAP sparse model: expected cameras.txt and images.txt, or "
                            "cameras.bin and images.bin");
-  writeText("# c\n1 OPENCV_FISHEYE 640 480 1 1 1 1 0 0 0 0\n");
+  writeText("# c\n1 FOV 640 480 1 1 1 1 0\n");
   EXPECT_EQ(errorOf(), cameras +
-                           ":2: camera model OPENCV_FISHEYE is not supported (SIMPLE_PINHOLE, "
-                           "PINHOLE, SIMPLE_RADIAL, RADIAL, OPENCV, FULL_OPENCV are)");
+                           ":2: camera model FOV is not supported (SIMPLE_PINHOLE, "
+                           "PINHOLE, SIMPLE_RADIAL, RADIAL, OPENCV, OPENCV_FISHEYE, FULL_OPENCV "
+                           "are)");
   writeText("1 WEIRD 640 480 1 1 1\n");
   EXPECT_EQ(errorOf(), cameras + ":1: unknown camera model 'WEIRD'");
   writeText("1 PINHOLE 640 480 500 500 320\n");
@@ -194,10 +201,6 @@ TEST_F(ColmapModel, TextErrorsNameFileAndLine) {
   EXPECT_EQ(errorOf(), cameras + ":1: 'nan' is not finite");
   writeText("1 PINHOLE 640 480 500 500 320 240\n1 PINHOLE 640 480 500 500 320 240\n");
   EXPECT_EQ(errorOf(), cameras + ":2: camera 1 given twice");
-  writeText("1 FULL_OPENCV 640 480 500 500 320 240 0 0 0 0 0 0.1 0 0\n");
-  EXPECT_EQ(errorOf(), cameras +
-                           ":1: FULL_OPENCV with rational coefficients k4, k5, k6 (not all zero) "
-                           "is not supported");
   writeText("1 PINHOLE 640 480 500 500 320 240\n");  // images use camera 2
   EXPECT_EQ(errorOf(), images +
                            ":4: image 'a.png' names camera 2, which the cameras file does "
@@ -233,11 +236,11 @@ TEST_F(ColmapModel, BinaryErrorsNameTheFile) {
   EXPECT_EQ(errorOf(), cameras +
                            ": the file announces 5 cameras but has only 144 bytes left at "
                            "byte 8");
-  writeFile("cameras.bin", camerasBin(5));
+  writeFile("cameras.bin", camerasBin(7));
   EXPECT_EQ(errorOf(), cameras +
-                           ": camera 2 at byte 64: camera model OPENCV_FISHEYE is not "
+                           ": camera 2 at byte 64: camera model FOV is not "
                            "supported (SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL, "
-                           "OPENCV, FULL_OPENCV are)");
+                           "OPENCV, OPENCV_FISHEYE, FULL_OPENCV are)");
   writeFile("cameras.bin", camerasBin(42));
   EXPECT_EQ(errorOf(), cameras + ": camera 2 at byte 64: unknown camera model id 42");
   writeFile("cameras.bin", camerasBin(4, {700, 700, 400, 300, std::nan(""), 0, 0, 0}));

@@ -108,7 +108,72 @@ TEST(Distortion, FoldOverIsDetected) {
   EXPECT_FALSE(folded.undistortPixel({-0.5, -0.5}).has_value());
 }
 
+const LensDistortion kRational{0.6, -0.2, 0.0008, -0.0005, 0.03, 0.9, -0.15, 0.04};
+
+TEST(Distortion, RationalModelMatchesOpenCvProjectPoints) {
+  const PinholeCamera camera = camera640(kRational);
+  const Eigen::Matrix3d K = camera.K(), R = camera.R();
+  cv::Mat K_cv, R_cv, rvec;
+  cv::eigen2cv(K, K_cv);
+  cv::eigen2cv(R, R_cv);
+  cv::Rodrigues(R_cv, rvec);
+  const cv::Mat tvec = (cv::Mat_<double>(3, 1) << camera.t().x(), camera.t().y(), camera.t().z());
+  const LensDistortion& d = kRational;
+  const cv::Mat D = (cv::Mat_<double>(1, 8) << d.k1, d.k2, d.p1, d.p2, d.k3, d.k4, d.k5, d.k6);
+  const std::vector<cv::Point3d> points = {{-0.6, -0.4, 0.1}, {0.0, 0.1, 0.0}, {0.5, 0.45, -0.2}};
+  std::vector<cv::Point2d> expected;
+  cv::projectPoints(points, rvec, tvec, K_cv, D, expected);
+  for (size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector2d pixel = camera.project({points[i].x, points[i].y, points[i].z});
+    EXPECT_NEAR(pixel.x(), expected[i].x, 1e-9);
+    EXPECT_NEAR(pixel.y(), expected[i].y, 1e-9);
+    const Eigen::Vector2d ideal = camera.undistortPixel(pixel).value();
+    EXPECT_LT((ideal - camera.projectIdeal({points[i].x, points[i].y, points[i].z})).norm(), 1e-8);
+  }
+}
+
+TEST(Distortion, RationalJacobianMatchesFiniteDifferences) {
+  const Eigen::Vector2d x(0.31, -0.22);
+  const Eigen::Matrix2d J = distortionJacobian(kRational, x);
+  const double h = 1e-6;
+  for (int axis = 0; axis < 2; ++axis) {
+    const Eigen::Vector2d step = Eigen::Vector2d::Unit(axis) * h;
+    const Eigen::Vector2d numeric =
+        (distortNormalised(kRational, x + step) - distortNormalised(kRational, x - step)) / (2 * h);
+    EXPECT_LT((J.col(axis) - numeric).norm(), 1e-7);
+  }
+  EXPECT_TRUE(kRational.rational());
+  EXPECT_FALSE(LensDistortion{}.rational());
+  EXPECT_FALSE((LensDistortion{0, 0, 0, 0, 0, 0, 0.1, 0}).isZero());
+}
+
+TEST(Distortion, FisheyeJacobianMatchesFiniteDifferencesAndZeroIsNotAPinhole) {
+  LensDistortion fisheye{0.05, -0.01, 0.0, 0.0, 0.002, -0.0004};
+  fisheye.fisheye = true;
+  for (const Eigen::Vector2d& x :
+       {Eigen::Vector2d(0.31, -0.22), Eigen::Vector2d(1.2, 0.7), Eigen::Vector2d(1e-9, 0.0)}) {
+    const Eigen::Matrix2d J = distortionJacobian(fisheye, x);
+    const double h = 1e-6;
+    for (int axis = 0; axis < 2; ++axis) {
+      const Eigen::Vector2d step = Eigen::Vector2d::Unit(axis) * h;
+      const Eigen::Vector2d numeric =
+          (distortNormalised(fisheye, x + step) - distortNormalised(fisheye, x - step)) / (2 * h);
+      EXPECT_LT((J.col(axis) - numeric).norm(), 1e-6) << x.transpose();
+    }
+    EXPECT_LT((undistortNormalised(fisheye, distortNormalised(fisheye, x)).value() - x).norm(),
+              1e-10);
+  }
+  LensDistortion equidistant;
+  equidistant.fisheye = true;  // theta_d = theta: the equidistant projection
+  EXPECT_FALSE(equidistant.isZero());
+  EXPECT_NEAR(distortNormalised(equidistant, {1.0, 0.0}).x(), M_PI / 4.0, 1e-15);
+  LensDistortion tangential = fisheye;
+  tangential.p1 = 0.001;
+  EXPECT_THROW(validate(tangential), std::invalid_argument);
+}
+
 TEST(Distortion, NonFiniteCoefficientsAreRefused) {
+  EXPECT_THROW(camera640({0.0, 0.0, 0.0, 0.0, 0.0, 0.0, NAN, 0.0}), std::invalid_argument);
   EXPECT_THROW(camera640({NAN, 0.0, 0.0, 0.0, 0.0}), std::invalid_argument);
   EXPECT_THROW(camera640({0.0, 0.0, 0.0, INFINITY, 0.0}), std::invalid_argument);
 }

@@ -32,27 +32,38 @@ TEST(BagCommand, WritesEveryViewOfASceneWithItsCamera) {
   const std::vector<CalibratedView> views = readCalibration(dir + "/scene_par.txt");
   rosbag::Bag bag(dir + "/scene.bag", rosbag::bagmode::Read);
   std::map<std::string, int> counts;
-  int info_index = 0;
+  std::map<std::string, int> info_index;
   for (const rosbag::MessageInstance& message : rosbag::View(bag)) {
     ++counts[message.getTopic()];
     if (const auto info = message.instantiate<sensor_msgs::CameraInfo>()) {
+      // The right image of the pair is the next view round the ring.
+      const int index = info_index[message.getTopic()]++;
+      const bool right = message.getTopic() == "/stereo/right/camera_info";
       EXPECT_EQ(info->width, 160u);
-      EXPECT_NEAR(info->K[0], views[info_index].camera.K()(0, 0), 1e-9);
-      EXPECT_NEAR(info->header.stamp.toSec(), 1.0 + 0.25 * info_index, 1e-9);
-      ++info_index;
+      EXPECT_NEAR(info->K[0], views[(index + right) % 4].camera.K()(0, 0), 1e-9);
+      EXPECT_NEAR(info->header.stamp.toSec(), 1.0 + 0.25 * index, 1e-9);
+      EXPECT_EQ(info->header.frame_id, message.getTopic() == "/camera/camera_info" ? "camera"
+                                       : right                                     ? "right"
+                                                                                   : "left");
     }
     if (message.getTopic() == "/camera/silhouette") {
       EXPECT_EQ(message.instantiate<sensor_msgs::Image>()->encoding, "mono8");
     }
     if (const auto tf = message.instantiate<tf2_msgs::TFMessage>()) {
-      ASSERT_EQ(tf->transforms.size(), 1u);
-      const Eigen::Vector3d centre = views[counts["/tf"] - 1].camera.centre();
+      ASSERT_EQ(tf->transforms.size(), 3u);
+      const int v = counts["/tf"] - 1;
+      const Eigen::Vector3d centre = views[v].camera.centre();
       EXPECT_NEAR(tf->transforms[0].transform.translation.x, centre.x(), 1e-9);
       EXPECT_EQ(tf->transforms[0].child_frame_id, "camera");
+      EXPECT_EQ(tf->transforms[1].child_frame_id, "left");
+      EXPECT_EQ(tf->transforms[2].child_frame_id, "right");
+      EXPECT_NEAR(tf->transforms[2].transform.translation.y, views[(v + 1) % 4].camera.centre().y(),
+                  1e-9);
     }
   }
-  for (const char* topic : {"/tf", "/camera/image", "/camera/silhouette", "/camera/camera_info",
-                            "/stereo/left/image", "/stereo/right/image"}) {
+  for (const char* topic :
+       {"/tf", "/camera/image", "/camera/silhouette", "/camera/camera_info", "/stereo/left/image",
+        "/stereo/right/image", "/stereo/left/camera_info", "/stereo/right/camera_info"}) {
     EXPECT_EQ(counts[topic], 4) << topic;
   }
 }

@@ -306,6 +306,32 @@ TEST_F(CalibratedMatcherTest, FiltersByEpipolarLinesAndTriangulatesOntoTheScene)
   EXPECT_GE(static_cast<double>(on_surface) / points, 0.9);
 }
 
+/// image_pipeline's lazy subscription: the images are subscribed only while someone listens to
+/// `correspondences` or `matches_image`, and given up when the last listener leaves.
+TEST(LazyMatcherTest, SubscribesTheImagesOnlyWhileSomeoneListens) {
+  ros::NodeHandle nh;
+  ros::Publisher left = nh.advertise<sensor_msgs::Image>("left/image", 1);
+  ros::Publisher right = nh.advertise<sensor_msgs::Image>("right/image", 1);
+  const auto subscribed = [&] {
+    return left.getNumSubscribers() > 0 && right.getNumSubscribers() > 0;
+  };
+  const auto unsubscribed = [&] {
+    return left.getNumSubscribers() == 0 && right.getNumSubscribers() == 0;
+  };
+  // Long enough for a subscription that would come to come.
+  EXPECT_FALSE(waitFor(subscribed, 2.0)) << "the matcher subscribed with nobody listening";
+  ros::Subscriber correspondences = nh.subscribe(
+      "correspondences", 1, +[](const sift_hull::CorrespondencesConstPtr&) {});
+  ASSERT_TRUE(waitFor(subscribed)) << "no subscription for a correspondences listener";
+  correspondences.shutdown();
+  ASSERT_TRUE(waitFor(unsubscribed)) << "the images stayed subscribed after the last listener left";
+  ros::Subscriber drawing = nh.subscribe(
+      "matches_image", 1, +[](const sensor_msgs::ImageConstPtr&) {});
+  ASSERT_TRUE(waitFor(subscribed)) << "no subscription for a matches_image listener";
+  drawing.shutdown();
+  EXPECT_TRUE(waitFor(unsubscribed));
+}
+
 }  // namespace
 }  // namespace sift_hull
 

@@ -78,6 +78,7 @@ void expectDefaultMatcher(const ros::NodeHandle& nh) {
   EXPECT_EQ(read.node.workers, standard.node.workers);
   EXPECT_EQ(read.node.approximate_sync, standard.node.approximate_sync);
   EXPECT_EQ(read.node.calibrated, standard.node.calibrated);
+  EXPECT_EQ(read.node.rectified, standard.node.rectified);
   EXPECT_EQ(read.node.frame_to_frame, standard.node.frame_to_frame);
   EXPECT_EQ(read.node.image_transport, standard.node.image_transport);
   EXPECT_EQ(read.node.diagnostic_period, standard.node.diagnostic_period);

@@ -42,13 +42,34 @@ std::vector<BagView> loadViews(const ArgParser& parser) {
   return views;
 }
 
-/// View v at time `stamp`: tf first, so that its pose is known when its images arrive.
+/// The pair (view v, next view round the ring) for the matcher: images, the camera_info beside
+/// each, frames "left" and "right". Their poses go to tf with the hull's (writeView): the pair
+/// changes with every view, so one static transform between the frames could not hold.
+void writeStereoPair(rosbag::Bag* bag, const BagView& left, const BagView& right,
+                     const ros::Time& stamp) {
+  std_msgs::Header header;
+  header.stamp = stamp;
+  header.frame_id = bag_topics::kLeftFrame;
+  bag->write(bag_topics::kLeftCameraInfo, stamp,
+             ros_conversions::cameraInfoMessage(left.camera, left.image.size(), header));
+  bag->write(bag_topics::kLeftImage, stamp, ros_conversions::imageMessage(left.image, header));
+  header.frame_id = bag_topics::kRightFrame;
+  bag->write(bag_topics::kRightCameraInfo, stamp,
+             ros_conversions::cameraInfoMessage(right.camera, right.image.size(), header));
+  bag->write(bag_topics::kRightImage, stamp, ros_conversions::imageMessage(right.image, header));
+}
+
+/// View v at time `stamp`: tf first (world -> camera, left, right), so that the poses are known
+/// when the images arrive.
 void writeView(rosbag::Bag* bag, const std::vector<BagView>& views, size_t v,
                const ros::Time& stamp, const std::string& world_frame) {
   const BagView& view = views[v];
+  const BagView& next = views[(v + 1) % views.size()];
   tf2_msgs::TFMessage tf;
-  tf.transforms.push_back(
-      ros_conversions::cameraPoseMessage(view.camera, world_frame, kCameraFrame, stamp));
+  tf.transforms = {
+      ros_conversions::cameraPoseMessage(view.camera, world_frame, kCameraFrame, stamp),
+      ros_conversions::cameraPoseMessage(view.camera, world_frame, bag_topics::kLeftFrame, stamp),
+      ros_conversions::cameraPoseMessage(next.camera, world_frame, bag_topics::kRightFrame, stamp)};
   bag->write("/tf", stamp, tf);
   std_msgs::Header header;
   header.stamp = stamp;
@@ -57,12 +78,7 @@ void writeView(rosbag::Bag* bag, const std::vector<BagView>& views, size_t v,
   bag->write(bag_topics::kSilhouette, stamp, ros_conversions::imageMessage(view.mask, header));
   bag->write(bag_topics::kCameraInfo, stamp,
              ros_conversions::cameraInfoMessage(view.camera, view.mask.size(), header));
-  // The stereo pair for the matcher: this view and the next one round the ring.
-  header.frame_id = "left";
-  bag->write(bag_topics::kLeftImage, stamp, ros_conversions::imageMessage(view.image, header));
-  header.frame_id = "right";
-  bag->write(bag_topics::kRightImage, stamp,
-             ros_conversions::imageMessage(views[(v + 1) % views.size()].image, header));
+  writeStereoPair(bag, view, next, stamp);
 }
 
 }  // namespace
@@ -70,8 +86,10 @@ void writeView(rosbag::Bag* bag, const std::vector<BagView>& views, size_t v,
 int runBag(const std::vector<std::string>& args) {
   ArgParser parser("bag",
                    "Writes calibrated views as a ROS bag for `rosbag play`: per view, tf\n"
-                   "(world -> camera), /camera/image, /camera/silhouette, /camera/camera_info,\n"
-                   "and the pair (view, next view) on /stereo/left/image and /stereo/right/image.");
+                   "(world -> camera, left, right), /camera/image, /camera/silhouette,\n"
+                   "/camera/camera_info, and the pair (view, next view) on /stereo/left/image\n"
+                   "and /stereo/right/image with /stereo/{left,right}/camera_info beside them\n"
+                   "(frames left and right), for the matcher with ~calibrated.");
   addViewSetOptions(&parser);
   parser.addOption("out", "BAG", "bag file to write");
   parser.addOption("rate", "HZ", "views per second", "2");

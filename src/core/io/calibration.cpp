@@ -272,9 +272,11 @@ std::string describeDistortion(const LensDistortion& d) {
   if (d.isZero()) return "no distortion";
   std::ostringstream text;
   text << std::setprecision(9);
-  const std::pair<const char*, double> coefficients[] = {
-      {"k1", d.k1}, {"k2", d.k2}, {"p1", d.p1}, {"p2", d.p2}, {"k3", d.k3}};
+  const std::pair<const char*, double> coefficients[] = {{"k1", d.k1}, {"k2", d.k2}, {"p1", d.p1},
+                                                         {"p2", d.p2}, {"k3", d.k3}, {"k4", d.k4},
+                                                         {"k5", d.k5}, {"k6", d.k6}};
   const char* separator = "";
+  if (d.fisheye) text << "fisheye", separator = " ";
   for (const auto& [name, value] : coefficients) {
     if (value == 0.0) continue;
     text << separator << name << "=" << value;

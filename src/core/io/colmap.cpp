@@ -30,7 +30,7 @@ constexpr ModelInfo kModels[] = {
     {2, "SIMPLE_RADIAL", 4, true},
     {3, "RADIAL", 5, true},
     {4, "OPENCV", 8, true},
-    {5, "OPENCV_FISHEYE", 8, false},
+    {5, "OPENCV_FISHEYE", 8, true},
     {6, "FULL_OPENCV", 12, true},
     {7, "FOV", 5, false},
     {8, "SIMPLE_RADIAL_FISHEYE", 4, false},
@@ -65,7 +65,7 @@ ColmapCamera makeCamera(const ModelInfo& model, uint64_t width, uint64_t height,
     throw ParseError(file, line,
                      std::string("camera model ") + model.name +
                          " is not supported (SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL, "
-                         "OPENCV, FULL_OPENCV are)");
+                         "OPENCV, OPENCV_FISHEYE, FULL_OPENCV are)");
   }
   if (static_cast<int>(p.size()) != model.params) {
     throw ParseError(file, line,
@@ -107,13 +107,15 @@ ColmapCamera makeCamera(const ModelInfo& model, uint64_t width, uint64_t height,
     d.p1 = p[6];
     d.p2 = p[7];
   }
+  if (name == "OPENCV_FISHEYE") {
+    d.fisheye = true;
+    d.k1 = p[4], d.k2 = p[5], d.k3 = p[6], d.k4 = p[7];
+  }
   if (name == "FULL_OPENCV") {
     d.k3 = p[8];
-    if (p[9] != 0.0 || p[10] != 0.0 || p[11] != 0.0) {
-      throw ParseError(file, line,
-                       "FULL_OPENCV with rational coefficients k4, k5, k6 (not all zero) is not "
-                       "supported");
-    }
+    d.k4 = p[9];
+    d.k5 = p[10];
+    d.k6 = p[11];
   }
   return camera;
 }

@@ -32,11 +32,21 @@ void writeCamera(std::ofstream& out, size_t id, const PinholeCamera& camera, int
                  int height_px) {
   const Eigen::Matrix3d& K = camera.K();
   const LensDistortion& d = camera.distortion();
-  const char* model = !camera.distorted() ? "PINHOLE" : d.k3 == 0.0 ? "OPENCV" : "FULL_OPENCV";
+  const bool full = d.k3 != 0.0 || d.rational();
+  const char* model = !camera.distorted() ? "PINHOLE"
+                      : d.fisheye         ? "OPENCV_FISHEYE"
+                      : full              ? "FULL_OPENCV"
+                                          : "OPENCV";
   out << id << ' ' << model << ' ' << width_px << ' ' << height_px << ' ' << K(0, 0) << ' '
       << K(1, 1) << ' ' << K(0, 2) + 0.5 << ' ' << K(1, 2) + 0.5;
+  if (d.fisheye) {
+    out << ' ' << d.k1 << ' ' << d.k2 << ' ' << d.k3 << ' ' << d.k4 << '\n';
+    return;
+  }
   if (camera.distorted()) out << ' ' << d.k1 << ' ' << d.k2 << ' ' << d.p1 << ' ' << d.p2;
-  if (camera.distorted() && d.k3 != 0.0) out << ' ' << d.k3 << " 0 0 0";
+  if (camera.distorted() && full) {
+    out << ' ' << d.k3 << ' ' << d.k4 << ' ' << d.k5 << ' ' << d.k6;
+  }
   out << '\n';
 }
 

@@ -92,86 +92,6 @@ cv::Mat eightBitImage(const sensor_msgs::ImageConstPtr& image, std::string* why_
   }
 }
 
-namespace {
-
-bool intrinsicsFromInfo(const sensor_msgs::CameraInfo& info, Eigen::Matrix3d* K,
-                        std::string* why_not) {
-  for (int i = 0; i < 9; ++i) (*K)(i / 3, i % 3) = info.K[i];
-  if (!K->allFinite()) {
-    *why_not = "camera_info K holds a value that is not finite";
-    return false;
-  }
-  if ((*K)(2, 2) == 0.0) {
-    *why_not = K->isZero() ? "camera_info K is all zero (an uncalibrated camera?)"
-                           : "camera_info K[8] is 0";
-    return false;
-  }
-  *K /= (*K)(2, 2);
-  if ((*K)(1, 0) != 0.0 || (*K)(2, 0) != 0.0 || (*K)(2, 1) != 0.0 || !((*K)(0, 0) > 0.0) ||
-      !((*K)(1, 1) > 0.0)) {
-    *why_not = "camera_info K is not upper triangular with positive focal lengths";
-    return false;
-  }
-  return true;
-}
-
-/// The lens distortion of camera_info: plumb_bob (or an empty model) with 5 coefficients, or none;
-/// rational_polynomial with k4 = k5 = k6 = 0.
-bool distortionFromInfo(const sensor_msgs::CameraInfo& info, LensDistortion* distortion,
-                        std::string* why_not) {
-  const std::vector<double>& D = info.D;
-  const bool all_zero = std::all_of(D.begin(), D.end(), [](double d) { return d == 0.0; });
-  if (D.empty() || all_zero) return true;
-  if (!std::all_of(D.begin(), D.end(), [](double d) { return std::isfinite(d); })) {
-    *why_not = "camera_info D holds a value that is not finite";
-    return false;
-  }
-  const std::string& model = info.distortion_model;
-  const bool plumb_bob = (model == "plumb_bob" || model.empty()) && D.size() == 5;
-  const bool rational =
-      model == "rational_polynomial" && D.size() == 8 && D[5] == 0.0 && D[6] == 0.0 && D[7] == 0.0;
-  if (!plumb_bob && !rational) {
-    *why_not = "camera_info distortion model '" + model + "' with " + std::to_string(D.size()) +
-               " coefficients is not supported (plumb_bob with 5, or rational_polynomial with "
-               "k4 = k5 = k6 = 0)";
-    return false;
-  }
-  *distortion = {D[0], D[1], D[2], D[3], D[4]};
-  return true;
-}
-
-}  // namespace
-
-bool cameraFromInfo(const sensor_msgs::CameraInfo& info, const Eigen::Isometry3d& T_W_C,
-                    cv::Size image_size, PinholeCamera* camera, std::string* why_not) {
-  Eigen::Matrix3d K;
-  if (!intrinsicsFromInfo(info, &K, why_not)) return false;
-  // Sides compared as they are: their product (cv::Size::area) overflows int for large images.
-  const bool has_size = image_size.width > 0 && image_size.height > 0;
-  if (has_size && (static_cast<int64_t>(info.width) != image_size.width ||
-                   static_cast<int64_t>(info.height) != image_size.height)) {
-    std::ostringstream message;
-    message << "camera_info is " << info.width << "x" << info.height << " but the silhouette is "
-            << image_size.width << "x" << image_size.height;
-    *why_not = message.str();
-    return false;
-  }
-  if (!T_W_C.matrix().allFinite()) {
-    *why_not = "camera pose is not finite";
-    return false;
-  }
-  LensDistortion distortion;
-  if (!distortionFromInfo(info, &distortion, why_not)) return false;
-  const Eigen::Isometry3d T_C_W = T_W_C.inverse();
-  try {
-    *camera = PinholeCamera(K, T_C_W.linear(), T_C_W.translation()).withDistortion(distortion);
-  } catch (const std::invalid_argument& e) {
-    *why_not = std::string("camera: ") + e.what();
-    return false;
-  }
-  return true;
-}
-
 sensor_msgs::Image imageMessage(const cv::Mat& image, const std_msgs::Header& header) {
   if (image.type() != CV_8UC1 && image.type() != CV_8UC3) {
     throw std::invalid_argument("imageMessage: expected an 8-bit grey or BGR image");
@@ -197,8 +117,12 @@ sensor_msgs::CameraInfo cameraInfoMessage(const PinholeCamera& camera, cv::Size 
   info.width = size.width;
   info.height = size.height;
   const LensDistortion& d = camera.distortion();
-  info.distortion_model = "plumb_bob";
+  info.distortion_model = d.fisheye      ? "equidistant"
+                          : d.rational() ? "rational_polynomial"
+                                         : "plumb_bob";
   info.D = {d.k1, d.k2, d.p1, d.p2, d.k3};
+  if (d.rational()) info.D.insert(info.D.end(), {d.k4, d.k5, d.k6});
+  if (d.fisheye) info.D = {d.k1, d.k2, d.k3, d.k4};
   for (int i = 0; i < 9; ++i) {
     info.K[i] = camera.K()(i / 3, i % 3);
     info.R[i] = i % 4 == 0 ? 1.0 : 0.0;

@@ -54,21 +54,61 @@ cv::Mat maskFromImage(const sensor_msgs::Image& image, std::string* why_not);
 /// pixels the data does not hold (holdsPixels).
 cv::Mat eightBitImage(const sensor_msgs::ImageConstPtr& image, std::string* why_not);
 
-/// The camera of a view: K and the lens distortion D from `info` (pixels; plumb_bob with 5
-/// coefficients, or rational_polynomial with k4 = k5 = k6 = 0) and the pose T_W_C (the camera frame
-/// in the world frame, as tf gives it). Returns false and sets `why_not` for a K that is zero, not
-/// finite or not upper triangular with K(2,2) = 1 (after scaling), another distortion model or a
-/// non-finite coefficient, a pose that is not finite, or an image size that disagrees with
-/// `image_size` (when non-zero).
+/// What a camera_info says of its image, read through image_geometry::PinholeCameraModel.
+struct CameraInfoGeometry {
+  /// The image is rectified: its camera is P's K' (and R), not K and D.
+  bool rectified = false;
+  /// The camera matrix of the image as it is (pixels): K for a raw image, K' = P[:3, :3] for a
+  /// rectified one.
+  Eigen::Matrix3d K = Eigen::Matrix3d::Identity();
+  LensDistortion distortion;  ///< D of a raw image; zero for a rectified one
+  Eigen::Matrix3d K_rect = Eigen::Matrix3d::Identity();  ///< P[:3, :3] (K when P is all zero)
+  /// R: the rotation from the camera's frame (frame_id) into the rectified frame (I when all zero).
+  Eigen::Matrix3d R_rect_C = Eigen::Matrix3d::Identity();
+  /// P's fourth column in metres, K'^-1 P[:, 3]: the camera's origin in the rectified frame of the
+  /// pair's first camera; (-B, 0, 0) for the right camera of a horizontal pair of baseline B m
+  /// (P[0,3] = -fx' B).
+  Eigen::Vector3d t_rect_m = Eigen::Vector3d::Zero();
+};
+
+/// Which matrices of `info` describe its image. Raw (the default): K and D (plumb_bob with 5
+/// coefficients, rational_polynomial with 8, equidistant, OpenCV's fisheye, with 4), R and P only
+/// kept for stereo. Rectified when `rectified` is set (image_proc's image_rect: its camera_info is
+/// the raw image's, D included) or when D is all zero (or empty) and R is not I or P[:3, :3] is not
+/// K: then the camera is K' = P[:3, :3] looking along R. An all-zero R or P counts as I or K [I |
+/// 0]. Returns false and sets `why_not` for a K or P that is zero, not finite or not upper
+/// triangular with positive focal lengths, a P with Tz (P[11]) not 0, an R that is not a rotation,
+/// another distortion model or a non-finite coefficient, binning or a region of interest.
+bool cameraInfoGeometry(const sensor_msgs::CameraInfo& info, bool rectified,
+                        CameraInfoGeometry* geometry, std::string* why_not);
+
+/// The camera of a view: cameraInfoGeometry's K and D (raw), or K' and R (rectified: the camera
+/// frame turned by R), and the pose T_W_C of the camera's frame (frame_id) in the world frame, as
+/// tf gives it. P's fourth column is not used: tf places the camera. Returns false and sets
+/// `why_not` as cameraInfoGeometry does, for a pose that is not finite, or an image size that
+/// disagrees with `image_size` (when non-zero).
 bool cameraFromInfo(const sensor_msgs::CameraInfo& info, const Eigen::Isometry3d& T_W_C,
-                    cv::Size image_size, PinholeCamera* camera, std::string* why_not);
+                    cv::Size image_size, PinholeCamera* camera, std::string* why_not,
+                    bool rectified = false);
+
+/// The cameras of a stereo pair whose camera_infos share one frame_id (stereo_image_proc's
+/// convention), in that frame: tf knows one frame only, and the baseline is in the right P,
+/// P[0,3] = -fx' B (and P[1,3] = -fy' B_y). The pair's rectified frame is the left R applied to
+/// the shared frame; each camera sits at K'^-1 P[:, 3] in it (the right one at (B, B_y, 0) m), a
+/// rectified image's camera looking along that frame, a raw one's turned back by its own R (with
+/// its own K and D). Fails, with `why_not`, as cameraFromInfo does for either camera_info.
+bool sharedFrameStereo(const sensor_msgs::CameraInfo& left_info,
+                       const sensor_msgs::CameraInfo& right_info, cv::Size left_size,
+                       cv::Size right_size, bool rectified, PinholeCamera* left,
+                       PinholeCamera* right, std::string* why_not);
 
 /// An 8-bit image as a message: CV_8UC1 as mono8, CV_8UC3 as bgr8. Throws std::invalid_argument
 /// for another type.
 sensor_msgs::Image imageMessage(const cv::Mat& image, const std_msgs::Header& header);
 
 /// camera_info of a camera of the given image size: K, P = K [I | 0], R = I, and its lens
-/// distortion as plumb_bob (k1, k2, p1, p2, k3; zero for an ideal lens).
+/// distortion as plumb_bob (k1, k2, p1, p2, k3; zero for an ideal lens), as rational_polynomial
+/// (8 coefficients) when k4, k5 or k6 is not zero, or as equidistant (k1..k4) for a fisheye lens.
 sensor_msgs::CameraInfo cameraInfoMessage(const PinholeCamera& camera, cv::Size size,
                                           const std_msgs::Header& header);
 

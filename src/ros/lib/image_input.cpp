@@ -11,20 +11,33 @@ namespace sift_hull {
 
 ImageInput::ImageInput(image_transport::ImageTransport& transport, ros::NodeHandle nh,
                        const ros::NodeHandle& private_nh, const std::string& topic,
-                       uint32_t queue_size, const std::string& transport_name) {
+                       uint32_t queue_size, const std::string& transport_name)
+    : transport_(transport),
+      nh_(nh),
+      private_nh_(private_nh),
+      resolved_topic_(nh.resolveName(topic)),
+      queue_size_(queue_size),
+      transport_name_(transport_name) {}
+
+void ImageInput::subscribe() {
   try {
-    image_sub_ = transport.subscribe(
-        topic, queue_size, &ImageInput::onImage, this,
-        image_transport::TransportHints(transport_name, ros::TransportHints(), private_nh));
+    image_sub_ = transport_.subscribe(
+        resolved_topic_, queue_size_, &ImageInput::onImage, this,
+        image_transport::TransportHints(transport_name_, ros::TransportHints(), private_nh_));
   } catch (const image_transport::TransportLoadException& e) {
-    if (transport_name != "compressed") {
-      throw std::runtime_error("image transport '" + transport_name +
+    if (transport_name_ != "compressed") {
+      throw std::runtime_error("image transport '" + transport_name_ +
                                "' is not installed: " + e.what());
     }
-    const std::string resolved = nh.resolveName(topic) + "/compressed";
-    compressed_sub_ = nh.subscribe(resolved, queue_size, &ImageInput::onCompressed, this);
+    const std::string resolved = resolved_topic_ + "/compressed";
+    compressed_sub_ = nh_.subscribe(resolved, queue_size_, &ImageInput::onCompressed, this);
     ROS_INFO("no image_transport plugin for 'compressed': decoding %s here", resolved.c_str());
   }
+}
+
+void ImageInput::unsubscribe() {
+  image_sub_.shutdown();
+  compressed_sub_.shutdown();
 }
 
 void ImageInput::onCompressed(const sensor_msgs::CompressedImageConstPtr& compressed) {

@@ -249,6 +249,7 @@ MatcherNodeConfig readMatcherNodeConfig(const ros::NodeHandle& private_nh) {
   read(private_nh, "workers", &config.workers);
   read(private_nh, "approximate_sync", &config.approximate_sync);
   read(private_nh, "calibrated", &config.calibrated);
+  read(private_nh, "rectified", &config.rectified);
   read(private_nh, "frame_to_frame", &config.frame_to_frame);
   read(private_nh, "image_transport", &config.image_transport);
   config.diagnostic_period = readDiagnosticPeriod(private_nh, config.diagnostic_period);

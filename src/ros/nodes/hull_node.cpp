@@ -1,5 +1,6 @@
 #include "nodes/hull_node.h"
 
+#include <image_transport/camera_common.h>
 #include <tf2_eigen/tf2_eigen.h>
 
 #include <sstream>
@@ -96,8 +97,10 @@ void HullNode::subscribe() {
   pose_gate_.connectInput(pose_filter_);
   sync_.connectInput(pose_gate_, info_sub_);
   sync_.registerCallback(&HullNode::onView, this);
-  info_sub_.subscribe(nh_, "camera_info", config_.queue_size);
-  silhouette_sub_.subscribe(nh_, config_.from_image ? "image" : "silhouette", config_.queue_size);
+  // camera_info beside the image, wherever remapping put it (image_transport's convention).
+  const std::string image_topic = nh_.resolveName(config_.from_image ? "image" : "silhouette");
+  info_sub_.subscribe(nh_, image_transport::getCameraInfoTopic(image_topic), config_.queue_size);
+  silhouette_sub_.subscribe(nh_, image_topic, config_.queue_size);
 }
 
 void HullNode::onInfoArrival(const sensor_msgs::CameraInfoConstPtr& info) {

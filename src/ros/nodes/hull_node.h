@@ -53,7 +53,8 @@ struct HullNodeConfig {
   double diagnostic_period = 1.0;
 };
 
-/// The hull node: silhouettes (mono8) with their camera_info, once tf knows the camera's pose in
+/// The hull node: silhouettes (mono8) with the camera_info beside them (the silhouette topic's
+/// namespace + camera_info, image_transport's convention), once tf knows the camera's pose in
 /// the world frame, refine a visual hull; the results are published latched after every view.
 /// Its OctoMap interface is octomap_server's: the topics octomap_binary, octomap_full,
 /// octomap_point_cloud_centers, occupied_cells_vis_array and free_cells_vis_array, the services

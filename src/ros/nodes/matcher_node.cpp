@@ -1,6 +1,7 @@
 #include "nodes/matcher_node.h"
 
 #include <cv_bridge/cv_bridge.h>
+#include <image_transport/camera_common.h>
 #include <tf2_eigen/tf2_eigen.h>
 
 #include <algorithm>
@@ -48,9 +49,6 @@ MatcherNode::MatcherNode(ros::NodeHandle nh, ros::NodeHandle private_nh, Matcher
           Pipeline{settings_, makeFilters(settings_),
                    ros_conversions::settingsJson(settings_.matching, settings_.filters)})),
       transport_(nh_),
-      correspondences_pub_(
-          nh_.advertise<sift_hull::Correspondences>("correspondences", settings_.node.queue_size)),
-      matches_image_pub_(transport_.advertise("matches_image", 1)),
       tf_listener_(tf_buffer_),
       work_(settings_.node.max_waiting_pairs, settings_.node.workers,
             [this](Pair& pair) { matchPair(pair); }),
@@ -58,9 +56,41 @@ MatcherNode::MatcherNode(ros::NodeHandle nh, ros::NodeHandle private_nh, Matcher
                    [this](diagnostic_updater::DiagnosticStatusWrapper& status) {
                      reportDiagnostics(status);
                    }) {
-  if (settings_.node.calibrated) points_pub_ = nh_.advertise<sensor_msgs::PointCloud2>("points", 1);
   serveReconfigure();
-  subscribe();
+  setUpInputs();
+  advertise();
+}
+
+void MatcherNode::advertise() {
+  // Held so that a connect callback cannot see a publisher half made.
+  std::lock_guard<std::mutex> lock(connect_mutex_);
+  const ros::SubscriberStatusCallback changed = [this](const ros::SingleSubscriberPublisher&) {
+    onOutputsChanged();
+  };
+  const image_transport::SubscriberStatusCallback image_changed =
+      [this](const image_transport::SingleSubscriberPublisher&) { onOutputsChanged(); };
+  correspondences_pub_ = nh_.advertise<sift_hull::Correspondences>(
+      "correspondences", settings_.node.queue_size, changed, changed);
+  matches_image_pub_ = transport_.advertise("matches_image", 1, image_changed, image_changed);
+  if (settings_.node.calibrated) {
+    points_pub_ = nh_.advertise<sensor_msgs::PointCloud2>("points", 1, changed, changed);
+  }
+}
+
+void MatcherNode::onOutputsChanged() {
+  std::lock_guard<std::mutex> lock(connect_mutex_);
+  const bool wanted = correspondences_pub_.getNumSubscribers() > 0 ||
+                      points_pub_.getNumSubscribers() > 0 ||
+                      matches_image_pub_.getNumSubscribers() > 0;
+  if (wanted == inputs_subscribed_) return;
+  try {
+    wanted ? subscribeInputs() : unsubscribeInputs();
+  } catch (const std::runtime_error& e) {
+    log_.error("matcher: cannot subscribe the images: ", e.what());
+    unsubscribeInputs();
+    return;
+  }
+  inputs_subscribed_ = wanted;
 }
 
 std::shared_ptr<const MatcherNode::Pipeline> MatcherNode::pipeline() const {
@@ -122,7 +152,7 @@ std::unique_ptr<ImageInput> MatcherNode::imageInput(const std::string& topic) {
                                       settings_.node.queue_size, settings_.node.image_transport);
 }
 
-void MatcherNode::subscribe() {
+void MatcherNode::setUpInputs() {
   const int queue = settings_.node.queue_size;
   if (settings_.node.frame_to_frame) {
     frame_sub_ = imageInput("image");
@@ -132,8 +162,6 @@ void MatcherNode::subscribe() {
   left_sub_ = imageInput("left/image");
   right_sub_ = imageInput("right/image");
   if (settings_.node.calibrated) {
-    left_info_sub_.subscribe(nh_, "left/camera_info", queue);
-    right_info_sub_.subscribe(nh_, "right/camera_info", queue);
     calibrated_sync_ = std::make_unique<CalibratedSync>(
         message_filters::sync_policies::ExactTime<Image, Image, Info, Info>(queue), *left_sub_,
         *right_sub_, left_info_sub_, right_info_sub_);
@@ -150,6 +178,27 @@ void MatcherNode::subscribe() {
   }
 }
 
+void MatcherNode::subscribeInputs() {
+  if (frame_sub_) return frame_sub_->subscribe();
+  left_sub_->subscribe();
+  right_sub_->subscribe();
+  if (!settings_.node.calibrated) return;
+  // camera_info beside each image, wherever remapping put it (image_transport's convention).
+  const int queue = settings_.node.queue_size;
+  left_info_sub_.subscribe(nh_, image_transport::getCameraInfoTopic(left_sub_->resolvedTopic()),
+                           queue);
+  right_info_sub_.subscribe(nh_, image_transport::getCameraInfoTopic(right_sub_->resolvedTopic()),
+                            queue);
+}
+
+void MatcherNode::unsubscribeInputs() {
+  for (ImageInput* input : {frame_sub_.get(), left_sub_.get(), right_sub_.get()}) {
+    if (input != nullptr) input->unsubscribe();
+  }
+  left_info_sub_.unsubscribe();
+  right_info_sub_.unsubscribe();
+}
+
 void MatcherNode::onCalibratedPair(const sensor_msgs::ImageConstPtr& left,
                                    const sensor_msgs::ImageConstPtr& right,
                                    const sensor_msgs::CameraInfoConstPtr& left_info,
@@ -157,28 +206,50 @@ void MatcherNode::onCalibratedPair(const sensor_msgs::ImageConstPtr& left,
   enqueue({left, right, left_info, right_info});
 }
 
-bool MatcherNode::stereoCameras(const Image& left, const Image& right, const Info& left_info,
-                                const Info& right_info, StereoCameras* cameras) {
-  Eigen::Isometry3d T_L_R;
+bool MatcherNode::rightPoseFromTf(const Image& left, const Image& right, Eigen::Isometry3d* T_L_R) {
   try {
     waitForTransform(left.header.frame_id, right.header.frame_id, left.header.stamp);
-    T_L_R = tf2::transformToEigen(
+    *T_L_R = tf2::transformToEigen(
         tf_buffer_.lookupTransform(left.header.frame_id, right.header.frame_id, left.header.stamp));
   } catch (const tf2::TransformException& e) {
     log_.error("matcher: pair ignored: ", e.what());
     return false;
   }
+  return true;
+}
+
+bool MatcherNode::stereoCameras(const Image& left, const Image& right, const Info& left_info,
+                                const Info& right_info, StereoCameras* cameras) {
+  const bool rectified = settings_.node.rectified;
+  const cv::Size left_size(left.width, left.height), right_size(right.width, right.height);
   std::string why_not;
-  const bool ok =
-      ros_conversions::cameraFromInfo(left_info, Eigen::Isometry3d::Identity(),
-                                      cv::Size(left.width, left.height), &cameras->left,
-                                      &why_not) &&
-      ros_conversions::cameraFromInfo(right_info, T_L_R, cv::Size(right.width, right.height),
-                                      &cameras->right, &why_not);
+  bool ok = false;
+  if (left.header.frame_id == right.header.frame_id) {
+    // One frame for both (stereo_image_proc): tf would say identity; the baseline is in P.
+    ok = ros_conversions::sharedFrameStereo(left_info, right_info, left_size, right_size, rectified,
+                                            &cameras->left, &cameras->right, &why_not);
+  } else {
+    Eigen::Isometry3d T_L_R;
+    if (!rightPoseFromTf(left, right, &T_L_R)) return false;
+    ok = ros_conversions::cameraFromInfo(left_info, Eigen::Isometry3d::Identity(), left_size,
+                                         &cameras->left, &why_not, rectified) &&
+         ros_conversions::cameraFromInfo(right_info, T_L_R, right_size, &cameras->right, &why_not,
+                                         rectified);
+  }
   if (!ok) {
     log_.error("matcher: pair ignored: ", why_not);
+    return false;
   }
-  return ok;
+  const double baseline_m = (cameras->right.centre() - cameras->left.centre()).norm();
+  if (!(baseline_m > 1e-9)) {
+    log_.error("matcher: pair ignored: ",
+               "the cameras have no baseline (frames '" + left.header.frame_id + "' and '" +
+                   right.header.frame_id +
+                   "'): with one frame for both, the right camera_info's P[0,3] must be "
+                   "-fx * baseline; with two, tf must place them apart");
+    return false;
+  }
+  return true;
 }
 
 void MatcherNode::onFrame(const sensor_msgs::ImageConstPtr& frame) {

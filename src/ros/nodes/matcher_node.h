@@ -13,6 +13,7 @@
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
 
+#include <Eigen/Geometry>
 #include <atomic>
 #include <boost/thread/recursive_mutex.hpp>
 #include <memory>
@@ -47,10 +48,17 @@ struct MatcherNodeConfig {
   /// time may be published out of stamp order.
   int workers = 2;
   bool approximate_sync = false;  ///< pair images by nearest stamps instead of equal ones
-  /// Also take left/camera_info and right/camera_info (paired by equal stamps with the images)
-  /// and the right camera's pose relative to the left from tf: the epipolar filter's F, and the
-  /// `points` of the matches the first filter keeps.
+  /// Also take the camera_info beside each image (image_transport's convention: the image topic's
+  /// namespace + camera_info, so left/camera_info and right/camera_info follow remappings of
+  /// left/image and right/image; paired by equal stamps with the images) and the right camera's
+  /// pose relative to the left: from tf when the images' frames differ, from the right P's
+  /// baseline when they share one frame (stereo_image_proc's convention). Gives the epipolar
+  /// filter's F, and the `points` of the matches the first filter keeps.
   bool calibrated = false;
+  /// The images are rectified (image_proc's image_rect, whose camera_info is the raw image's):
+  /// their cameras are camera_info's P and R, whatever D says. Without it, D all zero with an R or
+  /// P that rectifies counts as rectified too (ros_conversions::cameraInfoGeometry).
+  bool rectified = false;
   /// Subscribe one `image` topic instead, and match each frame with the one before it (the
   /// earlier frame is the left image). Not with `calibrated`.
   bool frame_to_frame = false;
@@ -71,7 +79,8 @@ struct MatcherSettings {
 
 /// The matcher node: a left and a right image, paired by stamp, give SIFT matches and the
 /// verdicts of each filter on them (`correspondences`), and, when someone subscribes, a drawing of
-/// the first filter's verdicts (`matches_image`).
+/// the first filter's verdicts (`matches_image`). Inputs are subscribed only while someone
+/// subscribes `correspondences`, `points` or `matches_image` (image_pipeline's connect callbacks).
 class MatcherNode {
  public:
   /// Reads the private parameters (ros_params.h) and subscribes.
@@ -107,7 +116,14 @@ class MatcherNode {
     sensor_msgs::CameraInfoConstPtr left_info, right_info;
   };
 
-  void subscribe();
+  /// Advertises the outputs, with the connect callbacks that subscribe the inputs.
+  void advertise();
+  /// Builds the inputs and their synchronisers, subscribing nothing.
+  void setUpInputs();
+  /// Subscribes the inputs while someone subscribes an output; unsubscribes when none does.
+  void onOutputsChanged();
+  void subscribeInputs();
+  void unsubscribeInputs();
   std::unique_ptr<ImageInput> imageInput(const std::string& topic);
   /// Serves the run-time thresholds (cfg/Matcher.cfg), starting from the node's own settings.
   void serveReconfigure();
@@ -128,6 +144,8 @@ class MatcherNode {
   void reportDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& status);
   bool stereoCameras(const Image& left, const Image& right, const Info& left_info,
                      const Info& right_info, StereoCameras* cameras);
+  /// The right camera's pose in the left camera's frame from tf.
+  bool rightPoseFromTf(const Image& left, const Image& right, Eigen::Isometry3d* T_L_R);
   void publishPoints(const std_msgs::Header& header, const StereoCameras& cameras,
                      const PutativeMatches& matches, const FilterResult& kept);
 
@@ -138,6 +156,8 @@ class MatcherNode {
   std::shared_ptr<const Pipeline> pipeline_;
   ThrottledLog log_;
   image_transport::ImageTransport transport_;
+  std::mutex connect_mutex_;  ///< the outputs' connect callbacks against each other
+  bool inputs_subscribed_ = false;
   ros::Publisher correspondences_pub_, points_pub_;
   image_transport::Publisher matches_image_pub_;
   tf2_ros::Buffer tf_buffer_;
