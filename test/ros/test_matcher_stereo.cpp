@@ -10,6 +10,7 @@
 #include <cmath>
 
 #include "bad_inputs.h"
+#include "cloud_checks.h"
 #include "lib/conversions.h"
 #include "ros_wait.h"
 #include "sift_hull/Correspondences.h"
@@ -87,16 +88,8 @@ TEST_F(SharedFrameMatcherTest, TakesTheBaselineFromPAndTriangulatesOntoTheScene)
   EXPECT_GE(kept, 50u) << "of " << last_->matches.size() << " matches";
   const PinholeCamera camera(left_.view.camera.K(), Eigen::Matrix3d::Identity(),
                              Eigen::Vector3d::Zero());
-  size_t points = 0, on_surface = 0;
-  for (sensor_msgs::PointCloud2ConstIterator<float> p(*points_, "x"); p != p.end(); ++p) {
-    const Eigen::Vector3d X(p[0], p[1], p[2]);
-    const Eigen::Vector2d pixel = camera.project(X);
-    const int u = static_cast<int>(std::lround(pixel.x())),
-              v = static_cast<int>(std::lround(pixel.y()));
-    ++points;
-    if (u < 0 || v < 0 || u >= left_.depth.cols || v >= left_.depth.rows) continue;
-    on_surface += std::abs(left_.depth.at<float>(v, u) - X.z()) < 0.02 * X.z();
-  }
+  const test::DepthAgreement agreement = test::depthAgreement(*points_, camera, left_.depth);
+  const size_t points = agreement.points, on_surface = agreement.on_surface;
   ASSERT_GE(points, 20u);
   EXPECT_GE(static_cast<double>(on_surface) / points, 0.9) << on_surface << " of " << points;
   RecordProperty("epipolar_kept", std::to_string(kept));

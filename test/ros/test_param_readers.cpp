@@ -51,6 +51,7 @@ void expectDefaultHull(const ros::NodeHandle& nh) {
   EXPECT_EQ(node.queue_size, node_default.queue_size);
   EXPECT_EQ(node.pose_timeout_s, node_default.pose_timeout_s);
   EXPECT_EQ(node.from_image, node_default.from_image);
+  EXPECT_EQ(node.rectified, node_default.rectified);
   EXPECT_EQ(node.diagnostic_period, node_default.diagnostic_period);
   EXPECT_EQ(node.recipe.silhouette_method, node_default.recipe.silhouette_method);
   EXPECT_EQ(node.recipe.threshold, node_default.recipe.threshold);
@@ -186,6 +187,8 @@ TEST(ParameterReaders, SetParametersAreRead) {
   nh.setParam("filters", std::vector<std::string>{"gsc", "magsac"});
   nh.setParam("max_descriptor_distance", 250.0);
   nh.setParam("image_transport", "compressed");
+  nh.setParam("rectified", true);
+  EXPECT_TRUE(readHullNodeConfig(nh).rectified);
   const HullStreamConfig hull = readHullStreamConfig(nh);
   EXPECT_EQ(hull.hull.max_depth, 6);
   ASSERT_TRUE(hull.box.has_value());

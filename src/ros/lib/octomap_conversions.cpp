@@ -18,40 +18,36 @@
 namespace sift_hull {
 namespace ros_conversions {
 
-sift_hull::Octomap octomapMessage(const octomap::OcTree& tree, const std_msgs::Header& header) {
+namespace {
+
+/// An OcTree's message: binary (OctoMap's binary stream) or full, `bytes` its data.
+sift_hull::Octomap mapMessage(const std_msgs::Header& header, bool binary, double resolution_m,
+                              const std::string& bytes) {
   sift_hull::Octomap message;
   message.header = header;
-  message.binary = true;
-  message.id = tree.getTreeType();
-  message.resolution = tree.getResolution();
-  std::stringstream stream;
-  writeOctomapBinaryData(tree, stream);
-  const std::string bytes = stream.str();
+  message.binary = binary;
+  message.id = "OcTree";
+  message.resolution = resolution_m;
   message.data.assign(bytes.begin(), bytes.end());
   return message;
+}
+
+}  // namespace
+
+sift_hull::Octomap octomapMessage(const octomap::OcTree& tree, const std_msgs::Header& header) {
+  std::stringstream stream;
+  writeOctomapBinaryData(tree, stream);
+  return mapMessage(header, true, tree.getResolution(), stream.str());
 }
 
 sift_hull::Octomap octomapMessage(const CompactOctomap& map, const std_msgs::Header& header) {
-  sift_hull::Octomap message;
-  message.header = header;
-  message.binary = true;
-  message.id = "OcTree";
-  message.resolution = map.resolution_m;
-  message.data.assign(map.binary_data.begin(), map.binary_data.end());
-  return message;
+  return mapMessage(header, true, map.resolution_m, map.binary_data);
 }
 
 sift_hull::Octomap octomapFullMessage(const octomap::OcTree& tree, const std_msgs::Header& header) {
-  sift_hull::Octomap message;
-  message.header = header;
-  message.binary = false;
-  message.id = tree.getTreeType();
-  message.resolution = tree.getResolution();
   std::stringstream stream;
   tree.writeData(stream);
-  const std::string bytes = stream.str();
-  message.data.assign(bytes.begin(), bytes.end());
-  return message;
+  return mapMessage(header, false, tree.getResolution(), stream.str());
 }
 
 std::unique_ptr<octomap::OcTree> octreeFromMessage(const sift_hull::Octomap& message) {

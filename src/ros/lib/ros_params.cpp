@@ -291,6 +291,7 @@ HullNodeConfig readHullNodeConfig(const ros::NodeHandle& private_nh) {
   read(private_nh, "queue_size", &config.queue_size);
   read(private_nh, "pose_timeout_s", &config.pose_timeout_s);
   read(private_nh, "from_image", &config.from_image);
+  read(private_nh, "rectified", &config.rectified);
   config.diagnostic_period = readDiagnosticPeriod(private_nh, config.diagnostic_period);
   config.recipe = readSilhouetteConfig(private_nh);
   if (config.queue_size < 1) throw std::invalid_argument("~queue_size must be at least 1");

@@ -150,7 +150,7 @@ bool HullNode::cameraOf(const sensor_msgs::Image& silhouette, const sensor_msgs:
   }
   std::string why_not;
   if (!ros_conversions::cameraFromInfo(info, T_W_C, cv::Size(silhouette.width, silhouette.height),
-                                       camera, &why_not)) {
+                                       camera, &why_not, config_.rectified)) {
     log_.error("hull: view '" + silhouette.header.frame_id + "' ignored: ", why_not);
     return false;
   }

@@ -48,6 +48,10 @@ struct HullNodeConfig {
   /// Subscribe `image` (8-bit colour or mono) instead of `silhouette`, and extract each
   /// silhouette by `recipe` (the Middlebury threshold, dilation and erosion).
   bool from_image = false;
+  /// The silhouettes are of rectified images (image_proc's image_rect, whose camera_info is the
+  /// raw image's): cameras from P and R, whatever D says. False: raw, K and D, unless D is zero
+  /// and R and P rectify (ros_conversions::cameraInfoGeometry).
+  bool rectified = false;
   SilhouetteConfig recipe;
   /// Seconds of wall time between /diagnostics reports (diagnostic_updater's own parameter).
   double diagnostic_period = 1.0;
