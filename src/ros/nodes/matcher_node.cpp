@@ -19,6 +19,27 @@
 namespace sift_hull {
 namespace {
 
+/// Wall time inputs may arrive without pairing before /diagnostics warns.
+constexpr double kPairingPatience_s = 5.0;
+
+/// The inputs a synchronizer pairs (none frame to frame), for PairingWatch.
+std::vector<std::string> pairedInputs(const MatcherNodeConfig& config) {
+  if (config.frame_to_frame) return {};
+  if (!config.calibrated) return {"left/image", "right/image"};
+  return {"left/image", "right/image", "left/camera_info", "right/camera_info"};
+}
+
+/// What pairing needs, for the warning.
+std::string pairingHint(const MatcherNodeConfig& config) {
+  if (config.calibrated) {
+    return "the two images and the camera_info beside each (the image's namespace + camera_info) "
+           "pair by equal stamps";
+  }
+  if (config.approximate_sync) return "approximate sync found no two stamps near enough";
+  return "the left and right images pair by equal stamps (~approximate_sync: true pairs the "
+         "nearest ones)";
+}
+
 std::vector<std::unique_ptr<MatchFilter>> makeFilters(const MatcherSettings& settings) {
   std::vector<std::unique_ptr<MatchFilter>> filters;
   for (const std::string& spec : settings.node.filters) {
@@ -52,6 +73,7 @@ MatcherNode::MatcherNode(ros::NodeHandle nh, ros::NodeHandle private_nh, Matcher
       tf_listener_(tf_buffer_),
       work_(settings_.node.max_waiting_pairs, settings_.node.workers,
             [this](Pair& pair) { matchPair(pair); }),
+      pairing_(pairedInputs(settings_.node), kPairingPatience_s, pairingHint(settings_.node)),
       diagnostics_(nh_, private_nh_, "matcher", settings_.node.diagnostic_period,
                    [this](diagnostic_updater::DiagnosticStatusWrapper& status) {
                      reportDiagnostics(status);
@@ -101,6 +123,11 @@ std::shared_ptr<const MatcherNode::Pipeline> MatcherNode::pipeline() const {
 void MatcherNode::reportDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& status) {
   reportQueue(work_.counts(), "pairs", &status);
   status.add("last pair ms", last_pair_ms_.load());
+  const std::string unpaired = pairing_.problem(PairingWatch::Clock::now());
+  if (!unpaired.empty()) {
+    status.mergeSummary(diagnostic_msgs::DiagnosticStatus::WARN, unpaired);
+    ROS_WARN_THROTTLE(5.0, "matcher: %s", unpaired.c_str());
+  }
 }
 
 void MatcherNode::serveReconfigure() {
@@ -161,6 +188,7 @@ void MatcherNode::setUpInputs() {
   }
   left_sub_ = imageInput("left/image");
   right_sub_ = imageInput("right/image");
+  watchArrivals();
   if (settings_.node.calibrated) {
     calibrated_sync_ = std::make_unique<CalibratedSync>(
         message_filters::sync_policies::ExactTime<Image, Image, Info, Info>(queue), *left_sub_,
@@ -176,6 +204,22 @@ void MatcherNode::setUpInputs() {
         message_filters::sync_policies::ExactTime<Image, Image>(queue), *left_sub_, *right_sub_);
     exact_sync_->registerCallback(&MatcherNode::onPair, this);
   }
+}
+
+void MatcherNode::watchArrivals() {
+  const auto arrived = [this](size_t input, const ros::Time& stamp) {
+    pairing_.arrived(input, stamp.toSec(), PairingWatch::Clock::now());
+  };
+  using ImageCallback = boost::function<void(const sensor_msgs::ImageConstPtr&)>;
+  using InfoCallback = boost::function<void(const sensor_msgs::CameraInfoConstPtr&)>;
+  left_sub_->registerCallback(ImageCallback(
+      [arrived](const sensor_msgs::ImageConstPtr& m) { arrived(0, m->header.stamp); }));
+  right_sub_->registerCallback(ImageCallback(
+      [arrived](const sensor_msgs::ImageConstPtr& m) { arrived(1, m->header.stamp); }));
+  left_info_sub_.registerCallback(InfoCallback(
+      [arrived](const sensor_msgs::CameraInfoConstPtr& m) { arrived(2, m->header.stamp); }));
+  right_info_sub_.registerCallback(InfoCallback(
+      [arrived](const sensor_msgs::CameraInfoConstPtr& m) { arrived(3, m->header.stamp); }));
 }
 
 void MatcherNode::subscribeInputs() {
@@ -203,6 +247,7 @@ void MatcherNode::onCalibratedPair(const sensor_msgs::ImageConstPtr& left,
                                    const sensor_msgs::ImageConstPtr& right,
                                    const sensor_msgs::CameraInfoConstPtr& left_info,
                                    const sensor_msgs::CameraInfoConstPtr& right_info) {
+  pairing_.paired();
   enqueue({left, right, left_info, right_info});
 }
 
@@ -263,6 +308,7 @@ void MatcherNode::onFrame(const sensor_msgs::ImageConstPtr& frame) {
 
 void MatcherNode::onPair(const sensor_msgs::ImageConstPtr& left,
                          const sensor_msgs::ImageConstPtr& right) {
+  pairing_.paired();
   enqueue({left, right, nullptr, nullptr});
 }
 

@@ -23,6 +23,7 @@
 
 #include "lib/image_input.h"
 #include "lib/node_diagnostics.h"
+#include "lib/pairing_watch.h"
 #include "lib/throttled_log.h"
 #include "lib/work_queue.h"
 #include "sift_hull/Correspondences.h"
@@ -122,6 +123,8 @@ class MatcherNode {
   void setUpInputs();
   /// Subscribes the inputs while someone subscribes an output; unsubscribes when none does.
   void onOutputsChanged();
+  /// Counts each input's arrivals for pairing_.
+  void watchArrivals();
   void subscribeInputs();
   void unsubscribeInputs();
   std::unique_ptr<ImageInput> imageInput(const std::string& topic);
@@ -164,6 +167,7 @@ class MatcherNode {
   tf2_ros::TransformListener tf_listener_;
   std::atomic<double> last_pair_ms_{0.0};
   WorkQueue<Pair> work_;
+  PairingWatch pairing_;  ///< images (and camera_infos) that arrive but do not pair
   NodeDiagnostics diagnostics_;
   boost::recursive_mutex reconfigure_mutex_;  // the server's, so updateConfig cannot race it
   std::unique_ptr<dynamic_reconfigure::Server<sift_hull::MatcherConfig>> reconfigure_;
