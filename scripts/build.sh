@@ -14,7 +14,10 @@ mkdir -p "$workspace/src"
 mkdir -p "$package"
 find "$package" -mindepth 1 -maxdepth 1 -type l -delete
 for entry in "$repo_root"/* "$repo_root"/.clang-format; do
-  [[ -e "$entry" && "$(realpath "$entry")" != "$workspace" ]] && ln -sfn "$entry" "$package/"
+  [[ -e "$entry" ]] || continue
+  # Left out: any entry that holds the workspace (SIFT_HULL_WORKSPACE may lie deeper inside).
+  [[ "$workspace/" == "$(realpath "$entry")/"* ]] && continue
+  ln -sfn "$entry" "$package/"
 done
 cd "$workspace"
 catkin_make -DCMAKE_BUILD_TYPE="${BUILD_TYPE:-Release}" -DPYTHON_EXECUTABLE=/usr/bin/python3 \

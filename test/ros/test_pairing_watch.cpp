@@ -49,5 +49,16 @@ TEST(PairingWatch, NamesAnInputThatNeverArrives) {
             std::string::npos);
 }
 
+TEST(PairingWatch, TakesAnInputThatCameBeforeButNotSinceForIdle) {
+  PairingWatch watch({"silhouette", "camera_info"}, 1.0, "HINT");
+  const Clock::time_point start{};
+  watch.arrived(0, 1.0, start);
+  watch.arrived(1, 1.0, start);
+  watch.paired();
+  for (int i = 1; i <= 10; ++i) watch.arrived(1, 1.0 + i, start + milliseconds(300 * i));
+  EXPECT_EQ(watch.problem(start + milliseconds(3000)), "")
+      << "camera_info streaming between masks that come now and then";
+}
+
 }  // namespace
 }  // namespace sift_hull

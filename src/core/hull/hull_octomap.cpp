@@ -94,6 +94,21 @@ void clearNode(octomap::OcTree* tree, octomap::OcTreeNode* node, int level,
   }
 }
 
+/// Prunes bottom up through every level: OcTree::prune stops at the first level where nothing
+/// collapsed, which can leave a coarser collapsible node (the hull's blocks come in at their own
+/// levels), so that the tree would not be the canonical one compactOctomap writes.
+void pruneFully(octomap::OcTree* tree, octomap::OcTreeNode* node, bool is_root) {
+  if (!tree->nodeHasChildren(node)) return;
+  for (unsigned int c = 0; c < 8; ++c) {
+    if (tree->nodeChildExists(node, c)) pruneFully(tree, tree->getNodeChild(node, c), false);
+  }
+  if (!is_root && tree->isNodeCollapsible(node)) tree->pruneNode(node);
+}
+
+void pruneFully(octomap::OcTree* tree) {
+  if (tree->getRoot() != nullptr) pruneFully(tree, tree->getRoot(), true);
+}
+
 /// The keys of the voxels a metric box touches, clipped to OctoMap's key range.
 KeyBox touchedKeys(const octomap::OcTree& tree, const Box3d& box_W) {
   const auto key = [&](double coordinate_m) {
@@ -116,7 +131,7 @@ std::unique_ptr<octomap::OcTree> toOctomap(const VisualHull& hull) {
   for (const VoxelBlock& block : occupiedBlocks(hull)) tree->insertBlock(toKeys(block), occupied);
   for (const VoxelBlock& block : carvedBlocks(hull)) tree->insertBlock(toKeys(block), free);
   tree->updateInnerOccupancy();
-  tree->prune();
+  pruneFully(tree.get());
   return tree;
 }
 
@@ -169,7 +184,7 @@ void clearBox(const Box3d& box_W, octomap::OcTree* tree) {
   if (tree->getRoot() == nullptr || !(keys.min_key.array() < keys.end_key.array()).all()) return;
   clearNode(tree, tree->getRoot(), 0, Eigen::Vector3i::Zero(), keys);
   tree->updateInnerOccupancy();
-  tree->prune();
+  pruneFully(tree);
 }
 
 void writeOctomap(const octomap::OcTree& tree, const std::string& path) {

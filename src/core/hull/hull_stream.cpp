@@ -170,8 +170,13 @@ void HullStream::refitBox() {
       (box_.max_W - tighter.max_W).maxCoeff() <= cell_m) {
     return;
   }
-  auto refitted = std::make_unique<VisualHull>(tighter, config_.hull);
-  refitted->addViews(hull_->views());
+  std::unique_ptr<VisualHull> refitted;
+  try {
+    refitted = std::make_unique<VisualHull>(tighter, config_.hull);
+    refitted->addViews(hull_->views());
+  } catch (const std::exception&) {
+    return;  // a box the views cannot join (too far, too fine a resolution): keep the one it had
+  }
   if (refitted->isEmpty()) return;
   hull_ = std::move(refitted);
   box_ = tighter;

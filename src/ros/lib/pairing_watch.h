@@ -14,8 +14,9 @@ namespace sift_hull {
 
 /// Notices inputs that arrive but do not pair (a synchronizer's inputs whose stamps differ, masks
 /// whose poses never come): counts each input's arrivals since the last pair; once some have
-/// waited `patience_s` without a pair, problem() says which arrived, how many, their newest
-/// stamps, and `hint` (what pairing needs). Thread-safe.
+/// waited `patience_s` without a pair while every input has arrived since (or never at all),
+/// problem() says which arrived, how many, their newest stamps, and `hint` (what pairing needs).
+/// Thread-safe.
 class PairingWatch {
  public:
   using Clock = std::chrono::steady_clock;
@@ -33,6 +34,7 @@ class PairingWatch {
     std::lock_guard<std::mutex> lock(mutex_);
     if (input >= inputs_.size()) return;
     ++inputs_[input].unpaired;
+    inputs_[input].ever = true;
     inputs_[input].newest_stamp_s = stamp_s;
     if (!first_unpaired_) first_unpaired_ = now;
   }
@@ -50,6 +52,11 @@ class PairingWatch {
   std::string problem(Clock::time_point now) const {
     std::lock_guard<std::mutex> lock(mutex_);
     if (!first_unpaired_ || now - *first_unpaired_ < patience_) return "";
+    // An input that came before but not since the last pair is idle (masks made now and then
+    // while camera_info streams), not failing to pair; one that never came is missing.
+    for (const Input& input : inputs_) {
+      if (input.unpaired == 0 && input.ever) return "";
+    }
     std::string arrivals;
     for (const Input& input : inputs_) {
       if (!arrivals.empty()) arrivals += ", ";
@@ -65,6 +72,7 @@ class PairingWatch {
   struct Input {
     std::string name;
     size_t unpaired = 0;
+    bool ever = false;  ///< arrived since the start
     double newest_stamp_s = std::numeric_limits<double>::quiet_NaN();
   };
 

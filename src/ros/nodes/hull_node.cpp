@@ -20,6 +20,8 @@ namespace {
 constexpr double kThrottle_s = 5.0;
 /// Wall time inputs may arrive without pairing before /diagnostics warns.
 constexpr double kPairingPatience_s = 5.0;
+/// Wall time a changed hull may wait for the queue to drain before it is published anyway.
+constexpr double kMaxPublishDelay_s = 1.0;
 
 std::string shortNumber(double value) {
   std::ostringstream out;
@@ -39,19 +41,12 @@ HullNode::HullNode(ros::NodeHandle nh, ros::NodeHandle private_nh, HullNodeConfi
       private_nh_(private_nh),
       config_(std::move(node_config)),
       stream_(std::move(hull_config)),
-      octomap_pub_(nh_.advertise<sift_hull::Octomap>(
-          "octomap_binary", 1, [this](const ros::SingleSubscriberPublisher&) { publishMapsNow(); },
-          ros::SubscriberStatusCallback(), ros::VoidConstPtr(), true)),
+      octomap_pub_(nh_.advertise<sift_hull::Octomap>("octomap_binary", 1, true)),
       octomap_full_pub_(nh_.advertise<sift_hull::Octomap>(
           "octomap_full", 1, [this](const ros::SingleSubscriberPublisher&) { publishFullNow(); },
           ros::SubscriberStatusCallback(), ros::VoidConstPtr(), true)),
-      cloud_pub_(nh_.advertise<sensor_msgs::PointCloud2>(
-          "occupied_cells", 1, [this](const ros::SingleSubscriberPublisher&) { publishMapsNow(); },
-          ros::SubscriberStatusCallback(), ros::VoidConstPtr(), true)),
-      centers_pub_(nh_.advertise<sensor_msgs::PointCloud2>(
-          "octomap_point_cloud_centers", 1,
-          [this](const ros::SingleSubscriberPublisher&) { publishMapsNow(); },
-          ros::SubscriberStatusCallback(), ros::VoidConstPtr(), true)),
+      cloud_pub_(nh_.advertise<sensor_msgs::PointCloud2>("occupied_cells", 1, true)),
+      centers_pub_(nh_.advertise<sensor_msgs::PointCloud2>("octomap_point_cloud_centers", 1, true)),
       markers_pub_(nh_.advertise<visualization_msgs::MarkerArray>(
           "occupied_cells_vis_array", 1,
           [this](const ros::SingleSubscriberPublisher&) { publishMarkersNow(); },
@@ -182,15 +177,20 @@ void HullNode::integrate(View& view) {
   last_view_stamp_ = view.stamp.toSec();
   if (changed) unpublished_stamp_ = view.stamp;
   // Waiting, skipped or redundant: the published hull stands. Views queued behind this one refine
-  // the hull at once: each state would cost a whole conversion the next view replaces, so the
-  // hull is published when the queue has drained, stamped with the newest view that changed it.
-  if (unpublished_stamp_.isZero() || work_.counts().waiting > 0) return;
+  // the hull at once: each state would cost a conversion the next view replaces, so the hull is
+  // published when the queue has drained, or kMaxPublishDelay_s after the last publication under
+  // a stream that never lets it drain, stamped with the newest view that changed it.
+  if (unpublished_stamp_.isZero()) return;
+  if (work_.counts().waiting > 0 &&
+      (ros::WallTime::now() - last_publish_wall_).toSec() < kMaxPublishDelay_s) {
+    return;
+  }
   try {
     publish(unpublished_stamp_);
   } catch (const std::exception& e) {  // e.g. a hull beyond OctoMap's key range
+    unpublished_stamp_ = ros::Time();
     log_.error("hull: cannot publish the hull: ", e.what());
   }
-  unpublished_stamp_ = ros::Time();
   last_publish_ms_ = (ros::WallTime::now() - carved).toSec() * 1e3;
 }
 
@@ -244,11 +244,14 @@ bool HullNode::reset(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
   std::lock_guard<std::mutex> lock(hull_mutex_);
   ++generation_;
   const size_t discarded = work_.clear();  // views from before the reset
+  const double resolution_m = stream_.hasHull() ? stream_.hull().cube().resolution_m
+                              : octree_         ? octree_->getResolution()
+                                                : 0.1;
   stream_.reset();
   unpublished_stamp_ = ros::Time();
   cleared_boxes_.clear();
   refused_views_ = 0;
-  publishEmpty();
+  publishEmpty(resolution_m);
   octree_.reset();
   published_ = false;
   mesh_.reset();
@@ -258,6 +261,11 @@ bool HullNode::reset(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
 
 bool HullNode::save(sift_hull::Save::Request& request, sift_hull::Save::Response& response) {
   std::lock_guard<std::mutex> lock(hull_mutex_);
+  try {
+    publishPending();  // views carved but not yet published: saved as published
+  } catch (const std::exception& e) {
+    log_.error("hull: cannot publish the hull: ", e.what());
+  }
   if (!stream_.hasHull() || !published_) {
     response.success = false;
     response.message = "no hull yet";

@@ -13,6 +13,7 @@
 #include <tf2_ros/transform_listener.h>
 
 #include <atomic>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -91,27 +92,29 @@ class HullNode {
   void integrate(View& view);
   /// Whether the view changed the hull.
   bool carve(const View& view);
-  /// The hull, stamped `stamp`, on every output someone subscribes; the OctoMap is built then, or
-  /// when first asked for (publishedTree).
+  /// The hull, stamped `stamp`: octomap_binary and the centres always, the other outputs while
+  /// someone subscribes; OctoMap's tree is built for those, or when first asked for.
   void publish(const ros::Time& stamp);
   /// The published hull as an OctoMap (carved space free, the cleared boxes applied), built from
   /// the stream when stale. Requires published_ and hull_mutex_.
   const octomap::OcTree& publishedTree();
-  /// Subscribers of the map topics, the markers included.
-  uint32_t mapSubscribers() const;
-  /// publishedTree on the map topics someone subscribes, stamped header_.
+  /// The maps, stamped header_: octomap_binary and the centres from compactOctomap (or the tree,
+  /// once boxes were cleared), the full map and the markers from publishedTree when subscribed.
   void publishMaps();
   /// The occupied cells' centres on occupied_cells and octomap_point_cloud_centers.
   void publishCentres(const sensor_msgs::PointCloud2& centres);
-  /// publishMaps for a new subscriber of octomap_binary, occupied_cells or the centres.
-  void publishMapsNow();
+  /// publish(unpublished_stamp_) when views were carved since the last publication.
+  void publishPending();
+  /// `send` under the hull's lock after publishPending, when a hull is published; what throws is
+  /// logged (never into roscpp's callback).
+  void sendToNewSubscriber(const std::function<void()>& send);
   /// octomap_full, markers and mesh for a new subscriber (they are built only while someone
   /// looks).
   void publishFullNow();
   void publishMarkersNow();
   void publishFreeMarkersNow();
   void publishMeshNow();
-  void publishEmpty();
+  void publishEmpty(double resolution_m);
   /// The published hull's mesh (marching cubes once per hull, shared by `mesh`, new subscribers
   /// and ~save). Requires published_.
   const TriangleMesh& publishedMesh();
@@ -145,6 +148,7 @@ class HullNode {
   std::unique_ptr<TriangleMesh> mesh_;       ///< its mesh, made when first asked for
   std_msgs::Header header_;                  ///< of the last publication
   ros::Time unpublished_stamp_;       ///< newest view that changed the hull since then (zero: none)
+  ros::WallTime last_publish_wall_;   ///< of the last publication
   std::vector<Box3d> cleared_boxes_;  ///< by ~clear_bbx since the start or ~reset
   std::atomic<uint64_t> generation_{0};
   ThrottledLog log_;

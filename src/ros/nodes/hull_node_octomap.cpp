@@ -1,5 +1,6 @@
 // The hull node's outputs: octomap_server's topics and services, the markers and the mesh.
 
+#include <functional>
 #include <sstream>
 
 #include "lib/conversions.h"
@@ -49,17 +50,17 @@ void HullNode::publish(const ros::Time& stamp) {
   header_.frame_id = config_.world_frame;
   published_ = true;
   tree_stale_ = true;  // built when first needed (publishedTree)
+  unpublished_stamp_ = ros::Time();
+  last_publish_wall_ = ros::WallTime::now();
   mesh_.reset();
-  if (mapSubscribers() > 0) publishMaps();
+  publishMaps();
   if (mesh_pub_.getNumSubscribers() > 0) {
     mesh_pub_.publish(ros_conversions::meshMarker(publishedMesh(), header_));
   }
 }
 
-uint32_t HullNode::mapSubscribers() const {
-  return octomap_pub_.getNumSubscribers() + octomap_full_pub_.getNumSubscribers() +
-         cloud_pub_.getNumSubscribers() + centers_pub_.getNumSubscribers() +
-         markers_pub_.getNumSubscribers() + free_markers_pub_.getNumSubscribers();
+void HullNode::publishPending() {
+  if (!unpublished_stamp_.isZero()) publish(unpublished_stamp_);
 }
 
 const octomap::OcTree& HullNode::publishedTree() {
@@ -71,22 +72,18 @@ const octomap::OcTree& HullNode::publishedTree() {
   return *octree_;
 }
 
-/// Each map topic someone subscribes (a latched topic nobody listens to costs no conversion; its
-/// first subscriber gets the map at once: publishMapsNow).
+/// octomap_binary and the centres clouds every time (latched: a later subscriber must not get an
+/// older map), from the compact map (no OctoMap nodes) unless boxes were cleared; the full map and
+/// the markers, which need OctoMap's tree, only while someone subscribes.
 void HullNode::publishMaps() {
-  const bool binary = octomap_pub_.getNumSubscribers() > 0;
-  const bool centres = cloud_pub_.getNumSubscribers() + centers_pub_.getNumSubscribers() > 0;
-  if ((binary || centres) && cleared_boxes_.empty()) {
-    // What every view publishes, from the compact map (no OctoMap nodes); OctoMap's own tree
-    // only for what needs it (the full map, markers, cleared boxes, services, ~save).
+  if (cleared_boxes_.empty()) {
     const CompactOctomap map = compactOctomap(stream_.hull());
-    if (binary) octomap_pub_.publish(ros_conversions::octomapMessage(map, header_));
-    if (centres)
-      publishCentres(ros_conversions::pointCloudMessage(map.occupied_centres_W, header_));
-  } else if (binary || centres) {
+    octomap_pub_.publish(ros_conversions::octomapMessage(map, header_));
+    publishCentres(ros_conversions::pointCloudMessage(map.occupied_centres_W, header_));
+  } else {
     const octomap::OcTree& tree = publishedTree();
-    if (binary) octomap_pub_.publish(ros_conversions::octomapMessage(tree, header_));
-    if (centres) publishCentres(ros_conversions::occupiedCellsCloud(tree, header_));
+    octomap_pub_.publish(ros_conversions::octomapMessage(tree, header_));
+    publishCentres(ros_conversions::occupiedCellsCloud(tree, header_));
   }
   if (octomap_full_pub_.getNumSubscribers() > 0) {  // its data is about 10 times the binary's
     octomap_full_pub_.publish(ros_conversions::octomapFullMessage(publishedTree(), header_));
@@ -104,47 +101,49 @@ void HullNode::publishCentres(const sensor_msgs::PointCloud2& centres) {
   centers_pub_.publish(centres);
 }
 
-void HullNode::publishMapsNow() {
-  std::lock_guard<std::mutex> lock(hull_mutex_);
-  if (published_) publishMaps();
-}
-
 const TriangleMesh& HullNode::publishedMesh() {
   if (!mesh_) mesh_ = std::make_unique<TriangleMesh>(stream_.hull().mesh());
   return *mesh_;
 }
 
-void HullNode::publishMarkersNow() {
+void HullNode::sendToNewSubscriber(const std::function<void()>& send) {
   std::lock_guard<std::mutex> lock(hull_mutex_);
-  if (published_) {
-    markers_pub_.publish(ros_conversions::occupiedCellsMarkers(publishedTree(), header_));
+  try {
+    publishPending();  // views carved but not yet published: their map, with their stamp
+    if (published_) send();
+  } catch (const std::exception& e) {  // e.g. a hull beyond OctoMap's key range
+    log_.error("hull: cannot publish the hull: ", e.what());
   }
+}
+
+void HullNode::publishMarkersNow() {
+  sendToNewSubscriber([this] {
+    markers_pub_.publish(ros_conversions::occupiedCellsMarkers(publishedTree(), header_));
+  });
 }
 
 void HullNode::publishFullNow() {
-  std::lock_guard<std::mutex> lock(hull_mutex_);
-  if (published_) {
+  sendToNewSubscriber([this] {
     octomap_full_pub_.publish(ros_conversions::octomapFullMessage(publishedTree(), header_));
-  }
+  });
 }
 
 void HullNode::publishFreeMarkersNow() {
-  std::lock_guard<std::mutex> lock(hull_mutex_);
-  if (published_) {
+  sendToNewSubscriber([this] {
     free_markers_pub_.publish(ros_conversions::freeCellsMarkers(publishedTree(), header_));
-  }
+  });
 }
 
 void HullNode::publishMeshNow() {
-  std::lock_guard<std::mutex> lock(hull_mutex_);
-  if (published_) mesh_pub_.publish(ros_conversions::meshMarker(publishedMesh(), header_));
+  sendToNewSubscriber(
+      [this] { mesh_pub_.publish(ros_conversions::meshMarker(publishedMesh(), header_)); });
 }
 
-/// An empty map at the last resolution, and markers deleted.
-void HullNode::publishEmpty() {
+/// An empty map at `resolution_m`, and markers deleted.
+void HullNode::publishEmpty(double resolution_m) {
   header_.stamp = ros::Time::now();
   header_.frame_id = config_.world_frame;
-  const octomap::OcTree empty(octree_ ? octree_->getResolution() : 0.1);
+  const octomap::OcTree empty(resolution_m);
   octomap_pub_.publish(ros_conversions::octomapMessage(empty, header_));
   octomap_full_pub_.publish(ros_conversions::octomapFullMessage(empty, header_));
   const sensor_msgs::PointCloud2 centres = ros_conversions::occupiedCellsCloud(empty, header_);
@@ -158,6 +157,7 @@ void HullNode::publishEmpty() {
 
 bool HullNode::getMap(bool binary, sift_hull::GetOctomap::Response* response) {
   std::lock_guard<std::mutex> lock(hull_mutex_);
+  publishPending();
   if (!published_) {
     log_.error(binary ? "hull: octomap_binary refused: " : "hull: octomap_full refused: ",
                "no map yet (no view carved since the start or ~reset)");
@@ -178,6 +178,7 @@ bool HullNode::clearBbx(sift_hull::BoundingBoxQuery::Request& request,
     return false;
   }
   std::lock_guard<std::mutex> lock(hull_mutex_);
+  publishPending();
   cleared_boxes_.push_back(box);  // applied to every later map too, until ~reset
   if (!published_) {
     ROS_INFO("hull: ~clear_bbx: no map yet; the box will be cleared in the first one");

@@ -241,6 +241,7 @@ void MatcherNode::unsubscribeInputs() {
   }
   left_info_sub_.unsubscribe();
   right_info_sub_.unsubscribe();
+  previous_frame_.reset();  // frame to frame: no pairing across a pause without listeners
 }
 
 void MatcherNode::onCalibratedPair(const sensor_msgs::ImageConstPtr& left,
