@@ -2,7 +2,6 @@
 // ~reset; bad input answered with an error while later good input still counts. Every wait has a
 // deadline.
 
-#include <diagnostic_msgs/DiagnosticArray.h>
 #include <geometry_msgs/TransformStamped.h>
 #include <gtest/gtest.h>
 #include <octomap/OcTree.h>
@@ -22,6 +21,7 @@
 #include <sstream>
 
 #include "common/octomap_volume.h"
+#include "diagnostics_wait.h"
 #include "hull_node_fixture.h"
 #include "lib/conversions.h"
 #include "ros_wait.h"
@@ -147,31 +147,14 @@ TEST_F(HullNodeTest, ASilhouetteWhosePoseComesAfterTheTimeoutIsReportedAndNotCar
 }
 
 TEST_F(HullNodeTest, WarnsWhenSilhouettesAndCameraInfoArriveButDoNotPair) {
-  std::mutex mutex;
-  std::string warning;
-  ros::Subscriber diagnostics = nh_.subscribe<diagnostic_msgs::DiagnosticArray>(
-      "/diagnostics", 20, [&](const diagnostic_msgs::DiagnosticArrayConstPtr& array) {
-        std::lock_guard<std::mutex> lock(mutex);
-        for (const diagnostic_msgs::DiagnosticStatus& status : array->status) {
-          if (status.name.find("hull") == std::string::npos) continue;
-          warning = status.level == diagnostic_msgs::DiagnosticStatus::WARN ? status.message : "";
-        }
-      });
   publishView(1);  // a pair: what arrived before is accounted for
   // A segmentation node that re-stamps its masks: the camera_info is 5 ms off.
-  const ros::WallTime start = ros::WallTime::now();
-  bool warned = false;
-  while (!warned && (ros::WallTime::now() - start).toSec() < 20.0) {
+  const std::string warning = test::warningOf(nh_, "hull", "have not paired", [&] {
     publishView(2, [](sensor_msgs::Image*, sensor_msgs::CameraInfo* info) {
       info->header.stamp += ros::Duration(0.005);
     });
-    ros::WallDuration(0.25).sleep();
-    ros::spinOnce();
-    std::lock_guard<std::mutex> lock(mutex);
-    warned = warning.find("have not paired") != std::string::npos;
-  }
-  std::lock_guard<std::mutex> lock(mutex);
-  ASSERT_TRUE(warned) << "no WARN on /diagnostics within 20 s; last: '" << warning << "'";
+  });
+  ASSERT_FALSE(warning.empty()) << "no WARN on /diagnostics within 20 s";
   EXPECT_NE(warning.find("silhouette ("), std::string::npos) << warning;
   EXPECT_NE(warning.find("camera_info ("), std::string::npos) << warning;
   EXPECT_NE(warning.find("equal stamp"), std::string::npos) << warning;

@@ -2,7 +2,6 @@
 // and a precision against the scene's ground truth; bad pairs answered with an error while later
 // good pairs still count. Every wait has a deadline.
 
-#include <diagnostic_msgs/DiagnosticArray.h>
 #include <dynamic_reconfigure/Reconfigure.h>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
@@ -18,6 +17,7 @@
 #include <set>
 
 #include "cloud_checks.h"
+#include "diagnostics_wait.h"
 #include "lib/conversions.h"
 #include "ros_wait.h"
 #include "sift_hull/Correspondences.h"
@@ -153,31 +153,14 @@ TEST_F(MatcherNodeTest, RefusesBadPairsAndCarriesOn) {
 }
 
 TEST_F(MatcherNodeTest, WarnsWhenImagesArriveButDoNotPair) {
-  std::mutex mutex;
-  std::string warning;
-  ros::Subscriber diagnostics = nh_.subscribe<diagnostic_msgs::DiagnosticArray>(
-      "/diagnostics", 20, [&](const diagnostic_msgs::DiagnosticArrayConstPtr& array) {
-        std::lock_guard<std::mutex> lock(mutex);
-        for (const diagnostic_msgs::DiagnosticStatus& status : array->status) {
-          if (status.name.find("matcher") == std::string::npos) continue;
-          warning = status.level == diagnostic_msgs::DiagnosticStatus::WARN ? status.message : "";
-        }
-      });
   ASSERT_TRUE(answeredAtLeast(publishPair(left_.image, right_.image)));
   // Stereo stamps 5 ms apart under exact sync: nothing pairs.
-  const ros::WallTime start = ros::WallTime::now();
-  bool warned = false;
-  while (!warned && (ros::WallTime::now() - start).toSec() < 20.0) {
+  const std::string warning = test::warningOf(nh_, "matcher", "have not paired", [&] {
     const ros::Time stamp = ros::Time::now();
     left_pub_.publish(bgrImage(left_.image, stamp, "left"));
     right_pub_.publish(bgrImage(right_.image, stamp + ros::Duration(0.005), "right"));
-    ros::WallDuration(0.25).sleep();
-    ros::spinOnce();
-    std::lock_guard<std::mutex> lock(mutex);
-    warned = warning.find("have not paired") != std::string::npos;
-  }
-  std::lock_guard<std::mutex> lock(mutex);
-  ASSERT_TRUE(warned) << "no WARN on /diagnostics within 20 s; last: '" << warning << "'";
+  });
+  ASSERT_FALSE(warning.empty()) << "no WARN on /diagnostics within 20 s";
   EXPECT_NE(warning.find("left/image ("), std::string::npos) << warning;
   EXPECT_NE(warning.find("right/image ("), std::string::npos) << warning;
   EXPECT_NE(warning.find("~approximate_sync"), std::string::npos) << warning;

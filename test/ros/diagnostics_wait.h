@@ -1,0 +1,42 @@
+#pragma once
+
+// Waiting for a node's /diagnostics task to warn, in the rostests.
+
+#include <diagnostic_msgs/DiagnosticArray.h>
+#include <ros/ros.h>
+
+#include <functional>
+#include <mutex>
+#include <string>
+
+namespace sift_hull {
+namespace test {
+
+/// Calls `poke` (which publishes what should make the node warn) every 0.25 s until the
+/// /diagnostics status whose name holds `task` is WARN with a message holding `text`, at most
+/// `deadline_s` of wall time; returns that message, or empty after the deadline.
+inline std::string warningOf(ros::NodeHandle& nh, const std::string& task, const std::string& text,
+                             const std::function<void()>& poke, double deadline_s = 20.0) {
+  std::mutex mutex;
+  std::string warning;
+  ros::Subscriber diagnostics = nh.subscribe<diagnostic_msgs::DiagnosticArray>(
+      "/diagnostics", 20, [&](const diagnostic_msgs::DiagnosticArrayConstPtr& array) {
+        std::lock_guard<std::mutex> lock(mutex);
+        for (const diagnostic_msgs::DiagnosticStatus& status : array->status) {
+          if (status.name.find(task) == std::string::npos) continue;
+          warning = status.level == diagnostic_msgs::DiagnosticStatus::WARN ? status.message : "";
+        }
+      });
+  const ros::WallTime start = ros::WallTime::now();
+  while ((ros::WallTime::now() - start).toSec() < deadline_s) {
+    poke();
+    ros::WallDuration(0.25).sleep();
+    ros::spinOnce();
+    std::lock_guard<std::mutex> lock(mutex);
+    if (warning.find(text) != std::string::npos) return warning;
+  }
+  return "";
+}
+
+}  // namespace test
+}  // namespace sift_hull
