@@ -106,6 +106,7 @@ TEST(HullCube, TakesAResolutionInMetresAtTheLeastDepthThatHoldsTheBox) {
     EXPECT_NE(std::string(e.what()).find("raise resolution_m (at least 0.00078"), std::string::npos)
         << e.what();
   }
+  EXPECT_THROW(HullCube::withResolution(box, 1e308), std::invalid_argument) << "no finite edge";
   config.resolution_m = -1.0;
   EXPECT_THROW(validate(config), std::invalid_argument);
 }

@@ -7,6 +7,7 @@
 // This file: hull_node.
 
 #include "bad_inputs.h"
+#include "hull_node_fixture.h"
 
 namespace sift_hull {
 namespace bad_inputs {
@@ -20,7 +21,7 @@ struct ViewData {
   cv::Mat mask;
 };
 
-constexpr int kViews = 8;
+using test::kViews;
 constexpr double kSphereRadius_m = 0.8;
 
 /// The camera turned by `degrees` about the world's z axis through the origin (still looking at
@@ -55,22 +56,16 @@ struct HullData {
 HullData& hullData() {
   static HullData data = [] {
     HullData d;
-    SceneConfig config;
-    config.shape = "sphere";
-    config.views = kViews;
-    config.layout = "sphere";
-    config.width_px = 320;
-    config.height_px = 240;
-    const std::vector<RenderedView> views = renderScene(config);
+    const std::vector<RenderedView> views = test::sphereViews();
     for (int v = 0; v < kViews; ++v) {
-      d.good.push_back({"camera_" + std::to_string(v), views[v].view.camera, views[v].mask});
+      d.good.push_back({test::frameOf(v), views[v].view.camera, views[v].mask});
     }
     const Shape shape = Shape::byName("sphere");
-    const cv::Size size(config.width_px, config.height_px);
+    const cv::Size size = views[0].mask.size();  // sphereViews: 320x240, the default seed
     for (double degrees : {20.0, 45.0}) {
       for (int v = 0; v < kViews; ++v) {
         CalibratedView view{"", turnedCamera(views[v].view.camera, degrees), "", ""};
-        const RenderedView rendered = renderView(shape, view, size, config.seed);
+        const RenderedView rendered = renderView(shape, view, size, SceneConfig().seed);
         d.fresh.push_back({"fresh_" + std::to_string(d.fresh.size()), view.camera, rendered.mask});
       }
     }

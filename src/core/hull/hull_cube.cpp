@@ -48,7 +48,15 @@ HullCube HullCube::withResolution(const Box3d& box, double resolution_m) {
     throw std::invalid_argument("the hull's resolution_m must be positive and finite");
   }
   for (int depth = 2; depth <= limits::kMaxHullDepth; ++depth) {
-    if (resolution_m * ((1 << depth) - 3) >= longest_m) return cubeAt(box, depth, resolution_m);
+    if (resolution_m * ((1 << depth) - 3) < longest_m) continue;
+    const HullCube cube = cubeAt(box, depth, resolution_m);
+    if (!std::isfinite(cube.edge_m()) || !cube.origin_W().allFinite()) {
+      std::ostringstream why;
+      why << "resolution_m " << resolution_m << " m is too large: the octree's cube of "
+          << (1 << depth) << " cells would have no finite edge";
+      throw std::invalid_argument(why.str());
+    }
+    return cube;
   }
   std::ostringstream why;
   why << "resolution_m " << resolution_m << " m needs an octree deeper than "
