@@ -107,7 +107,7 @@ HullStream::Outcome HullStream::add(const std::string& name, const PinholeCamera
 HullView HullStream::viewOf(const std::string& name, const PinholeCamera& camera,
                             const cv::Mat& mask) const {
   if (!hull_) return HullView(name, camera, mask, config_.hull);
-  const int reduction = distanceReduction(camera, mask.size(), hull_->cube().box(), config_.hull);
+  const int reduction = distanceReduction(camera, mask.size(), box_, config_.hull);
   if (reduction == 1) return HullView(name, camera, mask, config_.hull);
   return HullView(name, camera, RunLengthMask(mask), config_.hull, reduction);
 }
@@ -165,13 +165,13 @@ void HullStream::refitBox() {
   } catch (const std::exception&) {
     return;  // the LP over the taken views failed: keep the box it had
   }
-  const double cell_m = HullCube::forConfig(tighter, config_.hull).resolution_m;
-  if ((tighter.min_W - box_.min_W).maxCoeff() <= cell_m &&
-      (box_.max_W - tighter.max_W).maxCoeff() <= cell_m) {
-    return;
-  }
   std::unique_ptr<VisualHull> refitted;
   try {
+    const double cell_m = HullCube::forConfig(tighter, config_.hull).resolution_m;
+    if ((tighter.min_W - box_.min_W).maxCoeff() <= cell_m &&
+        (box_.max_W - tighter.max_W).maxCoeff() <= cell_m) {
+      return;
+    }
     refitted = std::make_unique<VisualHull>(tighter, config_.hull);
     refitted->addViews(hull_->views());
   } catch (const std::exception&) {
