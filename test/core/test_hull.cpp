@@ -8,6 +8,7 @@
 #include <array>
 #include <cmath>
 #include <sstream>
+#include <tuple>
 
 #include "common/test_data.h"
 #include "sift_hull/eval/hull_evaluation.h"
@@ -299,10 +300,15 @@ std::vector<std::array<double, 3>> sortedCentres(const std::vector<Eigen::Vector
 }
 
 TEST(CompactOctomap, IsToOctomapsMapByteForByteAndLeafForLeaf) {
-  for (const auto& [shape, depth_levels] :
-       {std::pair<const char*, int>{"sphere", 5}, {"sculpture", 6}, {"sculpture", 7}}) {
-    const HullResult result =
-        buildHull(test::sceneHullInput(shape, 8, "ring"), depth(depth_levels));
+  // Depth 6 and 7 on two threads write the subtrees in parallel, on one thread in one walk.
+  for (const auto& [shape, depth_levels, threads] :
+       {std::tuple<const char*, int, int>{"sphere", 5, 2},
+        {"sculpture", 6, 2},
+        {"sculpture", 7, 2},
+        {"sculpture", 7, 1}}) {
+    HullConfig config = depth(depth_levels);
+    config.threads = threads;
+    const HullResult result = buildHull(test::sceneHullInput(shape, 8, "ring"), config);
     const std::unique_ptr<octomap::OcTree> tree = toOctomap(result.hull);
     std::stringstream reference;
     writeOctomapBinaryData(*tree, reference);
