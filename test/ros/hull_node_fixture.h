@@ -26,15 +26,18 @@ namespace test {
 
 constexpr int kViews = 8;
 
-inline std::vector<RenderedView> sphereViews() {
+/// The hull rostests' scene: kViews views of the sphere from around it, 320x240.
+inline SceneConfig sphereSceneConfig() {
   SceneConfig config;
   config.shape = "sphere";
   config.views = kViews;
   config.layout = "sphere";
   config.width_px = 320;
   config.height_px = 240;
-  return renderScene(config);
+  return config;
 }
+
+inline std::vector<RenderedView> sphereViews() { return renderScene(sphereSceneConfig()); }
 
 inline std::string frameOf(int view) { return "camera_" + std::to_string(view); }
 

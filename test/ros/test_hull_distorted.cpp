@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "common/octomap_volume.h"
+#include "hull_node_fixture.h"
 #include "lib/conversions.h"
 #include "ros_wait.h"
 #include "sift_hull/Octomap.h"
@@ -31,19 +32,14 @@
 namespace sift_hull {
 namespace {
 
+using test::kViews;
 using test::occupiedVolume;
 using test::waitFor;
 
-constexpr int kViews = 8;
 constexpr int kMaxDepth = 7;  // hull_distorted.test's ~max_depth
 
 SceneConfig sceneConfig(const LensDistortion& distortion) {
-  SceneConfig config;
-  config.shape = "sphere";
-  config.views = kViews;
-  config.layout = "sphere";
-  config.width_px = 320;
-  config.height_px = 240;
+  SceneConfig config = test::sphereSceneConfig();
   config.fill_fraction = 0.9;  // the outline far from the centre, where the lens bends most
   config.distortion = distortion;
   return config;
