@@ -35,8 +35,7 @@ std_msgs::Header header() {
 }
 
 void expectHeader(const std_msgs::Header& h) {
-  EXPECT_EQ(h.frame_id, "hull_world");
-  EXPECT_EQ(h.stamp, ros::Time(1234, 567890));
+  EXPECT_TRUE(h.frame_id == "hull_world" && h.stamp == ros::Time(1234, 567890)) << h;
 }
 
 // ---- camera from camera_info ------------------------------------------------------------------
@@ -205,9 +204,8 @@ TEST(MaskFromImage, RefusesShortRowsOrDataOtherEncodingsAndEmptyOrOversizedImage
   message.data.pop_back();  // step x height - 1: the last row's padding is required too
   EXPECT_TRUE(has(maskRefusal(message), "(23 bytes, step 8) does not hold 5x3"));
   for (const char* encoding : {"rgb8", "bgr8", "mono16", "8UC3", "32FC1", ""}) {
-    EXPECT_EQ(maskRefusal(image(5, 3, 16, encoding)), "silhouette encoding is '" +
-                                                          std::string(encoding) +
-                                                          "', expected mono8 (or 8UC1)");
+    EXPECT_EQ(maskRefusal(image(5, 3, 16, encoding)),
+              "silhouette encoding is '" + std::string(encoding) + "', expected mono8 (or 8UC1)");
   }
   EXPECT_EQ(maskRefusal(image(5, 3, 16, "8UC1")), "accepted") << "cv_bridge's uint8 default";
   EXPECT_EQ(maskRefusal(image(0, 3, 0)), "silhouette: the image is empty (0x3)");
@@ -331,10 +329,15 @@ TEST(OctomapMessage, HandBuiltTreeReadsBackWithItsLeavesAndGivesACentreEachInClo
     EXPECT_EQ(std::count_if(points.begin(), points.end(), near), 1) << e.transpose();
   }
   const visualization_msgs::MarkerArray markers = rc::occupiedCellsMarkers(hand.tree, header());
-  ASSERT_EQ(markers.markers.size(), 2u);  // one per leaf size
-  for (const visualization_msgs::Marker& m : markers.markers) {
+  ASSERT_EQ(markers.markers.size(), hand.tree.getTreeDepth() + 1u);  // one per depth level
+  using visualization_msgs::Marker;
+  const auto added = [](const Marker& m) { return m.action == Marker::ADD; };
+  EXPECT_EQ(std::count_if(markers.markers.begin(), markers.markers.end(), added), 2);
+  for (const Marker& m : markers.markers) {
     expectHeader(m.header);
-    EXPECT_TRUE(m.ns == "occupied_cells" && m.type == visualization_msgs::Marker::CUBE_LIST);
+    EXPECT_TRUE(m.ns == "occupied_cells" && m.type == Marker::CUBE_LIST);
+    EXPECT_EQ(m.action, m.points.empty() ? +Marker::DELETE : +Marker::ADD);
+    if (m.points.empty()) continue;
     EXPECT_EQ(m.colors.size(), m.points.size());
     EXPECT_EQ(m.points.size(), m.scale.x > 1.5 * kRes ? 1u : 27u);
     EXPECT_NEAR(m.scale.x, m.points.size() == 1 ? 2 * kRes : kRes, 1e-9);

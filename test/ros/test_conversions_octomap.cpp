@@ -105,7 +105,7 @@ TEST(OctreeFromMessage, RefusesOtherTreesBadResolutionsAndCutData) {
   EXPECT_THROW(rc::octreeFromMessage(cut), std::invalid_argument);
 }
 
-TEST(FreeCellsMarkers, OneCubeListPerLeafSizeOfTheFreeLeavesOnly) {
+TEST(FreeCellsMarkers, OneCubeListPerDepthLevelOfTheFreeLeavesOnlyTheEmptyLevelsDeleted) {
   MixedTree mixed;
   // An aligned 2x2x2 block of free voxels at x, y, z in [-0.4, -0.2): one leaf of twice the size.
   for (int c = 0; c < 8; ++c) {
@@ -114,11 +114,19 @@ TEST(FreeCellsMarkers, OneCubeListPerLeafSizeOfTheFreeLeavesOnly) {
   }
   mixed.tree.prune();
   const visualization_msgs::MarkerArray markers = rc::freeCellsMarkers(mixed.tree, mapHeader());
-  ASSERT_EQ(markers.markers.size(), 2u);
+  ASSERT_EQ(markers.markers.size(), mixed.tree.getTreeDepth() + 1u);
   double volume_m3 = 0.0;
-  for (const visualization_msgs::Marker& m : markers.markers) {
+  size_t added = 0;
+  for (size_t level = 0; level < markers.markers.size(); ++level) {
+    const visualization_msgs::Marker& m = markers.markers[level];
+    EXPECT_EQ(m.id, static_cast<int>(level));
+    EXPECT_NEAR(m.scale.x, mixed.tree.getNodeSize(static_cast<unsigned>(level)), 1e-12);
+    EXPECT_EQ(m.action, m.points.empty() ? visualization_msgs::Marker::DELETE
+                                         : visualization_msgs::Marker::ADD);
     EXPECT_TRUE(m.ns == "free_cells" && m.type == visualization_msgs::Marker::CUBE_LIST);
     EXPECT_EQ(m.header.frame_id, "map");
+    if (m.points.empty()) continue;
+    ++added;
     EXPECT_EQ(m.points.size(), m.scale.x > 1.5 * kRes ? 1u : 6u);
     EXPECT_TRUE(m.color.b == 1.0f && m.color.a == 1.0f && m.color.r == 0.0f);
     for (const geometry_msgs::Point& p : m.points) {
@@ -127,6 +135,7 @@ TEST(FreeCellsMarkers, OneCubeListPerLeafSizeOfTheFreeLeavesOnly) {
     volume_m3 += m.points.size() * std::pow(m.scale.x, 3);
   }
   EXPECT_NEAR(volume_m3, 14 * std::pow(kRes, 3), 1e-12);
+  EXPECT_EQ(added, 2u);  // the block's leaf and the single voxels
   EXPECT_EQ(rc::occupiedCellsMarkers(mixed.tree, mapHeader()).markers.front().ns, "occupied_cells");
 }
 

@@ -145,8 +145,9 @@ sensor_msgs::PointCloud2 pointCloudMessage(const std::vector<Eigen::Vector3d>& p
 sensor_msgs::PointCloud2 occupiedCellsCloud(const octomap::OcTree& tree,
                                             const std_msgs::Header& header);
 
-/// Occupied leaves as CUBE_LIST markers, one per leaf size (octomap_server's
-/// occupied_cells_vis_array), coloured by height.
+/// Occupied leaves as CUBE_LIST markers, one per depth level 0..tree depth with id = level
+/// (octomap_server's occupied_cells_vis_array), coloured by height; a level without occupied
+/// leaves has action DELETE, so rviz drops what it showed there.
 visualization_msgs::MarkerArray occupiedCellsMarkers(const octomap::OcTree& tree,
                                                      const std_msgs::Header& header);
 
@@ -154,8 +155,8 @@ visualization_msgs::MarkerArray occupiedCellsMarkers(const octomap::OcTree& tree
 /// not checked (isValidClearBox checks it).
 Box3d boxFromCorners(const geometry_msgs::Point& min, const geometry_msgs::Point& max);
 
-/// Free leaves as CUBE_LIST markers, one per leaf size (octomap_server's free_cells_vis_array),
-/// blue, in namespace "free_cells".
+/// Free leaves as CUBE_LIST markers, one per depth level as occupiedCellsMarkers (octomap_server's
+/// free_cells_vis_array), blue, in namespace "free_cells".
 visualization_msgs::MarkerArray freeCellsMarkers(const octomap::OcTree& tree,
                                                  const std_msgs::Header& header);
 

@@ -7,7 +7,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -109,8 +108,10 @@ std_msgs::ColorRGBA heightColour(double fraction) {
   return colour;
 }
 
-/// One CUBE_LIST per leaf size of the occupied (or free) leaves, in namespace `ns`; occupied
-/// ones coloured by height, free ones all `free_colour`.
+/// octomap_server's layout: one CUBE_LIST per depth level 0..tree depth (id = level), in
+/// namespace `ns`, of the occupied (or free) leaves at that level; a level without such leaves is
+/// sent with action DELETE so rviz drops what it showed there before (after a re-root or a reset).
+/// Occupied cells are coloured by height, free ones all `freeColour()`.
 visualization_msgs::MarkerArray cellsMarkers(const octomap::OcTree& tree,
                                              const std_msgs::Header& header, bool occupied,
                                              const std::string& ns) {
@@ -118,26 +119,28 @@ visualization_msgs::MarkerArray cellsMarkers(const octomap::OcTree& tree,
   tree.getMetricMin(min_x, min_y, min_z);
   tree.getMetricMax(max_x, max_y, max_z);
   const double height = std::max(max_z - min_z, 1e-9);
-  std::map<unsigned, visualization_msgs::Marker> by_depth;
+  visualization_msgs::MarkerArray array;
+  array.markers.resize(static_cast<size_t>(tree.getTreeDepth()) + 1);
   for (auto leaf = tree.begin_leafs(); leaf != tree.end_leafs(); ++leaf) {
     if (tree.isNodeOccupied(*leaf) != occupied) continue;
-    visualization_msgs::Marker& marker = by_depth[leaf.getDepth()];
+    visualization_msgs::Marker& marker = array.markers.at(leaf.getDepth());
     geometry_msgs::Point centre;
     centre.x = leaf.getX(), centre.y = leaf.getY(), centre.z = leaf.getZ();
     marker.points.push_back(centre);
     if (occupied) marker.colors.push_back(heightColour((centre.z - min_z) / height));
-    marker.scale.x = marker.scale.y = marker.scale.z = leaf.getSize();
   }
-  visualization_msgs::MarkerArray array;
-  for (auto& [depth, marker] : by_depth) {
+  for (size_t depth = 0; depth < array.markers.size(); ++depth) {
+    visualization_msgs::Marker& marker = array.markers[depth];
     marker.header = header;
     marker.ns = ns;
     marker.id = static_cast<int>(depth);
     marker.type = visualization_msgs::Marker::CUBE_LIST;
-    marker.action = visualization_msgs::Marker::ADD;
+    marker.action = marker.points.empty() ? visualization_msgs::Marker::DELETE
+                                          : visualization_msgs::Marker::ADD;
+    marker.scale.x = marker.scale.y = marker.scale.z =
+        tree.getNodeSize(static_cast<unsigned>(depth));
     marker.pose.orientation.w = 1.0;
     if (!occupied) marker.color = freeColour();
-    array.markers.push_back(marker);
   }
   return array;
 }
