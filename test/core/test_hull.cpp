@@ -328,6 +328,8 @@ TEST(CompactOctomap, IsToOctomapsMapByteForByteAndLeafForLeaf) {
     for (size_t i = 0; i < actual.size(); ++i) {
       for (int a = 0; a < 3; ++a) ASSERT_NEAR(actual[i][a], expected[i][a], 1e-9) << i;
     }
+    const CompactOctomap without = compactOctomap(result.hull, false);  // no centres wanted
+    EXPECT_TRUE(without.binary_data == compact.binary_data && without.occupied_centres_W.empty());
   }
 }
 

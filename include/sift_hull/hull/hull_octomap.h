@@ -24,13 +24,14 @@ std::unique_ptr<octomap::OcTree> toOctomap(const VisualHull& hull);
 /// toOctomap's map without OctoMap's nodes, for what is published per view: the same pruned tree
 /// built in an array of its own (several times faster). `binary_data` equals
 /// writeOctomapBinaryData(*toOctomap(hull)) byte for byte; `occupied_centres_W` are that tree's
-/// occupied leaves' centres (any order). Throws as toOctomap.
+/// occupied leaves' centres (any order), left empty unless `occupied_centres`. Throws as
+/// toOctomap.
 struct CompactOctomap {
   double resolution_m = 0.0;
   std::string binary_data;
   std::vector<Eigen::Vector3d> occupied_centres_W;
 };
-CompactOctomap compactOctomap(const VisualHull& hull);
+CompactOctomap compactOctomap(const VisualHull& hull, bool occupied_centres = true);
 
 /// Whether a box (metres) can be cleared: finite, min <= max on each axis.
 bool isValidClearBox(const Box3d& box_W);

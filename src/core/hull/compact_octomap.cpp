@@ -46,11 +46,12 @@ constexpr int kMinParallelDepth = 6;
 
 class OctomapWriter {
  public:
-  OctomapWriter(const VisualHull& hull, CompactOctomap* map)
+  OctomapWriter(const VisualHull& hull, bool centres, CompactOctomap* map)
       : root_(&hull.rootNode()),
         depth_(hull.cube().depth),
         threads_(hull.config().threads),
         origin_key_(hull.cube().origin_voxels + Eigen::Vector3i::Constant(kKeyOffset)),
+        centres_(centres),
         map_(map) {
     toKeys({hull.cube().origin_voxels, 1 << depth_});  // throws beyond OctoMap's key range
     tabulateLevels();
@@ -234,7 +235,7 @@ class OctomapWriter {
     }
     out->binary_data[start] = static_cast<char>(halves[0]);
     out->binary_data[start + 1] = static_cast<char>(halves[1]);
-    for (unsigned int c = 0; c < 8; ++c) {
+    for (unsigned int c = 0; c < 8 && centres_; ++c) {
       if (codes[c] == kOccupied) addCentre(level + 1, childKey(min_key, edge, c), out);
     }
     return kInner;
@@ -258,6 +259,7 @@ class OctomapWriter {
   const int depth_;
   const int threads_;
   const Eigen::Vector3i origin_key_;  ///< the key of the cube's first voxel
+  const bool centres_;                ///< whether the occupied leaves' centres are wanted
   CompactOctomap* map_;
   Stage stage_ = Stage::kJoin;
   int split_level_ = -1;  ///< none: written in one walk
@@ -270,10 +272,10 @@ class OctomapWriter {
 
 }  // namespace
 
-CompactOctomap compactOctomap(const VisualHull& hull) {
+CompactOctomap compactOctomap(const VisualHull& hull, bool occupied_centres) {
   CompactOctomap map;
   map.resolution_m = hull.cube().resolution_m;
-  OctomapWriter(hull, &map).write();
+  OctomapWriter(hull, occupied_centres, &map).write();
   return map;
 }
 

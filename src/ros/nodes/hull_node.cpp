@@ -45,8 +45,14 @@ HullNode::HullNode(ros::NodeHandle nh, ros::NodeHandle private_nh, HullNodeConfi
       octomap_full_pub_(nh_.advertise<sift_hull::Octomap>(
           "octomap_full", 1, [this](const ros::SingleSubscriberPublisher&) { publishFullNow(); },
           ros::SubscriberStatusCallback(), ros::VoidConstPtr(), true)),
-      cloud_pub_(nh_.advertise<sensor_msgs::PointCloud2>("occupied_cells", 1, true)),
-      centers_pub_(nh_.advertise<sensor_msgs::PointCloud2>("octomap_point_cloud_centers", 1, true)),
+      cloud_pub_(nh_.advertise<sensor_msgs::PointCloud2>(
+          "occupied_cells", 1,
+          [this](const ros::SingleSubscriberPublisher&) { publishCentresNow(&cloud_pub_); },
+          ros::SubscriberStatusCallback(), ros::VoidConstPtr(), true)),
+      centers_pub_(nh_.advertise<sensor_msgs::PointCloud2>(
+          "octomap_point_cloud_centers", 1,
+          [this](const ros::SingleSubscriberPublisher&) { publishCentresNow(&centers_pub_); },
+          ros::SubscriberStatusCallback(), ros::VoidConstPtr(), true)),
       markers_pub_(nh_.advertise<visualization_msgs::MarkerArray>(
           "occupied_cells_vis_array", 1,
           [this](const ros::SingleSubscriberPublisher&) { publishMarkersNow(); },

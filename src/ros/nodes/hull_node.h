@@ -114,6 +114,8 @@ class HullNode {
   void publishMarkersNow();
   void publishFreeMarkersNow();
   void publishMeshNow();
+  /// The current centres cloud on `pub` (occupied_cells or octomap_point_cloud_centers).
+  void publishCentresNow(ros::Publisher* pub);
   void publishEmpty(double resolution_m);
   /// The published hull's mesh (marching cubes once per hull, shared by `mesh`, new subscribers
   /// and ~save). Requires published_.

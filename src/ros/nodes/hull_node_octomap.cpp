@@ -72,18 +72,21 @@ const octomap::OcTree& HullNode::publishedTree() {
   return *octree_;
 }
 
-/// octomap_binary and the centres clouds every time (latched: a later subscriber must not get an
-/// older map), from the compact map (no OctoMap nodes) unless boxes were cleared; the full map and
-/// the markers, which need OctoMap's tree, only while someone subscribes.
+/// octomap_binary every time (latched: a later subscriber must not get an older map), from the
+/// compact map (no OctoMap nodes) unless boxes were cleared; the centres clouds, the full map and
+/// the markers only while someone subscribes (a new subscriber is sent the current one at once).
 void HullNode::publishMaps() {
+  const bool centres = cloud_pub_.getNumSubscribers() > 0 || centers_pub_.getNumSubscribers() > 0;
   if (cleared_boxes_.empty()) {
-    const CompactOctomap map = compactOctomap(stream_.hull());
+    const CompactOctomap map = compactOctomap(stream_.hull(), centres);
     octomap_pub_.publish(ros_conversions::octomapMessage(map, header_));
-    publishCentres(ros_conversions::pointCloudMessage(map.occupied_centres_W, header_));
+    if (centres) {
+      publishCentres(ros_conversions::pointCloudMessage(map.occupied_centres_W, header_));
+    }
   } else {
     const octomap::OcTree& tree = publishedTree();
     octomap_pub_.publish(ros_conversions::octomapMessage(tree, header_));
-    publishCentres(ros_conversions::occupiedCellsCloud(tree, header_));
+    if (centres) publishCentres(ros_conversions::occupiedCellsCloud(tree, header_));
   }
   if (octomap_full_pub_.getNumSubscribers() > 0) {  // its data is about 10 times the binary's
     octomap_full_pub_.publish(ros_conversions::octomapFullMessage(publishedTree(), header_));
@@ -114,6 +117,11 @@ void HullNode::sendToNewSubscriber(const std::function<void()>& send) {
   } catch (const std::exception& e) {  // e.g. a hull beyond OctoMap's key range
     log_.error("hull: cannot publish the hull: ", e.what());
   }
+}
+
+void HullNode::publishCentresNow(ros::Publisher* pub) {
+  sendToNewSubscriber(
+      [this, pub] { pub->publish(ros_conversions::occupiedCellsCloud(publishedTree(), header_)); });
 }
 
 void HullNode::publishMarkersNow() {
