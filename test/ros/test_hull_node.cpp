@@ -17,6 +17,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <iostream>
 #include <mutex>
 #include <sstream>
 
@@ -41,6 +42,7 @@ using test::kDeadline_s;
 using test::kViews;
 using test::occupiedVolume;
 using test::waitFor;
+namespace rc = ros_conversions;
 
 TEST_F(HullNodeTest, CarvesTheSphereResetsAndSurvivesBadInput) {
   ros::Time last;
@@ -172,6 +174,67 @@ TEST_F(HullFromImageTest, ExtractsSilhouettesFromImagesAndCarves) {
   // The Middlebury recipe on the rendered images gives close to the rendered masks' hull.
   const double sphere_m3 = 4.0 / 3.0 * M_PI * std::pow(0.8, 3);
   EXPECT_NEAR(occupiedVolume(*last_octomap_), sphere_m3, 0.3 * sphere_m3);
+}
+
+/// A stream faster than the node carves at depth 8: 300 views from 300 viewpoints at 100 Hz,
+/// `~queue_size` large enough to hold them all (hull_sustained.test), so the queue does not drain
+/// until the stream ends. The map must still be published while the views come (at least every
+/// second, kMaxPublishDelay_s), and once they are all carved it is the offline hull of all of them.
+TEST(HullSustainedTest, PublishesWhileAFasterStreamLastsAndEndsWithTheHullOfAllViews) {
+  ros::NodeHandle nh;
+  SceneConfig scene = test::sphereSceneConfig();
+  scene.views = 300;
+  const std::vector<RenderedView> views = renderScene(scene);
+  tf2_ros::StaticTransformBroadcaster tf;
+  std::vector<geometry_msgs::TransformStamped> poses;
+  for (size_t v = 0; v < views.size(); ++v) {
+    poses.push_back(ros_conversions::cameraPoseMessage(views[v].view.camera, "world",
+                                                       frameOf(static_cast<int>(v)), {}));
+  }
+  tf.sendTransform(poses);
+  ros::Publisher silhouette_pub = nh.advertise<sensor_msgs::Image>("silhouette", 400);
+  ros::Publisher info_pub = nh.advertise<sensor_msgs::CameraInfo>("camera_info", 400);
+  std::vector<std::pair<ros::WallTime, sift_hull::OctomapConstPtr>> maps;
+  ros::Subscriber sub = nh.subscribe<sift_hull::Octomap>(
+      "octomap_binary", 400,
+      [&](const sift_hull::OctomapConstPtr& m) { maps.emplace_back(ros::WallTime::now(), m); });
+  ASSERT_TRUE(waitFor([&] {
+    return silhouette_pub.getNumSubscribers() > 0 && info_pub.getNumSubscribers() > 0 &&
+           sub.getNumPublishers() > 0;
+  }));
+  ros::WallDuration(0.5).sleep();
+  ros::spinOnce();
+  maps.clear();  // the empty latched map
+  const ros::WallTime start = ros::WallTime::now();
+  ros::Time last;
+  for (size_t v = 0; v < views.size(); ++v) {
+    std_msgs::Header header;
+    header.stamp = last = ros::Time::now();
+    header.frame_id = frameOf(static_cast<int>(v));
+    info_pub.publish(
+        ros_conversions::cameraInfoMessage(views[v].view.camera, views[v].mask.size(), header));
+    silhouette_pub.publish(ros_conversions::imageMessage(views[v].mask, header));
+    ros::spinOnce();
+    (start + ros::WallDuration(0.01 * (v + 1)) - ros::WallTime::now()).sleep();
+  }
+  const ros::WallTime end = ros::WallTime::now();
+  const size_t during = maps.size();
+  ASSERT_TRUE(
+      waitFor([&] { return !maps.empty() && maps.back().second->header.stamp == last; }, 120.0))
+      << "the last view's map did not come";
+  std::cout << "sustained: " << views.size() << " views in " << (end - start).toSec() << " s, "
+            << during << " maps while they came, " << maps.size() << " in all\n";
+  // While the views came (3 s): the first view's map, then at least one a second later.
+  EXPECT_GE(during, 2u) << "published " << during << " times in " << (end - start).toSec() << " s";
+  EXPECT_LT(during, views.size() / 2) << "the queue drained: the stream did not outpace carving";
+  HullConfig config;
+  config.max_depth = 8;
+  const HullResult offline = buildHull(hullInputOf(views), config);
+  const sift_hull::Octomap& final_map = *maps.back().second;
+  EXPECT_NEAR(final_map.resolution, offline.hull.cube().resolution_m,
+              0.02 * offline.hull.cube().resolution_m);
+  const double offline_m3 = occupiedVolume(rc::octomapMessage(*toOctomap(offline.hull), {}));
+  EXPECT_NEAR(occupiedVolume(final_map), offline_m3, 0.02 * offline_m3);
 }
 
 }  // namespace
