@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# Installs what is missing, builds, and runs every gtest and rostest of sift_hull, then the core
-# gtests again under AddressSanitizer + UndefinedBehaviorSanitizer (scripts/sanitize.sh) and each
-# libFuzzer harness for 30 s (scripts/fuzz.sh); docs/RELIABILITY.md says more.
+# Installs what is missing, builds, runs every gtest and rostest of sift_hull, checks the install
+# space (scripts/install_check.sh), then runs the core gtests again under AddressSanitizer +
+# UndefinedBehaviorSanitizer (scripts/sanitize.sh) and each libFuzzer harness for 30 s
+# (scripts/fuzz.sh); docs/RELIABILITY.md says more.
 # The last line is 'N passed, N failed, N skipped' over all of them; the exit code is non-zero on
 # any failure. SIFT_HULL_SANITIZE=0 leaves the sanitizer and fuzz runs out (a quicker local run);
 # SIFT_HULL_FUZZ_SECONDS sets the fuzzing time per harness (default 30).
@@ -26,6 +27,8 @@ if ! catkin_make run_tests -j"$(nproc)" >"$log" 2>&1; then
   echo "0 passed, 1 failed"
   exit 1
 fi
+echo "install space (scripts/install_check.sh) ..."
+bash "$here/install_check.sh" build/test_results/install || true
 if [[ "${SIFT_HULL_SANITIZE:-1}" != 0 ]]; then
   # Each writes JUnit XML under build/test_results, counted below with the rest; a failure there
   # is a failed case, so the scripts' own exit codes need not stop this one.
