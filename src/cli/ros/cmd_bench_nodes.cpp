@@ -63,20 +63,19 @@ nlohmann::json targetsJson(const std::vector<MatcherRun>& matcher,
         std::max(worst_resolution, std::abs(r.resolution_m / r.cli_resolution_m - 1.0));
     dropped += r.rate_dropped;
   }
-  return {
-      {"matcher_pairs_per_s>=10", {{"measured", best_rate}, {"met", best_rate >= 10.0}}},
-      {"hull_view_to_octomap_depth8_median_ms<=50",
-       {{"measured_ms", worst_latency}, {"met", worst_latency <= 50.0}}},
-      {"hull_resolution_within_2%_of_cli",
-       {{"measured", worst_resolution}, {"met", worst_resolution <= 0.02}}},
-      {"hull_views_dropped_at_10_hz==0", {{"measured", dropped}, {"met", dropped == 0.0}}}};
+  return {{"matcher_pairs_per_s>=10", {{"measured", best_rate}, {"met", best_rate >= 10.0}}},
+          {"hull_view_to_octomap_depth8_median_ms<=50",
+           {{"measured_ms", worst_latency}, {"met", worst_latency <= 50.0}}},
+          {"hull_resolution_within_2%_of_cli",
+           {{"measured", worst_resolution}, {"met", worst_resolution <= 0.02}}},
+          {"hull_views_dropped_at_10_hz==0", {{"measured", dropped}, {"met", dropped == 0.0}}}};
 }
 
 std::string markdownReport(const std::vector<MatcherRun>& matcher,
                            const std::vector<HullRun>& hulls, const nlohmann::json& targets) {
   std::ostringstream out;
   out << "Written by `sift_hull_ros bench-nodes --write docs/BENCHMARKS.md` on " << todayUtc()
-      << ", " << std::thread::hardware_concurrency()
+      << ", CPU " << cpuModel() << " (/proc/cpuinfo), " << std::thread::hardware_concurrency()
       << " hardware threads. The nodes run as processes "
       << "of their own against a ROS master of their own; this program publishes their input and "
       << "subscribes their output over TCP, as `rosbag play` and rviz would.\n\n"
@@ -95,8 +94,9 @@ std::string markdownReport(const std::vector<MatcherRun>& matcher,
   }
   out << "\nHull node, one view at a time (the next sent once /diagnostics counts the view "
       << "processed). Medians over the views that refine an existing hull: carving (`HullStream` "
-      << "add), publishing (OctoMap conversion, octomap_binary and the centres cloud; octomap_full "
-         "and the markers only when subscribed), and the "
+      << "add), publishing (OctoMap conversion and octomap_binary, the one output this program "
+         "subscribes; the centres clouds, octomap_full and the markers are built only when "
+         "subscribed), and the "
       << "latency from sending a view to receiving its octomap; the node's finest cell edge "
          "against `sift_hull hull`'s at the same depth on the same views. Then, after a "
          "`~reset`, the views once each at 10 Hz (views dropped, latency). Then the same views "
@@ -161,7 +161,9 @@ int runBenchNodes(const std::vector<std::string>& args) {
   spinner.stop();
   ros::shutdown();
 
-  nlohmann::json json = {{"matcher", nlohmann::json::array()},
+  nlohmann::json json = {{"cpu", cpuModel()},
+                         {"hardware_threads", std::thread::hardware_concurrency()},
+                         {"matcher", nlohmann::json::array()},
                          {"hull", nlohmann::json::array()},
                          {"targets", targetsJson(matcher, hulls)}};
   for (const MatcherRun& r : matcher) json["matcher"].push_back(matcherJson(r));
