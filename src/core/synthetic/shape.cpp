@@ -88,6 +88,39 @@ bool hitTorus(const LocalRay& ray, double major, double minor, double* distance,
   return false;
 }
 
+/// Where a ray is inside a sphere or a box: [enter, leave] with the outward normals there (world
+/// frame); false when it misses.
+bool primitiveInterval(const Primitive& part, const Eigen::Vector3d& origin,
+                       const Eigen::Vector3d& direction, double* enter, double* leave,
+                       Eigen::Vector3d* enter_normal_W, Eigen::Vector3d* leave_normal_W) {
+  const LocalRay ray = toLocal(part, origin, direction);
+  if (part.type == Primitive::Type::kSphere) {
+    if (!sphereInterval(ray, part.size_m.x(), enter, leave)) return false;
+    *enter_normal_W = part.R_W_P * (ray.origin + *enter * ray.direction) / part.size_m.x();
+    *leave_normal_W = part.R_W_P * (ray.origin + *leave * ray.direction) / part.size_m.x();
+    return true;
+  }
+  *enter = -std::numeric_limits<double>::infinity();
+  *leave = std::numeric_limits<double>::infinity();
+  int enter_axis = 0, leave_axis = 0;
+  for (int axis = 0; axis < 3; ++axis) {
+    const double inverse = 1.0 / ray.direction[axis];
+    double near = (-part.size_m[axis] - ray.origin[axis]) * inverse;
+    double far = (part.size_m[axis] - ray.origin[axis]) * inverse;
+    if (near > far) std::swap(near, far);
+    if (std::isnan(near)) return false;
+    if (near > *enter) *enter = near, enter_axis = axis;
+    if (far < *leave) *leave = far, leave_axis = axis;
+  }
+  if (*enter > *leave || *leave <= 0.0) return false;
+  Eigen::Vector3d n_in = Eigen::Vector3d::Zero(), n_out = Eigen::Vector3d::Zero();
+  n_in[enter_axis] = ray.direction[enter_axis] > 0.0 ? -1.0 : 1.0;
+  n_out[leave_axis] = ray.direction[leave_axis] > 0.0 ? 1.0 : -1.0;
+  *enter_normal_W = part.R_W_P * n_in;
+  *leave_normal_W = part.R_W_P * n_out;
+  return true;
+}
+
 bool hitPrimitive(const Primitive& part, const Eigen::Vector3d& origin,
                   const Eigen::Vector3d& direction, RayHit* hit) {
   const LocalRay ray = toLocal(part, origin, direction);
@@ -179,17 +212,28 @@ double Primitive::boundingRadius() const {
 }
 
 Shape::Shape(std::vector<Primitive> parts) : parts_(std::move(parts)) {
-  if (parts_.empty()) throw std::invalid_argument("a shape needs at least one primitive");
+  const bool adds = std::any_of(parts_.begin(), parts_.end(), [](auto& p) { return !p.subtract; });
+  if (!adds) throw std::invalid_argument("a shape needs at least one primitive that adds");
+  for (const Primitive& p : parts_) {
+    if (hasCuts() && p.type == Primitive::Type::kTorus) {
+      throw std::invalid_argument("a shape with cuts takes spheres and boxes only");
+    }
+  }
   Eigen::Vector3d lo, hi;
   boundingBox(&lo, &hi);
   bounding_centre_ = 0.5 * (lo + hi);
   for (const Primitive& p : parts_) {
+    if (p.subtract) continue;
     bounding_radius_ = std::max(bounding_radius_, farthestDistance(p, bounding_centre_));
   }
 }
 
+bool Shape::hasCuts() const {
+  return std::any_of(parts_.begin(), parts_.end(), [](const Primitive& p) { return p.subtract; });
+}
+
 std::vector<std::string> Shape::names() {
-  return {"sculpture", "sphere", "box", "torus", "dumbbell"};
+  return {"sculpture", "sphere", "box", "torus", "dumbbell", "cup", "ublock"};
 }
 
 Shape Shape::byName(const std::string& name) {
@@ -212,16 +256,31 @@ Shape Shape::byName(const std::string& name) {
                   makePrimitive(T::kSphere, {0.05, 0, 0.05}, {0.42, 0, 0}),
                   makePrimitive(T::kTorus, {0.05, 0, 0.2}, {0.5, 0.14, 0}, rotation(1.3, y))});
   }
+  if (name == "cup") {  // walls 0.2 m, floor 0.3 m, a pocket 1.0 m wide and 0.9 m deep
+    Primitive pocket = makePrimitive(T::kBox, {0, 0, 0.2}, {0.5, 0.5, 0.5});
+    pocket.subtract = true;
+    return Shape({makePrimitive(T::kBox, {0, 0, 0}, {0.7, 0.7, 0.6}), pocket});
+  }
+  if (name == "ublock") {  // a groove 0.3 m wide and 0.5 m deep along the block's 1.8 m length
+    Primitive groove = makePrimitive(T::kBox, {0, 0, 0.25}, {0.15, 1.0, 0.3});
+    groove.subtract = true;
+    return Shape({makePrimitive(T::kBox, {0, 0, 0}, {0.6, 0.9, 0.45}), groove});
+  }
   throw std::invalid_argument("unknown shape '" + name + "'");
 }
 
 bool Shape::contains(const Eigen::Vector3d& X_W) const {
-  return std::any_of(parts_.begin(), parts_.end(),
-                     [&](const Primitive& p) { return p.contains(X_W); });
+  bool inside = false;
+  for (const Primitive& p : parts_) {
+    if (p.subtract && p.contains(X_W)) return false;
+    inside = inside || (!p.subtract && p.contains(X_W));
+  }
+  return inside;
 }
 
 bool Shape::firstHit(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
                      RayHit* hit) const {
+  if (hasCuts()) return firstHitWithCuts(origin, direction, hit);
   // The union's surface is first entered where the first part is entered, the origin being outside.
   bool found = false;
   for (const Primitive& part : parts_) {
@@ -235,10 +294,35 @@ bool Shape::firstHit(const Eigen::Vector3d& origin, const Eigen::Vector3d& direc
   return found;
 }
 
+/// The solid is entered where a part that adds is entered or a cut is left, at the first such
+/// place whose next point along the ray lies inside the solid.
+bool Shape::firstHitWithCuts(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction,
+                             RayHit* hit) const {
+  std::vector<RayHit> candidates;
+  for (const Primitive& part : parts_) {
+    double enter, leave;
+    Eigen::Vector3d n_enter, n_leave;
+    if (!primitiveInterval(part, origin, direction, &enter, &leave, &n_enter, &n_leave)) continue;
+    if (!part.subtract && enter > 0.0) candidates.push_back({enter, n_enter});
+    if (part.subtract && leave > 0.0) candidates.push_back({leave, -n_leave});
+  }
+  std::sort(candidates.begin(), candidates.end(),
+            [](const RayHit& a, const RayHit& b) { return a.distance_m < b.distance_m; });
+  const double step = 1e-9 * std::max(bounding_radius_, 1.0);
+  for (const RayHit& candidate : candidates) {
+    if (contains(origin + (candidate.distance_m + step) * direction)) {
+      *hit = candidate;
+      return true;
+    }
+  }
+  return false;
+}
+
 void Shape::boundingBox(Eigen::Vector3d* min_W, Eigen::Vector3d* max_W) const {
   *min_W = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   *max_W = -*min_W;
   for (const Primitive& p : parts_) {
+    if (p.subtract) continue;
     const Eigen::Vector3d half = halfExtents(p);
     *min_W = min_W->cwiseMin(p.centre_W - half);
     *max_W = max_W->cwiseMax(p.centre_W + half);
