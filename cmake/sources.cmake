@@ -31,6 +31,7 @@ set(SIFT_HULL_CORE_SOURCES
   src/core/hull/compact_octomap.cpp
   src/core/hull/hull_cube.cpp
   src/core/hull/octree.cpp
+  src/core/hull/free_carving.cpp
   src/core/hull/reduced_distance_map.cpp
   src/core/hull/run_length_mask.cpp
   src/core/hull/silhouette.cpp

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <unordered_set>
 #include <vector>
 
 #include "sift_hull/hull/bounding_box.h"
@@ -88,8 +89,21 @@ class VisualHull {
   void dropLastView();
   /// Whether nothing is occupied: no in cell and no surface cell whose centre is inside.
   bool isEmpty() const;
-  /// Back to one in cell and no views.
+  /// Back to one in cell, no views and no free voxels.
   void reset();
+
+  /// Free-space carving: finest voxels (indices in the cube, 0 .. 2^depth - 1 on each axis; others
+  /// are ignored) known to be empty, from lines of sight to surface points (src/core/refine).
+  /// They become out, and so does every voxel all of whose corners touch free voxels; the in
+  /// voxels next to them become finest surface cells, so that the mesh closes around the cavity
+  /// (mesh() polygonises f = max(f_iso, f_free), f_free > 0 at the corners of free voxels: the
+  /// mesh's cavity is the free voxels grown by a quarter of a voxel). The
+  /// result depends only on the views and the union of the voxels given, not on the order of the
+  /// calls: views added later carve the tree as they would have without free voxels.
+  void carveFree(const std::vector<Eigen::Vector3i>& voxels);
+  /// The free voxels so far (those given and those the closure added), in no particular order.
+  std::vector<Eigen::Vector3i> freeVoxels() const;
+  size_t freeVoxelCount() const { return free_.size(); }
 
   const HullCube& cube() const { return cube_; }
   const HullConfig& config() const { return config_; }
@@ -99,7 +113,8 @@ class VisualHull {
   HullStats stats() const;
   /// The leaf holding a world point (a point outside the cube is out).
   HullCell leafAt(const Eigen::Vector3d& X_W) const;
-  /// f_iso at a world point over all views (-kFarOutside_px without views).
+  /// f_iso at a world point over all views (-kFarOutside_px without views): the silhouettes'
+  /// field, free voxels aside.
   float valueAt(const Eigen::Vector3d& X_W) const;
   /// f_iso at many points, on config.threads threads.
   void sampleField(const std::vector<Eigen::Vector3d>& points_W, std::vector<float>* values) const;
@@ -120,6 +135,11 @@ class VisualHull {
   double frame_scale_;
   std::vector<HullView> views_;
   std::unique_ptr<detail::OctreeNode> root_;
+  std::unordered_set<uint64_t> free_;  ///< packed finest voxel indices (free_carving.cpp)
+
+  void applyFree(const std::vector<Eigen::Vector3i>& voxels);
+  /// f_free's part in mesh(): raises `values` at the corners of free voxels.
+  void addFreeField(const std::vector<Eigen::Vector3d>& points_W, std::vector<float>* values) const;
 };
 
 /// Occupied cells for maps: in cells of any size and surface cells at the finest level, each as

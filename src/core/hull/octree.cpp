@@ -157,7 +157,8 @@ class Refiner {
     if (verdict == Verdict::kUndecided && node.state == CellState::kIn) {
       node.state = CellState::kSurface;
       if (cell.depth == cube_.depth) return;
-      node.children = std::make_unique<OctreeNode[]>(8);
+      // Children may be there already: free-space carving splits in cells (free_carving.cpp).
+      if (!node.children) node.children = std::make_unique<OctreeNode[]>(8);
       updateChildren(node, cell, views_not_in);
     } else if (node.children) {
       updateChildren(node, cell, views_not_in);
@@ -288,14 +289,17 @@ void VisualHull::dropLastView() {
   if (views_.empty()) return;
   std::vector<HullView> others = std::move(views_);
   others.pop_back();
+  const std::vector<Eigen::Vector3i> free = freeVoxels();
   reset();
   addViews(std::move(others));
+  carveFree(free);
 }
 
 bool VisualHull::isEmpty() const { return !holdsOccupied(*root_); }
 
 void VisualHull::reset() {
   views_.clear();
+  free_.clear();
   root_ = std::make_unique<OctreeNode>();
 }
 
@@ -371,9 +375,11 @@ SurfaceCells VisualHull::surfaceCells() const {
 }
 
 TriangleMesh VisualHull::mesh() const {
-  return marchingCubes(surfaceCells(),
-                       [this](const std::vector<Eigen::Vector3d>& points,
-                              std::vector<float>* values) { sampleField(points, values); });
+  return marchingCubes(surfaceCells(), [this](const std::vector<Eigen::Vector3d>& points,
+                                              std::vector<float>* values) {
+    sampleField(points, values);
+    addFreeField(points, values);
+  });
 }
 
 std::vector<VoxelBlock> occupiedBlocks(const VisualHull& hull) {

@@ -1,0 +1,156 @@
+// Free-space carving of VisualHull's octree: finest voxels known to be empty (lines of sight to
+// surface points, src/core/refine) become out, with the closure and the surface cells around them
+// that keep the result independent of the order of views and voxels and the mesh closed.
+
+#include <array>
+#include <cmath>
+
+#include "hull/octree_node.h"
+#include "sift_hull/hull/octree.h"
+
+namespace sift_hull {
+namespace {
+
+using detail::OctreeNode;
+
+constexpr int kKeyBits = 21;  ///< per axis: limits::kMaxHullDepth is below this
+constexpr uint64_t kKeyMask = (uint64_t{1} << kKeyBits) - 1;
+/// f_free at the corners of free voxels, in the silhouettes' units (pixels); the corners next to
+/// them are held no lower than kWallField_px, so that marching cubes puts the cavity's wall a
+/// quarter of a voxel beyond the free voxels (1 / (1 + 3) of the edge).
+constexpr float kFreeField_px = 1.0f;
+constexpr float kWallField_px = -3.0f;
+
+uint64_t pack(const Eigen::Vector3i& v) {
+  return (static_cast<uint64_t>(v.x()) << (2 * kKeyBits)) |
+         (static_cast<uint64_t>(v.y()) << kKeyBits) | static_cast<uint64_t>(v.z());
+}
+
+Eigen::Vector3i unpack(uint64_t key) {
+  return {static_cast<int>(key >> (2 * kKeyBits)), static_cast<int>((key >> kKeyBits) & kKeyMask),
+          static_cast<int>(key & kKeyMask)};
+}
+
+bool inCube(const Eigen::Vector3i& v, int cells) {
+  return (v.array() >= 0).all() && (v.array() < cells).all();
+}
+
+/// The 26 neighbours' offsets.
+const std::array<Eigen::Vector3i, 26>& neighbourOffsets() {
+  static const std::array<Eigen::Vector3i, 26> offsets = [] {
+    std::array<Eigen::Vector3i, 26> list;
+    size_t n = 0;
+    for (int dz = -1; dz <= 1; ++dz) {
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          if (dx != 0 || dy != 0 || dz != 0) list[n++] = Eigen::Vector3i(dx, dy, dz);
+        }
+      }
+    }
+    return list;
+  }();
+  return offsets;
+}
+
+Eigen::Vector3i cornerOffset(int c) { return {c & 1, (c >> 1) & 1, (c >> 2) & 1}; }
+
+/// Whether a grid point (a voxel corner, in voxels from the cube's corner) touches a free voxel.
+bool cornerTouchesFree(const std::unordered_set<uint64_t>& free, const Eigen::Vector3i& corner,
+                       int cells) {
+  for (int c = 0; c < 8; ++c) {
+    const Eigen::Vector3i voxel = corner - cornerOffset(c);
+    if (inCube(voxel, cells) && free.count(pack(voxel)) > 0) return true;
+  }
+  return false;
+}
+
+/// The finest leaf of a voxel, splitting in leaves on the way (their children are in, as they
+/// are); nullptr when the voxel lies in an out cell.
+OctreeNode* finestLeaf(OctreeNode* root, const Eigen::Vector3i& voxel, int depth) {
+  OctreeNode* node = root;
+  for (int level = 0; level < depth; ++level) {
+    if (node->state == CellState::kOut) return nullptr;
+    if (!node->children) node->children = std::make_unique<OctreeNode[]>(8);
+    const int shift = depth - level - 1;
+    const int child = ((voxel.x() >> shift) & 1) | (((voxel.y() >> shift) & 1) << 1) |
+                      (((voxel.z() >> shift) & 1) << 2);
+    node = &node->children[child];
+  }
+  return node->state == CellState::kOut ? nullptr : node;
+}
+
+}  // namespace
+
+void VisualHull::carveFree(const std::vector<Eigen::Vector3i>& voxels) {
+  const int cells = 1 << cube_.depth;
+  std::vector<Eigen::Vector3i> added;
+  for (const Eigen::Vector3i& voxel : voxels) {
+    if (inCube(voxel, cells) && free_.insert(pack(voxel)).second) added.push_back(voxel);
+  }
+  // The closure: a voxel all of whose corners touch free voxels has f_free > 0 all over; it is
+  // free too. Adding it changes no corner's state, so the closure needs one pass.
+  const size_t given = added.size();
+  for (size_t i = 0; i < given; ++i) {
+    for (const Eigen::Vector3i& offset : neighbourOffsets()) {
+      const Eigen::Vector3i voxel = added[i] + offset;
+      if (!inCube(voxel, cells) || free_.count(pack(voxel)) > 0) continue;
+      bool enclosed = true;
+      for (int c = 0; c < 8 && enclosed; ++c) {
+        enclosed = cornerTouchesFree(free_, voxel + cornerOffset(c), cells);
+      }
+      if (enclosed && free_.insert(pack(voxel)).second) added.push_back(voxel);
+    }
+  }
+  applyFree(added);
+}
+
+void VisualHull::applyFree(const std::vector<Eigen::Vector3i>& voxels) {
+  const int cells = 1 << cube_.depth;
+  for (const Eigen::Vector3i& voxel : voxels) {
+    OctreeNode* leaf = finestLeaf(root_.get(), voxel, cube_.depth);
+    if (leaf != nullptr) leaf->state = CellState::kOut;
+  }
+  // Their in neighbours hold the cavity's wall: finest surface cells, for marching cubes.
+  for (const Eigen::Vector3i& voxel : voxels) {
+    for (const Eigen::Vector3i& offset : neighbourOffsets()) {
+      const Eigen::Vector3i neighbour = voxel + offset;
+      if (!inCube(neighbour, cells) || free_.count(pack(neighbour)) > 0) continue;
+      OctreeNode* leaf = finestLeaf(root_.get(), neighbour, cube_.depth);
+      if (leaf != nullptr) leaf->state = CellState::kSurface;
+    }
+  }
+}
+
+std::vector<Eigen::Vector3i> VisualHull::freeVoxels() const {
+  std::vector<Eigen::Vector3i> voxels;
+  voxels.reserve(free_.size());
+  for (const uint64_t key : free_) voxels.push_back(unpack(key));
+  return voxels;
+}
+
+void VisualHull::addFreeField(const std::vector<Eigen::Vector3d>& points_W,
+                              std::vector<float>* values) const {
+  if (free_.empty()) return;
+  const int cells = 1 << cube_.depth;
+  const Eigen::Vector3d origin_W = cube_.origin_W();
+  for (size_t i = 0; i < points_W.size(); ++i) {
+    // Marching cubes samples the voxels' corners: grid points, up to rounding.
+    const Eigen::Vector3d grid = (points_W[i] - origin_W) / cube_.resolution_m;
+    const Eigen::Vector3i corner = grid.array().round().cast<int>();
+    float& value = (*values)[i];
+    if (cornerTouchesFree(free_, corner, cells)) {
+      value = std::max(value, kFreeField_px);
+      continue;
+    }
+    for (int axis = 0; axis < 3 && value < kWallField_px; ++axis) {
+      for (const int step : {-1, 1}) {
+        if (cornerTouchesFree(free_, corner + step * Eigen::Vector3i::Unit(axis), cells)) {
+          value = kWallField_px;
+          break;
+        }
+      }
+    }
+  }
+}
+
+}  // namespace sift_hull
