@@ -24,6 +24,7 @@ set(SIFT_HULL_CORE_GTESTS
   test_mesh_render eval
   test_hull eval
   test_free_carving eval
+  test_refine eval
   test_reduced_distance eval
   test_hull_data eval
   test_hull_stream eval

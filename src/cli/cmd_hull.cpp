@@ -8,6 +8,7 @@
 #include "bench_timing.h"
 #include "commands.h"
 #include "hull_options.h"
+#include "refine_options.h"
 #include "sift_hull/eval/mesh_render.h"
 #include "sift_hull/geometry/camera_set.h"
 #include "sift_hull/hull/hull_config.h"
@@ -113,6 +114,21 @@ std::string hullText(const nlohmann::json& result) {
        << " faces, watertight " << result["mesh"]["watertight"] << "\ntime (ms) "
        << result["time_ms"].dump() << "\nreprojection IoU min " << result["reprojection_iou"]["min"]
        << ", mean " << result["reprojection_iou"]["mean"] << '\n';
+  if (result.contains("points")) {
+    text << "refined with matches: " << result["points"]["kept"] << " surface points of "
+         << result["points"]["triangulated"] << " triangulated (" << result["points"]["pairs"]
+         << " pairs), " << result["free_voxels"] << " free voxels, carved "
+         << result["carved_volume_m3"] << " m^3\n";
+  }
+  if (result.contains("volume_iou_vs_truth")) {
+    text << "volume IoU against the true solid " << result["volume_iou_vs_truth"]["before"]
+         << (result.contains("points") ? " before, " : "");
+    if (result.contains("points")) {
+      text << result["volume_iou_vs_truth"]["after"] << " after; false carving "
+           << result["false_carved_fraction"] << " of the true volume";
+    }
+    text << '\n';
+  }
   return text.str();
 }
 
@@ -127,6 +143,7 @@ int runHull(const std::vector<std::string>& args) {
   parser.addOption("out-mesh", "PLY", "write the mesh (binary PLY, world coordinates)");
   parser.addOption("out-octree", "BT", "write the OctoMap (.bt)");
   parser.addOption("out-render", "PNG", "write shaded renderings of the mesh");
+  addRefineOptions(&parser);
   parser.addFlag("json", "print the result as one JSON object");
   parser.addFlag("allow-poor",
                  "warn instead of failing on a result that cannot be right (no faces, mean IoU "
@@ -141,7 +158,8 @@ int runHull(const std::vector<std::string>& args) {
     poor.warn(warning);
   const std::optional<Box3d> box = boxFromArgs(parser);
   if (box) checkBox(*box, input, &poor);
-  const HullResult result = buildHull(input, config, box);
+  HullResult result = buildHull(input, config, box);
+  const nlohmann::json refined = refineWithMatches(parser, input, &result);
   const double hull_peak_mib = peakMemoryMiB();
   const std::unique_ptr<octomap::OcTree> octree = toOctomap(result.hull);
   const ReprojectionIoU iou = reprojectionIoU(result.mesh, result.hull.views());
@@ -151,6 +169,7 @@ int runHull(const std::vector<std::string>& args) {
   checkResult(result, iou, &poor);
   writeOutputs(parser, result, *octree);
   nlohmann::json json = hullJson(result, occupiedLeaves(*octree), iou);
+  json.update(refined);
   json["warnings"] = poor.warnings();
   json["peak_memory_mib"] = {{"through_hull", hull_peak_mib}, {"total", peakMemoryMiB()}};
   printResult(parser.flag("json"), json, hullText(json));

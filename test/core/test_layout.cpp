@@ -28,9 +28,10 @@ const std::map<std::string, std::set<std::string>>& allowedIncludes() {
       {"features", {"geometry"}},
       {"filters", {"geometry", "features"}},
       {"hull", {"geometry"}},
+      {"refine", {"geometry", "hull"}},
       {"io", {"geometry", "features", "filters", "hull"}},
       {"synthetic", {"geometry", "features", "filters", "hull", "io"}},
-      {"eval", {"geometry", "features", "filters", "hull", "io"}},
+      {"eval", {"geometry", "features", "filters", "hull", "refine", "io"}},
   };
   return allowed;
 }

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "sift_hull/hull/mesh.h"
@@ -44,6 +45,37 @@ DenseGrid denseCarving(const std::vector<HullView>& views, const Box3d& cube, in
 /// point when its leaf is in, or is a surface cell and f_iso <= 0 at the point (the surface the
 /// mesh follows), so that the octree's in and out decisions are what is compared.
 double volumeIoU(const VisualHull& hull, const DenseGrid& dense);
+
+/// Whether the hull holds a point, as volumeIoU decides it.
+bool hullHolds(const VisualHull& hull, const Eigen::Vector3d& X_W);
+
+/// The hull and a true solid sampled at the centres of a regular grid of per_axis^3 cells over
+/// the hull's cube (x fastest): the ground truth of free-space carving.
+struct SolidSamples {
+  int per_axis = 0;
+  double cell_m3 = 0.0;
+  std::vector<uint8_t> truth, hull;
+  std::vector<uint8_t> cavity;  ///< in the solid's cavities (empty without `cavities`)
+};
+using SolidPredicate = std::function<bool(const Eigen::Vector3d& X_W)>;
+/// `cavities`, when given, tells the space that a visual hull of the solid cannot remove (the
+/// shape with its cuts filled, less the shape).
+SolidSamples sampleAgainstSolid(const VisualHull& hull, const SolidPredicate& inside, int per_axis,
+                                const SolidPredicate& cavities = {});
+
+/// Volumes from the samples, cubic metres: the hull's, the solid's, the hull's beyond the solid
+/// (what a visual hull cannot remove) and the solid's beyond the hull (wrongly carved).
+struct SolidComparison {
+  double iou = 0.0, hull_m3 = 0.0, truth_m3 = 0.0, excess_m3 = 0.0, missing_m3 = 0.0;
+  double cavity_m3 = 0.0;         ///< the cavities' volume (within the cube)
+  double cavity_filled_m3 = 0.0;  ///< the hull's volume in the cavities
+};
+SolidComparison compareWithSolid(const SolidSamples& samples);
+
+/// The solid's volume held before and not after (of two samplings of one cube), over the solid's
+/// volume: what refinement carved that it should not have. Throws std::invalid_argument for
+/// samplings of different grids.
+double falseCarvedFraction(const SolidSamples& before, const SolidSamples& after);
 
 /// Mean distance of the mesh's vertices to a sphere's surface.
 double meanDistanceToSphere(const TriangleMesh& mesh, const Eigen::Vector3d& centre_W,

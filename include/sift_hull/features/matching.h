@@ -50,6 +50,16 @@ struct PutativeMatches {
 std::vector<cv::DMatch> matchDescriptors(const cv::Mat& left, const cv::Mat& right,
                                          const MatchConfig& config);
 
+/// Guided matching of a calibrated pair: each left keypoint's two nearest descriptors among the
+/// right keypoints within max_epipolar_px of its epipolar line (ideal pixels, both ways), then
+/// config's distance and ratio tests among those (cross_check and backend do not apply). Wide
+/// baselines keep the matches that the ratio test against every right keypoint loses. Throws
+/// std::invalid_argument for descriptors that do not fit their keypoints.
+std::vector<cv::DMatch> matchAlongEpipolarLines(const Features& left, const Features& right,
+                                                const PinholeCamera& left_camera,
+                                                const PinholeCamera& right_camera,
+                                                const MatchConfig& config, double max_epipolar_px);
+
 /// Detects, describes and matches: the putative matches of two images.
 PutativeMatches matchImages(const cv::Mat& left_image, const cv::Mat& right_image,
                             const SiftConfig& sift, const MatchConfig& matching);

@@ -46,6 +46,9 @@ class Shape {
   static Shape byName(const std::string& name);
   /// Whether a part takes volume away (silhouettes then do not bound the solid tightly).
   bool hasCuts() const;
+  /// The shape with its cuts filled: the parts that add. Its difference with the shape is the
+  /// cavities.
+  Shape withoutCuts() const;
 
   const std::vector<Primitive>& parts() const { return parts_; }
   bool contains(const Eigen::Vector3d& X_W) const;

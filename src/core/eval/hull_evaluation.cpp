@@ -81,15 +81,77 @@ DenseGrid denseCarving(const std::vector<HullView>& views, const Box3d& cube, in
   return grid;
 }
 
+bool hullHolds(const VisualHull& hull, const Eigen::Vector3d& X_W) {
+  const CellState state = hull.leafAt(X_W).state;
+  return state == CellState::kIn || (state == CellState::kSurface && hull.valueAt(X_W) <= 0.0f);
+}
+
+SolidSamples sampleAgainstSolid(const VisualHull& hull, const SolidPredicate& inside, int per_axis,
+                                const SolidPredicate& cavities) {
+  if (per_axis < 1) throw std::invalid_argument("sampleAgainstSolid: per_axis must be >= 1");
+  SolidSamples samples;
+  samples.per_axis = per_axis;
+  const double cell_m = hull.cube().edge_m() / per_axis;
+  samples.cell_m3 = cell_m * cell_m * cell_m;
+  const size_t count = static_cast<size_t>(per_axis) * per_axis * per_axis;
+  samples.truth.resize(count);
+  samples.hull.resize(count);
+  if (cavities) samples.cavity.resize(count);
+  const Eigen::Vector3d origin_W = hull.cube().origin_W();
+  for (size_t n = 0; n < count; ++n) {
+    const Eigen::Vector3d cell(static_cast<double>(n % per_axis),
+                               static_cast<double>(n / per_axis % per_axis),
+                               static_cast<double>(n / per_axis / per_axis));
+    const Eigen::Vector3d X_W = origin_W + (cell.array() + 0.5).matrix() * cell_m;
+    samples.truth[n] = inside(X_W) ? 1 : 0;
+    samples.hull[n] = hullHolds(hull, X_W) ? 1 : 0;
+    if (cavities) samples.cavity[n] = cavities(X_W) ? 1 : 0;
+  }
+  return samples;
+}
+
+SolidComparison compareWithSolid(const SolidSamples& samples) {
+  size_t both = 0, hull = 0, truth = 0, cavity = 0, cavity_filled = 0;
+  for (size_t n = 0; n < samples.truth.size(); ++n) {
+    both += samples.truth[n] && samples.hull[n];
+    hull += samples.hull[n];
+    truth += samples.truth[n];
+    if (!samples.cavity.empty()) {
+      cavity += samples.cavity[n];
+      cavity_filled += samples.cavity[n] && samples.hull[n];
+    }
+  }
+  SolidComparison comparison;
+  comparison.cavity_m3 = cavity * samples.cell_m3;
+  comparison.cavity_filled_m3 = cavity_filled * samples.cell_m3;
+  comparison.hull_m3 = hull * samples.cell_m3;
+  comparison.truth_m3 = truth * samples.cell_m3;
+  comparison.excess_m3 = (hull - both) * samples.cell_m3;
+  comparison.missing_m3 = (truth - both) * samples.cell_m3;
+  const size_t either = hull + truth - both;
+  comparison.iou = either == 0 ? 1.0 : static_cast<double>(both) / either;
+  return comparison;
+}
+
+double falseCarvedFraction(const SolidSamples& before, const SolidSamples& after) {
+  if (before.per_axis != after.per_axis || before.truth != after.truth) {
+    throw std::invalid_argument("falseCarvedFraction: the samplings differ");
+  }
+  size_t carved = 0, truth = 0;
+  for (size_t n = 0; n < before.truth.size(); ++n) {
+    truth += before.truth[n];
+    carved += before.truth[n] && before.hull[n] && !after.hull[n];
+  }
+  return truth == 0 ? 0.0 : static_cast<double>(carved) / truth;
+}
+
 double volumeIoU(const VisualHull& hull, const DenseGrid& dense) {
   size_t both = 0, either = 0;
   for (int k = 0; k < dense.cells; ++k) {
     for (int j = 0; j < dense.cells; ++j) {
       for (int i = 0; i < dense.cells; ++i) {
         const Eigen::Vector3d centre = dense.centre(i, j, k);
-        const CellState state = hull.leafAt(centre).state;
-        const bool in_hull = state == CellState::kIn ||
-                             (state == CellState::kSurface && hull.valueAt(centre) <= 0.0f);
+        const bool in_hull = hullHolds(hull, centre);
         const bool in_dense = dense.occupied[dense.index(i, j, k)];
         both += in_hull && in_dense;
         either += in_hull || in_dense;

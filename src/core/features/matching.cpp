@@ -1,7 +1,9 @@
 #include "sift_hull/features/matching.h"
 
 #include <cmath>
+#include <limits>
 #include <opencv2/features2d.hpp>
+#include <optional>
 #include <stdexcept>
 
 namespace sift_hull {
@@ -39,6 +41,76 @@ void validate(const MatchConfig& config) {
   require(config.ratio > 0.0, "ratio must be > 0 (1 turns the test off)");
   require(config.backend == "brute-force" || config.backend == "flann",
           "backend must be 'brute-force' or 'flann', not '" + config.backend + "'");
+}
+
+namespace {
+
+/// Ideal pixels of keypoints (NaN where the distortion cannot be undone).
+std::vector<Eigen::Vector3d> idealPoints(const std::vector<cv::KeyPoint>& keypoints,
+                                         const PinholeCamera& camera) {
+  std::vector<Eigen::Vector3d> points;
+  points.reserve(keypoints.size());
+  for (const cv::KeyPoint& k : keypoints) {
+    const std::optional<Eigen::Vector2d> ideal = camera.undistortPixel({k.pt.x, k.pt.y});
+    points.push_back(ideal ? Eigen::Vector3d(ideal->x(), ideal->y(), 1.0)
+                           : Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN()));
+  }
+  return points;
+}
+
+/// A line (a, b, c) scaled so that a x + b y + c is the distance in pixels.
+Eigen::Vector3d unitLine(const Eigen::Vector3d& line) {
+  return line / std::hypot(line.x(), line.y());
+}
+
+}  // namespace
+
+std::vector<cv::DMatch> matchAlongEpipolarLines(const Features& left, const Features& right,
+                                                const PinholeCamera& left_camera,
+                                                const PinholeCamera& right_camera,
+                                                const MatchConfig& config, double max_epipolar_px) {
+  validate(config);
+  if (!(max_epipolar_px > 0.0)) {
+    throw std::invalid_argument("matchAlongEpipolarLines: max_epipolar_px must be > 0");
+  }
+  if (left.descriptors.rows != static_cast<int>(left.keypoints.size()) ||
+      right.descriptors.rows != static_cast<int>(right.keypoints.size()) ||
+      (!left.keypoints.empty() && !right.keypoints.empty() &&
+       (left.descriptors.cols != right.descriptors.cols || left.descriptors.type() != CV_32F ||
+        right.descriptors.type() != CV_32F))) {
+    throw std::invalid_argument("matchAlongEpipolarLines: descriptors do not fit the keypoints");
+  }
+  const Eigen::Matrix3d F = fundamentalMatrix(left_camera, right_camera);
+  const std::vector<Eigen::Vector3d> x_left = idealPoints(left.keypoints, left_camera);
+  const std::vector<Eigen::Vector3d> x_right = idealPoints(right.keypoints, right_camera);
+  std::vector<Eigen::Vector3d> lines_in_left(x_right.size());
+  for (size_t j = 0; j < x_right.size(); ++j)
+    lines_in_left[j] = unitLine(F.transpose() * x_right[j]);
+  std::vector<cv::DMatch> matches;
+  for (size_t i = 0; i < x_left.size(); ++i) {
+    const Eigen::Vector3d line = unitLine(F * x_left[i]);
+    if (!line.allFinite()) continue;
+    float best = std::numeric_limits<float>::infinity(), second = best;
+    int best_j = -1;
+    for (size_t j = 0; j < x_right.size(); ++j) {
+      if (!(std::abs(line.dot(x_right[j])) <= max_epipolar_px) ||
+          !(std::abs(lines_in_left[j].dot(x_left[i])) <= max_epipolar_px)) {
+        continue;
+      }
+      const float distance =
+          static_cast<float>(cv::norm(left.descriptors.row(static_cast<int>(i)),
+                                      right.descriptors.row(static_cast<int>(j)), cv::NORM_L2));
+      if (distance < best) {
+        second = best, best = distance, best_j = static_cast<int>(j);
+      } else if (distance < second) {
+        second = distance;
+      }
+    }
+    if (best_j < 0 || best > config.max_descriptor_distance) continue;
+    if (config.ratio < 1.0 && std::isfinite(second) && !(best < config.ratio * second)) continue;
+    matches.emplace_back(static_cast<int>(i), best_j, best);
+  }
+  return matches;
 }
 
 std::vector<cv::DMatch> matchDescriptors(const cv::Mat& left, const cv::Mat& right,

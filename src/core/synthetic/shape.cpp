@@ -228,6 +228,14 @@ Shape::Shape(std::vector<Primitive> parts) : parts_(std::move(parts)) {
   }
 }
 
+Shape Shape::withoutCuts() const {
+  std::vector<Primitive> adding;
+  for (const Primitive& p : parts_) {
+    if (!p.subtract) adding.push_back(p);
+  }
+  return Shape(std::move(adding));
+}
+
 bool Shape::hasCuts() const {
   return std::any_of(parts_.begin(), parts_.end(), [](const Primitive& p) { return p.subtract; });
 }

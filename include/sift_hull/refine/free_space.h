@@ -1,0 +1,51 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "sift_hull/geometry/camera.h"
+#include "sift_hull/hull/octree.h"
+#include "sift_hull/refine/surface_points.h"
+
+namespace sift_hull {
+
+/// Which voxels the lines of sight to surface points make free. Each view's points are joined
+/// into a surface by a Delaunay triangulation of their projections; that surface's depth map
+/// bounds what the view sees as empty. Triangles longer than max_edge_fraction of the cube's
+/// edge or seen more obliquely than max_slant_deg (across a depth jump, from a rim down to the
+/// floor of a cavity) are left out.
+struct FreeSpaceConfig {
+  /// A voxel's centre must lie this many finest voxels, plus two of the surface's depth_sigma_m
+  /// and its bulge (below), in front of a view's surface to be empty for that view: the surface
+  /// and its uncertainty stay.
+  double stop_margin_voxels = 3.0;
+  /// Views that must see a voxel empty before it is free. One suffices by default: what a view
+  /// sees empty ends on a triangle of three surface points, each of which passed the reprojection,
+  /// hull and track tests and agrees in depth with the median of its Delaunay neighbours in that
+  /// view (a lone wrong point is dropped there). 2 asks two views to agree as well.
+  int min_views = 1;
+  /// Voxels whose centre lies this close to a surface point (finest voxels) are never free.
+  double keep_radius_voxels = 1.5;
+  /// Longest edge of a triangle of a view's surface, as a fraction of the cube's edge.
+  double max_edge_fraction = 0.08;
+  /// Largest angle between a triangle's normal and the line of sight to it, degrees: a triangle
+  /// seen edge-on spans a depth jump (a column in front of a wall) more often than a surface.
+  double max_slant_deg = 75.0;
+  /// The surface between a triangle's corners may bulge towards the camera by this fraction of
+  /// the triangle's longest edge (a round surface of radius no less than half the edge bulges by
+  /// at most a quarter of it), which is added to the margin there.
+  double bulge_fraction = 0.25;
+};
+
+/// Throws std::invalid_argument naming the first bad field.
+void validate(const FreeSpaceConfig& config);
+
+/// The finest voxels of the hull's cube, occupied in the hull now, that at least min_views of the
+/// points' views see in front of their surfaces (FreeSpaceConfig), in z, y, x order. The order of
+/// the points does not matter. Throws std::invalid_argument for a point's view beyond `cameras`.
+std::vector<Eigen::Vector3i> freeVoxels(const VisualHull& hull,
+                                        const std::vector<PinholeCamera>& cameras,
+                                        const std::vector<SurfacePoint>& points,
+                                        const FreeSpaceConfig& config);
+
+}  // namespace sift_hull

@@ -1,0 +1,253 @@
+// hull --refine-with-matches: the filtered matches of calibrated pairs carve what silhouettes
+// cannot (src/core/refine), and with --gt-scene the result against the renderer's solid.
+
+#include "refine_options.h"
+
+#include <algorithm>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <set>
+#include <sstream>
+
+#include "sift_hull/eval/hull_evaluation.h"
+#include "sift_hull/features/sift.h"
+#include "sift_hull/filters/filter.h"
+#include "sift_hull/io/images.h"
+#include "sift_hull/refine/free_space.h"
+#include "sift_hull/refine/surface_points.h"
+#include "sift_hull/synthetic/scene.h"
+#include "sift_hull/synthetic/shape.h"
+
+namespace sift_hull {
+namespace cli {
+namespace {
+
+/// Samples per axis of the comparison with the true solid (--gt-scene).
+constexpr int kSolidSamplesPerAxis = 160;
+/// SIFT's contrast threshold for refinement: lower than SiftConfig's 0.04, for denser points.
+constexpr double kRefineContrastThreshold = 0.04;
+/// How far from its epipolar line a match may lie in guided matching, pixels.
+constexpr double kGuidedEpipolarPx = 2.0;
+/// Views each view pairs with under --match-pairs neighbours: its nearest by camera centre.
+constexpr size_t kNeighbours = 2;
+
+std::string number(double value) {
+  std::ostringstream text;
+  text << value;
+  return text.str();
+}
+
+/// (a, b) with a < b: each view with its kNeighbours nearest, or every pair.
+std::vector<std::pair<uint32_t, uint32_t>> viewPairs(const std::vector<PinholeCamera>& cameras,
+                                                     bool all) {
+  std::set<std::pair<uint32_t, uint32_t>> pairs;
+  const uint32_t n = static_cast<uint32_t>(cameras.size());
+  for (uint32_t a = 0; a < n; ++a) {
+    std::vector<uint32_t> others;
+    for (uint32_t b = 0; b < n; ++b) {
+      if (b != a) others.push_back(b);
+    }
+    const Eigen::Vector3d centre = cameras[a].centre();
+    std::sort(others.begin(), others.end(), [&](uint32_t x, uint32_t y) {
+      return (cameras[x].centre() - centre).norm() < (cameras[y].centre() - centre).norm();
+    });
+    if (!all && others.size() > kNeighbours) others.resize(kNeighbours);
+    for (const uint32_t b : others) pairs.insert({std::min(a, b), std::max(a, b)});
+  }
+  return {pairs.begin(), pairs.end()};
+}
+
+/// The kept matches of each pair, SIFT computed once per view.
+std::vector<PairMatches> matchedPairs(const ArgParser& parser, const HullInput& input) {
+  if (!parser.has("images")) throw UsageError("--refine-with-matches needs --images");
+  const std::string match_pairs = parser.get("match-pairs");
+  if (match_pairs != "neighbours" && match_pairs != "all") {
+    throw UsageError("--match-pairs must be neighbours or all, not '" + match_pairs + "'");
+  }
+  const FilterConfigs filter_configs;
+  std::unique_ptr<MatchFilter> filter;
+  try {
+    filter = makeFilter(parser.get("filter"), filter_configs);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(std::string("--filter: ") + e.what());
+  }
+  SiftConfig sift;
+  sift.contrast_threshold = parser.getDouble("contrast-threshold");
+  try {
+    validate(sift);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+  MatchConfig matching;
+  matching.ratio = parser.getDouble("ratio");
+  std::vector<std::optional<Features>> features(input.cameras.size());
+  std::vector<cv::Size> sizes(input.cameras.size());
+  const auto featuresOf = [&](uint32_t view) -> const Features& {
+    if (!features[view]) {
+      const cv::Mat image = readImage(parser.get("images") + "/" + input.names[view]);
+      sizes[view] = image.size();
+      features[view] = detectSift(image, sift);
+    }
+    return *features[view];
+  };
+  std::vector<PairMatches> pairs;
+  for (const auto& [a, b] : viewPairs(input.cameras, match_pairs == "all")) {
+    const Features& left = featuresOf(a);
+    const Features& right = featuresOf(b);
+    PutativeMatches putative;
+    putative.matches = matchAlongEpipolarLines(left, right, input.cameras[a], input.cameras[b],
+                                               matching, kGuidedEpipolarPx);
+    putative.left_keypoints = left.keypoints;
+    putative.right_keypoints = right.keypoints;
+    putative.left_image_size = sizes[a];
+    putative.right_image_size = sizes[b];
+    calibratePair(&putative, input.cameras[a], input.cameras[b]);
+    const FilterResult kept = filter->apply(putative);
+    PairMatches pair;
+    pair.left_view = a, pair.right_view = b;
+    for (size_t m = 0; m < putative.matches.size(); ++m) {
+      if (!kept.keep[m]) continue;
+      pair.left_px.emplace_back(putative.left(m).pt.x, putative.left(m).pt.y);
+      pair.right_px.emplace_back(putative.right(m).pt.x, putative.right(m).pt.y);
+      pair.left_keypoint.push_back(putative.matches[m].queryIdx);
+      pair.right_keypoint.push_back(putative.matches[m].trainIdx);
+    }
+    pairs.push_back(std::move(pair));
+  }
+  return pairs;
+}
+
+SurfacePointConfig surfacePointConfigFromArgs(const ArgParser& parser) {
+  SurfacePointConfig config;
+  config.max_reprojection_px = parser.getDouble("max-reprojection-px");
+  config.confirm_radius_voxels = parser.getDouble("confirm-radius-voxels");
+  try {
+    validate(config);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+  return config;
+}
+
+FreeSpaceConfig freeSpaceConfigFromArgs(const ArgParser& parser) {
+  FreeSpaceConfig config;
+  config.stop_margin_voxels = parser.getDouble("stop-margin-voxels");
+  config.min_views = parser.getInt("min-views");
+  config.max_edge_fraction = parser.getDouble("max-edge-fraction");
+  config.max_slant_deg = parser.getDouble("max-slant-deg");
+  config.bulge_fraction = parser.getDouble("bulge-fraction");
+  config.keep_radius_voxels = parser.getDouble("keep-radius-voxels");
+  try {
+    validate(config);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(e.what());
+  }
+  return config;
+}
+
+nlohmann::json solidJson(const SolidComparison& c) {
+  return {{"iou", c.iou},
+          {"hull_m3", c.hull_m3},
+          {"truth_m3", c.truth_m3},
+          {"excess_m3", c.excess_m3},
+          {"missing_m3", c.missing_m3}};
+}
+
+}  // namespace
+
+void addRefineOptions(ArgParser* parser) {
+  const SurfacePointConfig points;
+  const FreeSpaceConfig free;
+  parser->addFlag("refine-with-matches",
+                  "match calibrated pairs of views (SIFT on --images), triangulate the filtered "
+                  "matches and carve the lines of sight to them from the hull");
+  parser->addOption("match-pairs", "neighbours|all",
+                    "pairs to match: each view with its two nearest (camera centres), or all",
+                    "neighbours");
+  parser->addOption("filter", "NAME", "match filter for --refine-with-matches (makeFilter names)",
+                    "gsc");
+  parser->addOption("contrast-threshold", "T",
+                    "SIFT's contrast threshold for --refine-with-matches (SiftConfig's default: "
+                    "0.04; lower finds more features)",
+                    number(kRefineContrastThreshold));
+  parser->addOption("ratio", "R",
+                    "Lowe's ratio among a keypoint's candidates along its epipolar line "
+                    "(--refine-with-matches)",
+                    number(MatchConfig{}.ratio));
+  parser->addOption("max-reprojection-px", "PX",
+                    "largest reprojection error of a surface point in either view",
+                    number(points.max_reprojection_px));
+  parser->addOption(
+      "confirm-radius-voxels", "V",
+      "points of two pairs sharing a feature confirm each other this close (finest voxels)",
+      number(points.confirm_radius_voxels));
+  parser->addOption("stop-margin-voxels", "V",
+                    "a voxel is empty for a view when this many voxels (plus two depth sigmas) in "
+                    "front of the surface of its points",
+                    number(free.stop_margin_voxels));
+  parser->addOption("min-views", "N", "views that must see a voxel empty before it is free",
+                    std::to_string(free.min_views));
+  parser->addOption("max-edge-fraction", "F",
+                    "longest triangle of a view's surface of points, as a fraction of the cube's "
+                    "edge",
+                    number(free.max_edge_fraction));
+  parser->addOption("max-slant-deg", "DEG",
+                    "largest angle between a triangle's normal and the line of sight to it",
+                    number(free.max_slant_deg));
+  parser->addOption("bulge-fraction", "F",
+                    "margin added per triangle, as a fraction of its longest edge (the surface "
+                    "may bulge towards the camera between points)",
+                    number(free.bulge_fraction));
+  parser->addOption("keep-radius-voxels", "V",
+                    "voxels this close to a surface point are never free",
+                    number(free.keep_radius_voxels));
+  parser->addOption("gt-scene", "DIR",
+                    "a scene `sift_hull scene` rendered: compare the hull with its true solid "
+                    "(volume IoU, and with --refine-with-matches before and after, false carving)");
+}
+
+nlohmann::json refineWithMatches(const ArgParser& parser, const HullInput& input,
+                                 HullResult* result) {
+  nlohmann::json json = nlohmann::json::object();
+  const bool refine = parser.flag("refine-with-matches");
+  std::optional<Shape> solid;
+  if (parser.has("gt-scene")) solid = Shape::byName(readScene(parser.get("gt-scene")).config.shape);
+  const SolidPredicate inside = [&](const Eigen::Vector3d& X_W) { return solid->contains(X_W); };
+  std::optional<SolidSamples> before;
+  if (solid) before = sampleAgainstSolid(result->hull, inside, kSolidSamplesPerAxis);
+  if (refine) {
+    const SurfacePointConfig point_config = surfacePointConfigFromArgs(parser);
+    const FreeSpaceConfig free_config = freeSpaceConfigFromArgs(parser);
+    const std::vector<PairMatches> pairs = matchedPairs(parser, input);
+    SurfacePointCounts counts;
+    const std::vector<SurfacePoint> points =
+        surfacePoints(input.cameras, pairs, result->hull, point_config, &counts);
+    const double before_m3 = result->hull.stats().occupied_volume_m3;
+    result->hull.carveFree(freeVoxels(result->hull, input.cameras, points, free_config));
+    result->mesh = result->hull.mesh();
+    result->mesh_check = checkMesh(result->mesh);
+    size_t matches = 0;
+    for (const PairMatches& pair : pairs) matches += pair.left_px.size();
+    json["points"] = {{"pairs", pairs.size()},
+                      {"matches_kept", matches},
+                      {"triangulated", counts.triangulated},
+                      {"reprojected", counts.reprojected},
+                      {"inside_hull", counts.inside_hull},
+                      {"confirmed", counts.confirmed},
+                      {"kept", counts.kept}};
+    json["free_voxels"] = result->hull.freeVoxelCount();
+    json["carved_volume_m3"] = before_m3 - result->hull.stats().occupied_volume_m3;
+  }
+  if (solid) {
+    const SolidSamples after = sampleAgainstSolid(result->hull, inside, kSolidSamplesPerAxis);
+    const SolidComparison was = compareWithSolid(*before), is = compareWithSolid(after);
+    json["volume_iou_vs_truth"] = {{"before", was.iou}, {"after", is.iou}};
+    json["solid"] = {{"before", solidJson(was)}, {"after", solidJson(is)}};
+    json["false_carved_fraction"] = falseCarvedFraction(*before, after);
+  }
+  return json;
+}
+
+}  // namespace cli
+}  // namespace sift_hull

@@ -1,0 +1,24 @@
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include "args.h"
+#include "sift_hull/hull/hull_pipeline.h"
+
+namespace sift_hull {
+namespace cli {
+
+/// --refine-with-matches, --match-pairs, --filter, the SurfacePointConfig and FreeSpaceConfig
+/// settings under their field names, and --gt-scene.
+void addRefineOptions(ArgParser* parser);
+
+/// With --refine-with-matches: SIFT on every view's image (--images), the chosen pairs matched
+/// and filtered, triangulated into consistent surface points, their lines of sight carved from
+/// result->hull and the mesh made again. Returns the JSON it adds to `hull --json` ("points",
+/// "carved_volume_m3", and with --gt-scene the comparison with the rendered solid), an empty
+/// object without either flag. Throws UsageError for bad settings.
+nlohmann::json refineWithMatches(const ArgParser& parser, const HullInput& input,
+                                 HullResult* result);
+
+}  // namespace cli
+}  // namespace sift_hull
