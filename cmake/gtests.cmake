@@ -19,6 +19,7 @@ set(SIFT_HULL_CORE_GTESTS
   test_filters eval
   test_evaluation eval
   test_scene eval
+  test_cut_shapes eval
   test_scene_backgrounds eval
   test_silhouettes eval
   test_mesh_render eval
