@@ -21,16 +21,27 @@ namespace sift_hull {
 namespace cli {
 namespace {
 
+void writeRender(const std::string& path, const TriangleMesh& mesh) {
+  if (!cv::imwrite(path, renderTurntable(mesh, 4, cv::Size(480, 480)))) {
+    throw std::runtime_error(path + ": cannot write the image");
+  }
+}
+
+/// PATH.png -> PATH_before.png: the silhouettes' hull beside the refined one.
+std::string beforePath(const std::string& path) {
+  const size_t dot = path.find_last_of('.');
+  const size_t slash = path.find_last_of('/');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) {
+    return path + "_before";
+  }
+  return path.substr(0, dot) + "_before" + path.substr(dot);
+}
+
 void writeOutputs(const ArgParser& parser, const HullResult& result,
                   const octomap::OcTree& octree) {
   if (parser.has("out-mesh")) writePly(parser.get("out-mesh"), result.mesh);
   if (parser.has("out-octree")) writeOctomap(octree, parser.get("out-octree"));
-  if (parser.has("out-render")) {
-    const std::string path = parser.get("out-render");
-    if (!cv::imwrite(path, renderTurntable(result.mesh, 4, cv::Size(480, 480)))) {
-      throw std::runtime_error(path + ": cannot write the image");
-    }
-  }
+  if (parser.has("out-render")) writeRender(parser.get("out-render"), result.mesh);
 }
 
 /// The tree's occupied leaves (its free leaves, the carved space, aside).
@@ -142,7 +153,9 @@ int runHull(const std::vector<std::string>& args) {
   addHullOptions(&parser);
   parser.addOption("out-mesh", "PLY", "write the mesh (binary PLY, world coordinates)");
   parser.addOption("out-octree", "BT", "write the OctoMap (.bt)");
-  parser.addOption("out-render", "PNG", "write shaded renderings of the mesh");
+  parser.addOption("out-render", "PNG",
+                   "write shaded renderings of the mesh (with --refine-with-matches also those of "
+                   "the silhouettes' hull, as PNG with _before before the extension)");
   addRefineOptions(&parser);
   parser.addFlag("json", "print the result as one JSON object");
   parser.addFlag("allow-poor",
@@ -159,6 +172,9 @@ int runHull(const std::vector<std::string>& args) {
   const std::optional<Box3d> box = boxFromArgs(parser);
   if (box) checkBox(*box, input, &poor);
   HullResult result = buildHull(input, config, box);
+  if (parser.flag("refine-with-matches") && parser.has("out-render")) {
+    writeRender(beforePath(parser.get("out-render")), result.mesh);
+  }
   const nlohmann::json refined = refineWithMatches(parser, input, &result);
   const double hull_peak_mib = peakMemoryMiB();
   const std::unique_ptr<octomap::OcTree> octree = toOctomap(result.hull);

@@ -151,7 +151,9 @@ nlohmann::json solidJson(const SolidComparison& c) {
           {"hull_m3", c.hull_m3},
           {"truth_m3", c.truth_m3},
           {"excess_m3", c.excess_m3},
-          {"missing_m3", c.missing_m3}};
+          {"missing_m3", c.missing_m3},
+          {"cavity_m3", c.cavity_m3},
+          {"cavity_filled_m3", c.cavity_filled_m3}};
 }
 
 }  // namespace
@@ -214,8 +216,13 @@ nlohmann::json refineWithMatches(const ArgParser& parser, const HullInput& input
   std::optional<Shape> solid;
   if (parser.has("gt-scene")) solid = Shape::byName(readScene(parser.get("gt-scene")).config.shape);
   const SolidPredicate inside = [&](const Eigen::Vector3d& X_W) { return solid->contains(X_W); };
+  std::optional<Shape> filled;
+  if (solid) filled = solid->withoutCuts();
+  const SolidPredicate cavities = [&](const Eigen::Vector3d& X_W) {
+    return filled->contains(X_W) && !solid->contains(X_W);
+  };
   std::optional<SolidSamples> before;
-  if (solid) before = sampleAgainstSolid(result->hull, inside, kSolidSamplesPerAxis);
+  if (solid) before = sampleAgainstSolid(result->hull, inside, kSolidSamplesPerAxis, cavities);
   if (refine) {
     const SurfacePointConfig point_config = surfacePointConfigFromArgs(parser);
     const FreeSpaceConfig free_config = freeSpaceConfigFromArgs(parser);
@@ -240,11 +247,13 @@ nlohmann::json refineWithMatches(const ArgParser& parser, const HullInput& input
     json["carved_volume_m3"] = before_m3 - result->hull.stats().occupied_volume_m3;
   }
   if (solid) {
-    const SolidSamples after = sampleAgainstSolid(result->hull, inside, kSolidSamplesPerAxis);
+    const SolidSamples after =
+        sampleAgainstSolid(result->hull, inside, kSolidSamplesPerAxis, cavities);
     const SolidComparison was = compareWithSolid(*before), is = compareWithSolid(after);
     json["volume_iou_vs_truth"] = {{"before", was.iou}, {"after", is.iou}};
     json["solid"] = {{"before", solidJson(was)}, {"after", solidJson(is)}};
     json["false_carved_fraction"] = falseCarvedFraction(*before, after);
+    json["cavity_filled_m3"] = {{"before", was.cavity_filled_m3}, {"after", is.cavity_filled_m3}};
   }
   return json;
 }

@@ -40,7 +40,8 @@ struct FreeSpaceConfig {
 /// Throws std::invalid_argument naming the first bad field.
 void validate(const FreeSpaceConfig& config);
 
-/// The finest voxels of the hull's cube, occupied in the hull now, that at least min_views of the
+/// The finest voxels occupied in the hull (in cells: min_views; surface cells, which the
+/// silhouettes settle within a voxel already: at least two) that at least min_views of the
 /// points' views see in front of their surfaces (FreeSpaceConfig), in z, y, x order. The order of
 /// the points does not matter. Throws std::invalid_argument for a point's view beyond `cameras`.
 std::vector<Eigen::Vector3i> freeVoxels(const VisualHull& hull,

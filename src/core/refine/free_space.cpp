@@ -255,11 +255,14 @@ std::vector<Eigen::Vector3i> freeVoxels(const VisualHull& hull,
       }
     }
   }
-  // Every occupied finest voxel, by the hull's leaves.
+  // Every occupied finest voxel. The silhouettes settle the hull's surface cells within a voxel
+  // already: those need two views (the lid a visual hull puts over a cup's opening has them; the
+  // faces silhouettes see stay smooth).
   std::vector<HullCell> leaves;
   hull.forEachLeaf([&](const HullCell& cell) {
     if (cell.state != CellState::kOut) leaves.push_back(cell);
   });
+  const int surface_views = std::max(config.min_views, 2);
   const double margin_m = config.stop_margin_voxels * voxel_m;
   std::vector<Eigen::Vector3i> free;
   std::mutex free_mutex;
@@ -272,11 +275,12 @@ std::vector<Eigen::Vector3i> freeVoxels(const VisualHull& hull,
           cell.index * edge + Eigen::Vector3i(n % edge, n / edge % edge, n / edge / edge);
       const Eigen::Vector3d centre_W =
           cube.origin_W() + (voxel.cast<double>().array() + 0.5).matrix() * voxel_m;
+      const int needed = cell.state == CellState::kIn ? config.min_views : surface_views;
       int empty = 0;
-      for (size_t s = 0; s < surfaces.size() && empty < config.min_views; ++s) {
+      for (size_t s = 0; s < surfaces.size() && empty < needed; ++s) {
         empty += surfaces[s].seesEmpty(centre_W, margin_m) ? 1 : 0;
       }
-      if (empty >= config.min_views && kept.count(pack(voxel)) == 0) found.push_back(voxel);
+      if (empty >= needed && kept.count(pack(voxel)) == 0) found.push_back(voxel);
     }
     if (found.empty()) return;
     std::lock_guard<std::mutex> lock(free_mutex);
