@@ -214,5 +214,11 @@ cv::Size parseSizeOption(const std::string& option, const std::string& text) {
   return {width, height};
 }
 
+std::string numberText(double value) {
+  std::ostringstream out;
+  out << value;
+  return out.str();
+}
+
 }  // namespace cli
 }  // namespace sift_hull

@@ -71,6 +71,9 @@ class ArgParser {
 /// "WIDTHxHEIGHT" as a size; throws UsageError naming `option` ("--size") otherwise.
 cv::Size parseSizeOption(const std::string& option, const std::string& text);
 
+/// A number as an option's default shows it (std::ostream's shortest form: 0.04, 1e-06).
+std::string numberText(double value);
+
 /// validate(config), a bad value reported as a bad command line (UsageError).
 template <typename Config>
 void validateOptions(const Config& config) {

@@ -37,12 +37,6 @@ LensDistortion parseDistortion(const std::string& text) {
   return {values[0], values[1], values[2], values[3], values[4]};
 }
 
-std::string formatNumber(double value) {
-  std::ostringstream out;
-  out << value;
-  return out.str();
-}
-
 std::string joined(const std::vector<std::string>& words) {
   std::string out;
   for (const std::string& word : words) out += (out.empty() ? "" : ", ") + word;
@@ -82,7 +76,7 @@ int runScene(const std::vector<std::string>& args) {
   parser.addOption("layout", "NAME", "camera layout: ring or sphere", defaults.layout);
   parser.addOption("seed", "S", "texture and camera jitter seed", std::to_string(defaults.seed));
   parser.addOption("camera-distance-m", "M", "camera distance from the object's centre in metres",
-                   formatNumber(defaults.camera_distance_m));
+                   numberText(defaults.camera_distance_m));
   parser.addDeprecatedAlias("distance", {"camera-distance-m"});
   parser.addOption("background", "NAME",
                    "what the rays missing the object see: " + joined(sceneBackgrounds()) +

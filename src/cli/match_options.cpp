@@ -10,20 +10,14 @@ namespace sift_hull {
 namespace cli {
 namespace {
 
-std::string text(double value) {
-  std::ostringstream out;
-  out << value;
-  return out.str();
-}
-
 void addSiftOptions(ArgParser* parser) {
   const SiftConfig sift;
   parser->addOption("max-features", "N", "SIFT: keep the N strongest keypoints (0: all)",
-                    text(sift.max_features));
+                    numberText(sift.max_features));
   parser->addOption("contrast-threshold", "T", "SIFT contrast threshold",
-                    text(sift.contrast_threshold));
-  parser->addOption("edge-threshold", "T", "SIFT edge threshold", text(sift.edge_threshold));
-  parser->addOption("sigma-px", "PX", "SIFT base blur in pixels", text(sift.sigma_px));
+                    numberText(sift.contrast_threshold));
+  parser->addOption("edge-threshold", "T", "SIFT edge threshold", numberText(sift.edge_threshold));
+  parser->addOption("sigma-px", "PX", "SIFT base blur in pixels", numberText(sift.sigma_px));
   parser->addDeprecatedAlias("sigma", {"sigma-px"});
   parser->addOption("max-image-pixels", "N", "larger images are refused",
                     std::to_string(sift.max_image_pixels));
@@ -31,7 +25,7 @@ void addSiftOptions(ArgParser* parser) {
 
 void addMatchingOptions(ArgParser* parser) {
   const MatchConfig matching;
-  parser->addOption("ratio", "R", "Lowe's ratio test; 1 turns it off", text(matching.ratio));
+  parser->addOption("ratio", "R", "Lowe's ratio test; 1 turns it off", numberText(matching.ratio));
   parser->addOption("max-descriptor-distance", "D",
                     "largest descriptor distance kept (SIFT descriptors have norm 512)", "inf");
   parser->addDeprecatedAlias("max-distance", {"max-descriptor-distance"});
@@ -43,21 +37,21 @@ void addMatchingOptions(ArgParser* parser) {
 void addFilterOptions(ArgParser* parser) {
   const FilterConfigs filters;
   parser->addOption("max-epipolar-px", "PX", "epipolar: largest point-to-line distance",
-                    text(filters.epipolar.max_epipolar_px));
+                    numberText(filters.epipolar.max_epipolar_px));
   parser->addOption("max-histogram-distance", "D", "gsc: largest histogram distance kept",
-                    text(filters.gsc.max_histogram_distance));
+                    numberText(filters.gsc.max_histogram_distance));
   parser->addDeprecatedAlias("gsc-max-distance", {"max-histogram-distance"});
-  parser->addOption("threads", "N", "gsc: threads (0: all)", text(filters.gsc.threads));
+  parser->addOption("threads", "N", "gsc: threads (0: all)", numberText(filters.gsc.threads));
   parser->addOption("ransac-max-epipolar-px", "PX", "ransac: inlier threshold",
-                    text(filters.ransac.max_epipolar_px));
+                    numberText(filters.ransac.max_epipolar_px));
   parser->addOption("magsac-max-epipolar-px", "PX", "magsac: inlier threshold",
-                    text(filters.magsac.max_epipolar_px));
+                    numberText(filters.magsac.max_epipolar_px));
   parser->addDeprecatedAlias("ransac-px", {"ransac-max-epipolar-px", "magsac-max-epipolar-px"});
   parser->addOption("grid-cells", "N", "gms: grid cells per image side",
-                    text(filters.gms.grid_cells));
+                    numberText(filters.gms.grid_cells));
   parser->addDeprecatedAlias("gms-cells", {"grid-cells"});
   parser->addOption("threshold-factor", "A", "gms: alpha in the cell-pair threshold alpha sqrt(n)",
-                    text(filters.gms.threshold_factor));
+                    numberText(filters.gms.threshold_factor));
   parser->addFlag("with-rotation", "gms: try rotated neighbourhoods");
   parser->addDeprecatedAlias("gms-rotation", {"with-rotation"});
   parser->addFlag("with-scale", "gms: try scaled right grids");

@@ -4,6 +4,7 @@
 #include "refine_options.h"
 
 #include <algorithm>
+#include <chrono>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -23,6 +24,20 @@ namespace sift_hull {
 namespace cli {
 namespace {
 
+/// Milliseconds since the last lap (or the start).
+class Stopwatch {
+ public:
+  double lapMs() {
+    const auto now = std::chrono::steady_clock::now();
+    const double ms = std::chrono::duration<double, std::milli>(now - last_).count();
+    last_ = now;
+    return ms;
+  }
+
+ private:
+  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+};
+
 /// Samples per axis of the comparison with the true solid (--gt-scene).
 constexpr int kSolidSamplesPerAxis = 160;
 /// SIFT's contrast threshold for refinement: lower than SiftConfig's 0.04, for denser points.
@@ -31,12 +46,6 @@ constexpr double kRefineContrastThreshold = 0.04;
 constexpr double kGuidedEpipolarPx = 2.0;
 /// Views each view pairs with under --match-pairs neighbours: its nearest by camera centre.
 constexpr size_t kNeighbours = 2;
-
-std::string number(double value) {
-  std::ostringstream text;
-  text << value;
-  return text.str();
-}
 
 /// (a, b) with a < b: each view with its kNeighbours nearest, or every pair.
 std::vector<std::pair<uint32_t, uint32_t>> viewPairs(const std::vector<PinholeCamera>& cameras,
@@ -74,11 +83,7 @@ std::vector<PairMatches> matchedPairs(const ArgParser& parser, const HullInput& 
   }
   SiftConfig sift;
   sift.contrast_threshold = parser.getDouble("contrast-threshold");
-  try {
-    validate(sift);
-  } catch (const std::invalid_argument& e) {
-    throw UsageError(e.what());
-  }
+  validateOptions(sift);
   MatchConfig matching;
   matching.ratio = parser.getDouble("ratio");
   std::vector<std::optional<Features>> features(input.cameras.size());
@@ -122,11 +127,7 @@ SurfacePointConfig surfacePointConfigFromArgs(const ArgParser& parser) {
   SurfacePointConfig config;
   config.max_reprojection_px = parser.getDouble("max-reprojection-px");
   config.confirm_radius_voxels = parser.getDouble("confirm-radius-voxels");
-  try {
-    validate(config);
-  } catch (const std::invalid_argument& e) {
-    throw UsageError(e.what());
-  }
+  validateOptions(config);
   return config;
 }
 
@@ -138,11 +139,7 @@ FreeSpaceConfig freeSpaceConfigFromArgs(const ArgParser& parser) {
   config.max_slant_deg = parser.getDouble("max-slant-deg");
   config.bulge_fraction = parser.getDouble("bulge-fraction");
   config.keep_radius_voxels = parser.getDouble("keep-radius-voxels");
-  try {
-    validate(config);
-  } catch (const std::invalid_argument& e) {
-    throw UsageError(e.what());
-  }
+  validateOptions(config);
   return config;
 }
 
@@ -172,38 +169,38 @@ void addRefineOptions(ArgParser* parser) {
   parser->addOption("contrast-threshold", "T",
                     "SIFT's contrast threshold for --refine-with-matches (SiftConfig's default: "
                     "0.04; lower finds more features)",
-                    number(kRefineContrastThreshold));
+                    numberText(kRefineContrastThreshold));
   parser->addOption("ratio", "R",
                     "Lowe's ratio among a keypoint's candidates along its epipolar line "
                     "(--refine-with-matches)",
-                    number(MatchConfig{}.ratio));
+                    numberText(MatchConfig{}.ratio));
   parser->addOption("max-reprojection-px", "PX",
                     "largest reprojection error of a surface point in either view",
-                    number(points.max_reprojection_px));
+                    numberText(points.max_reprojection_px));
   parser->addOption(
       "confirm-radius-voxels", "V",
       "points of two pairs sharing a feature confirm each other this close (finest voxels)",
-      number(points.confirm_radius_voxels));
+      numberText(points.confirm_radius_voxels));
   parser->addOption("stop-margin-voxels", "V",
                     "a voxel is empty for a view when this many voxels (plus two depth sigmas) in "
                     "front of the surface of its points",
-                    number(free.stop_margin_voxels));
+                    numberText(free.stop_margin_voxels));
   parser->addOption("min-views", "N", "views that must see a voxel empty before it is free",
                     std::to_string(free.min_views));
   parser->addOption("max-edge-fraction", "F",
                     "longest triangle of a view's surface of points, as a fraction of the cube's "
                     "edge",
-                    number(free.max_edge_fraction));
+                    numberText(free.max_edge_fraction));
   parser->addOption("max-slant-deg", "DEG",
                     "largest angle between a triangle's normal and the line of sight to it",
-                    number(free.max_slant_deg));
+                    numberText(free.max_slant_deg));
   parser->addOption("bulge-fraction", "F",
                     "margin added per triangle, as a fraction of its longest edge (the surface "
                     "may bulge towards the camera between points)",
-                    number(free.bulge_fraction));
+                    numberText(free.bulge_fraction));
   parser->addOption("keep-radius-voxels", "V",
                     "voxels this close to a surface point are never free",
-                    number(free.keep_radius_voxels));
+                    numberText(free.keep_radius_voxels));
   parser->addOption("gt-scene", "DIR",
                     "a scene `sift_hull scene` rendered: compare the hull with its true solid "
                     "(volume IoU, and with --refine-with-matches before and after, false carving)");
@@ -226,14 +223,28 @@ nlohmann::json refineWithMatches(const ArgParser& parser, const HullInput& input
   if (refine) {
     const SurfacePointConfig point_config = surfacePointConfigFromArgs(parser);
     const FreeSpaceConfig free_config = freeSpaceConfigFromArgs(parser);
+    const ReprojectionIoU iou_before = reprojectionIoU(result->mesh, result->hull.views());
+    json["reprojection_iou_before"] = {{"min", iou_before.min}, {"mean", iou_before.mean}};
+    Stopwatch watch;
     const std::vector<PairMatches> pairs = matchedPairs(parser, input);
+    const double matching_ms = watch.lapMs();
     SurfacePointCounts counts;
     const std::vector<SurfacePoint> points =
         surfacePoints(input.cameras, pairs, result->hull, point_config, &counts);
+    const double points_ms = watch.lapMs();
     const double before_m3 = result->hull.stats().occupied_volume_m3;
-    result->hull.carveFree(freeVoxels(result->hull, input.cameras, points, free_config));
+    const std::vector<Eigen::Vector3i> free =
+        freeVoxels(result->hull, input.cameras, points, free_config);
+    const double free_ms = watch.lapMs();
+    result->hull.carveFree(free);
+    const double carve_ms = watch.lapMs();
     result->mesh = result->hull.mesh();
     result->mesh_check = checkMesh(result->mesh);
+    json["refine_time_ms"] = {{"matching", matching_ms},
+                              {"points", points_ms},
+                              {"free_voxels", free_ms},
+                              {"carving", carve_ms},
+                              {"mesh", watch.lapMs()}};
     size_t matches = 0;
     for (const PairMatches& pair : pairs) matches += pair.left_px.size();
     json["points"] = {{"pairs", pairs.size()},
