@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
+#include <map>
 #include <sstream>
 #include <thread>
 
@@ -88,10 +89,11 @@ struct DatasetRuns {
   std::vector<DepthRun> depths;
   /// Of a separate `sift_hull hull --max-depth 9` process: through buildHull, and in all.
   double peak_mib_depth9 = 0.0, command_peak_mib_depth9 = 0.0;
+  nlohmann::json refinement;  ///< refinementAtDepth8
 };
 
 DatasetRuns benchDataset(const HullInput& input, const std::string& name) {
-  DatasetRuns runs{name, input.names.size(), {}, 0.0, 0.0};
+  DatasetRuns runs{name, input.names.size(), {}, 0.0, 0.0, {}};
   for (int depth : kDepths) {
     std::optional<HullResult> last;
     runs.depths.push_back(timeHull(input, depth, &last));
@@ -100,12 +102,12 @@ DatasetRuns benchDataset(const HullInput& input, const std::string& name) {
   return runs;
 }
 
-/// Peak memory of the `hull` command at depth 9, run as a child process so that nothing else of
-/// this benchmark counts: {"through_hull": loading, silhouettes and buildHull, "total": also the
-/// OctoMap, the IoU and the outputs}.
-nlohmann::json hullCommandPeakMiB(const std::string& directory, const HullDataset& dataset) {
+/// `sift_hull hull --json` on a data set as a child process (so that nothing else of this
+/// benchmark counts), with `extra` options; its JSON.
+nlohmann::json hullCommand(const std::string& directory, const HullDataset& dataset,
+                           const std::string& extra) {
   const std::string self = std::filesystem::read_symlink("/proc/self/exe").string();
-  std::string command = "'" + self + "' hull --max-depth 9 --json --threshold " +
+  std::string command = "'" + self + "' hull --json " + extra + " --threshold " +
                         std::to_string(dataset.threshold) + " --calib '" + directory + "/" +
                         dataset.calibration + "' --images '" + directory + "'";
   if (!dataset.view_list.empty())
@@ -116,7 +118,33 @@ nlohmann::json hullCommandPeakMiB(const std::string& directory, const HullDatase
   char buffer[4096];
   while (size_t read = fread(buffer, 1, sizeof buffer, pipe)) output.append(buffer, read);
   if (pclose(pipe) != 0) throw std::runtime_error("failed: " + command);
-  return nlohmann::json::parse(output).at("peak_memory_mib");
+  return nlohmann::json::parse(output);
+}
+
+/// Peak memory of the `hull` command at depth 9: {"through_hull": loading, silhouettes and
+/// buildHull, "total": also the OctoMap, the IoU and the outputs}.
+nlohmann::json hullCommandPeakMiB(const std::string& directory, const HullDataset& dataset) {
+  return hullCommand(directory, dataset, "--max-depth 9").at("peak_memory_mib");
+}
+
+/// The stages of `hull --max-depth 8 --refine-with-matches` (median of 3 runs, ms), with the
+/// hull's own total beside them, the points kept and the reprojection IoU before and after.
+nlohmann::json refinementAtDepth8(const std::string& directory, const HullDataset& dataset) {
+  std::map<std::string, std::vector<double>> stages;
+  nlohmann::json last;
+  for (int run = 0; run < 3; ++run) {
+    last = hullCommand(directory, dataset, "--max-depth 8 --refine-with-matches");
+    for (const auto& [stage, ms] : last.at("refine_time_ms").items()) {
+      stages[stage].push_back(ms.get<double>());
+    }
+    stages["hull"].push_back(last.at("time_ms").at("total").get<double>());
+  }
+  nlohmann::json json = {{"points_kept", last.at("points").at("kept")},
+                         {"carved_volume_m3", last.at("carved_volume_m3")},
+                         {"reprojection_iou_before", last.at("reprojection_iou_before")},
+                         {"reprojection_iou_after", last.at("reprojection_iou")}};
+  for (auto& [stage, values] : stages) json["time_ms"][stage] = median(values);
+  return json;
 }
 
 nlohmann::json depthJson(const DepthRun& run) {
@@ -177,8 +205,9 @@ nlohmann::json targetsJson(const std::vector<DatasetRuns>& all) {
 
 std::string markdownReport(const std::vector<DatasetRuns>& all, const nlohmann::json& targets) {
   std::ostringstream out;
-  out << "Written by `sift_hull bench-hull --write docs/BENCHMARKS.md` on " << todayUtc() << ", "
-      << std::thread::hardware_concurrency() << " hardware threads, 2 carving threads. Times are "
+  out << "Written by `sift_hull bench-hull --write docs/BENCHMARKS.md` on " << todayUtc()
+      << ", CPU " << cpuModel() << " (/proc/cpuinfo), " << std::thread::hardware_concurrency()
+      << " hardware threads, 2 carving threads. Times are "
       << "medians of at least 3 runs (dense carving: at least 1, more within 3 s).\n\n"
       << markdownTable(all) << "\nPeak resident memory of `sift_hull hull --max-depth 9`, through "
       << "the hull (images, silhouettes, distance maps, octree, mesh) / the whole command (also "
@@ -187,7 +216,24 @@ std::string markdownReport(const std::vector<DatasetRuns>& all, const nlohmann::
     out << ' ' << runs.name << ' ' << fixed(runs.peak_mib_depth9, 0) << " / "
         << fixed(runs.command_peak_mib_depth9, 0) << " MiB;";
   }
-  out << "\n\n" << targetsMarkdown(targets);
+  out << "\n\n`sift_hull hull --max-depth 8 --refine-with-matches` (free-space carving from the "
+         "filtered matches of neighbouring views; README), median of 3 runs:\n\n"
+      << "| data | hull | matching | points | free voxels | carving | mesh | points kept | "
+         "reproj. IoU min before / after |\n| --- | --- | --- | --- | --- | --- | --- | --- | "
+         "--- |\n";
+  for (const DatasetRuns& runs : all) {
+    const nlohmann::json& r = runs.refinement;
+    const nlohmann::json& t = r.at("time_ms");
+    out << "| " << runs.name << " | " << fixed(t.at("hull").get<double>(), 0) << " ms | "
+        << fixed(t.at("matching").get<double>(), 0) << " ms | "
+        << fixed(t.at("points").get<double>(), 0) << " ms | "
+        << fixed(t.at("free_voxels").get<double>(), 0) << " ms | "
+        << fixed(t.at("carving").get<double>(), 0) << " ms | "
+        << fixed(t.at("mesh").get<double>(), 0) << " ms | " << r.at("points_kept") << " | "
+        << fixed(r.at("reprojection_iou_before").at("min").get<double>(), 4) << " / "
+        << fixed(r.at("reprojection_iou_after").at("min").get<double>(), 4) << " |\n";
+  }
+  out << "\n" << targetsMarkdown(targets);
   return out.str();
 }
 
@@ -202,7 +248,8 @@ int reportBench(const ArgParser& parser, const std::vector<DatasetRuns>& all,
                                 {"views", runs.views},
                                 {"depths", depths},
                                 {"depth9_peak_mib", runs.peak_mib_depth9},
-                                {"depth9_command_peak_mib", runs.command_peak_mib_depth9}});
+                                {"depth9_command_peak_mib", runs.command_peak_mib_depth9},
+                                {"refinement_depth8", runs.refinement}});
   }
   std::string report = all.empty() ? "" : markdownReport(all, json["targets"]);
   if (parser.has("write") && !all.empty()) {
@@ -225,7 +272,8 @@ int reportBench(const ArgParser& parser, const std::vector<DatasetRuns>& all,
 int runBenchHull(const std::vector<std::string>& args) {
   ArgParser parser("bench-hull",
                    "Times the visual hull (distance transforms, LP box, octree, mesh) on dino and\n"
-                   "temple at depths 7, 8, 9 against dense voxel carving at the same resolution,\n"
+                   "temple at depths 7, 8, 9 against dense voxel carving at the same resolution\n"
+                   "(and, at depth 8, refined with the matches of neighbouring views),\n"
                    "and on 120 rendered views of 4000x3000 at depth 9 with reduced and with\n"
                    "full-resolution distance maps.");
   parser.addOption("data", "DIR", "data root (default: $SIFT_HULL_DATA or ../shared/data)");
@@ -272,6 +320,7 @@ int runBenchHull(const std::vector<std::string>& args) {
     const nlohmann::json peak = hullCommandPeakMiB(directory, dataset);
     all.back().peak_mib_depth9 = peak.at("through_hull").get<double>();
     all.back().command_peak_mib_depth9 = peak.at("total").get<double>();
+    all.back().refinement = refinementAtDepth8(directory, dataset);
   }
   return reportBench(parser, all, synthetic);
 }

