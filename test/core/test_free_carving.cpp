@@ -2,13 +2,16 @@
 // the mesh closes around the cavity they make.
 
 #include <gtest/gtest.h>
+#include <octomap/OcTree.h>
 
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <sstream>
 
 #include "common/test_data.h"
 #include "sift_hull/hull/hull_config.h"
+#include "sift_hull/hull/hull_octomap.h"
 #include "sift_hull/hull/hull_pipeline.h"
 #include "sift_hull/hull/hull_view.h"
 #include "sift_hull/hull/mesh.h"
@@ -96,6 +99,18 @@ TEST_F(FreeCarving, TheCavityLeavesTheHullExactlyAndTheMeshClosesAroundIt) {
         (v.cast<double>().array() + 0.5).matrix() * hull.cube().resolution_m;
     EXPECT_EQ(hull.leafAt(centre).state, CellState::kOut);
   }
+  // The OctoMap holds the cavity as free space; its compact writer agrees byte for byte.
+  const std::unique_ptr<octomap::OcTree> tree = toOctomap(hull);
+  for (const Eigen::Vector3i& v : {voxels.front(), voxels.back()}) {
+    const Eigen::Vector3d c = hull.cube().origin_W() +
+                              (v.cast<double>().array() + 0.5).matrix() * hull.cube().resolution_m;
+    const octomap::OcTreeNode* node = tree->search(c.x(), c.y(), c.z());
+    ASSERT_NE(node, nullptr);
+    EXPECT_FALSE(tree->isNodeOccupied(node));
+  }
+  std::stringstream reference;
+  writeOctomapBinaryData(*tree, reference);
+  EXPECT_TRUE(compactOctomap(hull).binary_data == reference.str());
   const TriangleMesh mesh = hull.mesh();
   const MeshCheck check = checkMesh(mesh);
   EXPECT_TRUE(check.watertight) << check.boundary_edges << " boundary edges";
