@@ -164,5 +164,45 @@ TEST(OctomapServices, HaveOctomapMsgsMd5sums) {
                "9a45536b45c5e409cd49f04bb2d9999f");
 }
 
+TEST(SurfacePointsMessage, RoundTripsIntoTheWorldAndRefusesBadMessages) {
+  const Eigen::Matrix3d K = (Eigen::Matrix3d() << 500, 0, 320, 0, 500, 240, 0, 0, 1).finished();
+  const PinholeCamera left(K, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero());
+  const PinholeCamera right(K, Eigen::Matrix3d::Identity(), Eigen::Vector3d(-0.2, 0.0, 0.0));
+  std::vector<SurfacePoint> points(2);
+  points[0].X_W = Eigen::Vector3d(0.1, 0.2, 2.0), points[0].reprojection_px = 0.3;
+  points[1].X_W = Eigen::Vector3d(-0.3, 0.0, 3.0), points[1].reprojection_px = 0.0;
+  const sift_hull::SurfacePoints message =
+      rc::surfacePointsMessage(mapHeader(), left, right, points);
+  // The message's frame 1 m along the world's x and turned 90 degrees about z.
+  Eigen::Isometry3d T_W_F = Eigen::Isometry3d::Identity();
+  T_W_F.linear() = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  T_W_F.translation() = Eigen::Vector3d(1.0, 0.0, 0.0);
+  PinholeCamera l, r;
+  std::vector<SurfacePoint> read;
+  std::string why_not;
+  ASSERT_TRUE(rc::surfacePointsFromMessage(message, T_W_F, &l, &r, &read, &why_not)) << why_not;
+  ASSERT_EQ(read.size(), 2u);
+  for (size_t i = 0; i < 2; ++i) {
+    EXPECT_LT((read[i].X_W - T_W_F * points[i].X_W).norm(), 1e-9);
+    EXPECT_FLOAT_EQ(read[i].reprojection_px, points[i].reprojection_px);
+    EXPECT_EQ(read[i].views, std::vector<uint32_t>({0, 1}));
+    EXPECT_GT(read[i].depth_sigma_m, 0.0);
+    // Each camera sees the world point where the original saw the point in the frame.
+    EXPECT_LT((l.project(read[i].X_W) - left.project(points[i].X_W)).norm(), 1e-6);
+    EXPECT_LT((r.project(read[i].X_W) - right.project(points[i].X_W)).norm(), 1e-6);
+  }
+  sift_hull::SurfacePoints short_errors = message, nan = message, zero_k = message, bad_r = message,
+                           negative = message;
+  short_errors.reprojection_px.pop_back();
+  nan.points[1].z = std::nan("");
+  zero_k.left_K.fill(0.0);
+  bad_r.right_R[0] = 2.0;
+  negative.reprojection_px[0] = -1.0f;
+  for (const sift_hull::SurfacePoints* bad : {&short_errors, &nan, &zero_k, &bad_r, &negative}) {
+    EXPECT_FALSE(rc::surfacePointsFromMessage(*bad, T_W_F, &l, &r, &read, &why_not));
+    EXPECT_FALSE(why_not.empty());
+  }
+}
+
 }  // namespace
 }  // namespace sift_hull

@@ -313,6 +313,28 @@ TEST_F(CalibratedMatcherTest, FiltersByEpipolarLinesAndTriangulatesOntoTheScene)
   const size_t points = agreement.points, on_surface = agreement.on_surface;
   ASSERT_GE(points, 20u);
   EXPECT_GE(static_cast<double>(on_surface) / points, 0.9);
+
+  // surface_points (for the hull node): the same points with both cameras, in the left frame,
+  // published once someone listens.
+  sift_hull::SurfacePointsConstPtr surface;
+  ros::Subscriber surface_sub = nh_.subscribe<sift_hull::SurfacePoints>(
+      "surface_points", 5, [&](const sift_hull::SurfacePointsConstPtr& m) { surface = m; });
+  ASSERT_TRUE(waitFor([&] { return surface_sub.getNumPublishers() > 0; }));
+  const ros::Time again = publishCalibratedPair();
+  ASSERT_TRUE(waitFor([&] { return surface && surface->header.stamp == again; }))
+      << "no surface_points";
+  EXPECT_EQ(surface->header.frame_id, "left");
+  PinholeCamera left, right;
+  std::vector<SurfacePoint> surface_points;
+  std::string why_not;
+  ASSERT_TRUE(ros_conversions::surfacePointsFromMessage(*surface, Eigen::Isometry3d::Identity(),
+                                                        &left, &right, &surface_points, &why_not))
+      << why_not;
+  EXPECT_EQ(surface_points.size(), static_cast<size_t>(points_->width) * points_->height);
+  EXPECT_LT((left.centre()).norm(), 1e-9);  // the left camera at the left frame's origin
+  size_t small_error = 0;
+  for (const SurfacePoint& p : surface_points) small_error += p.reprojection_px < 1.0 ? 1 : 0;
+  EXPECT_GE(small_error, 0.9 * surface_points.size());
 }
 
 /// image_pipeline's lazy subscription: the images are subscribed only while someone listens to

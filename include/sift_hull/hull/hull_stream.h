@@ -87,6 +87,11 @@ class HullStream {
   const Box3d& box() const { return box_; }
   /// How often the hull was carved again in a smaller box since the start or the last reset.
   size_t refits() const { return refits_; }
+  /// Changes whenever the tree starts again (a first box, a refit, the views carved anew): free
+  /// voxels carved into the old tree are gone then.
+  uint64_t hullGeneration() const { return hull_generation_; }
+  /// Free-space carving of the hull (VisualHull::carveFree). Requires hasHull().
+  void carveFree(const std::vector<Eigen::Vector3i>& voxels) { hull_->carveFree(voxels); }
   /// Why the waiting views give no box yet (empty when there is a hull).
   const std::string& whyNoBox() const { return why_no_box_; }
 
@@ -118,6 +123,7 @@ class HullStream {
   std::vector<Arrival> waiting_;
   std::unique_ptr<VisualHull> hull_;
   Box3d box_;  ///< the hull's
+  uint64_t hull_generation_ = 0;
   size_t refits_ = 0;
   std::string why_no_box_ = "no view yet";
 };

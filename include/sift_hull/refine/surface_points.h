@@ -51,6 +51,17 @@ struct SurfacePointCounts {
   size_t kept = 0;          ///< confirmed, or seen by one pair only (nothing to contradict them)
 };
 
+/// One pair's matches triangulated (DLT on ideal pixels), in the cameras' frame, each with its
+/// reprojection error, depth sigma and the pair's two views (left_view, right_view); matches at
+/// infinity or behind a camera are left out. Throws std::invalid_argument for vectors of
+/// different lengths.
+std::vector<SurfacePoint> triangulatePair(const PinholeCamera& left, const PinholeCamera& right,
+                                          const PairMatches& pair);
+
+/// The depth sigma of a point seen by two cameras with a reprojection error (SurfacePoint).
+double depthSigma(const PinholeCamera& a, const PinholeCamera& b, const Eigen::Vector3d& X,
+                  double reprojection_px);
+
 /// Triangulates every pair's matches (DLT on ideal pixels) and keeps the points that are
 /// consistent: small reprojection errors, inside the hull, and where more than two views see the
 /// feature (its keypoint matched in more than one pair), confirmed by another pair's point of it

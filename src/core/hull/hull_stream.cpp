@@ -179,6 +179,7 @@ void HullStream::refitBox() {
   }
   if (refitted->isEmpty()) return;
   hull_ = std::move(refitted);
+  ++hull_generation_;
   box_ = tighter;
   ++refits_;
 }
@@ -235,6 +236,7 @@ void HullStream::dropViewMissingTheOthers() {
 /// it to nothing, they are added again one by one (addToHull) to refuse the ones that do.
 void HullStream::startHull(const Box3d& box) {
   hull_ = std::make_unique<VisualHull>(box, config_.hull);
+  ++hull_generation_;
   box_ = box;
   std::vector<Arrival> joining;
   for (Arrival& arrival : waiting_) {
@@ -251,6 +253,7 @@ void HullStream::startHull(const Box3d& box) {
   hull_->addViews(std::move(views));
   if (hull_->isEmpty()) {
     hull_->reset();
+    ++hull_generation_;
     for (Arrival& arrival : joining) addToHull(std::move(arrival));
   }
   if (hull_->views().empty()) {  // every view refused: the next views bound a box afresh

@@ -34,13 +34,7 @@ std::optional<Candidate> triangulated(const PinholeCamera& left, const PinholeCa
   point.X_W = *X;
   point.reprojection_px =
       std::max((left.project(*X) - left_px).norm(), (right.project(*X) - right_px).norm());
-  const Eigen::Vector3d ray_left = (*X - left.centre()).normalized();
-  const Eigen::Vector3d ray_right = (*X - right.centre()).normalized();
-  const double sine = std::max(ray_left.cross(ray_right).norm(), kMinRaySine);
-  const double focal_px =
-      0.25 * (left.K()(0, 0) + left.K()(1, 1) + right.K()(0, 0) + right.K()(1, 1));
-  const double depth_m = std::max(left.depth(*X), right.depth(*X));
-  point.depth_sigma_m = std::max(point.reprojection_px, 0.5) * depth_m / focal_px / sine;
+  point.depth_sigma_m = depthSigma(left, right, *X, point.reprojection_px);
   return candidate;
 }
 
@@ -69,6 +63,34 @@ void checkPairs(const std::vector<PinholeCamera>& cameras, const std::vector<Pai
 }
 
 }  // namespace
+
+double depthSigma(const PinholeCamera& a, const PinholeCamera& b, const Eigen::Vector3d& X,
+                  double reprojection_px) {
+  const Eigen::Vector3d ray_a = (X - a.centre()).normalized();
+  const Eigen::Vector3d ray_b = (X - b.centre()).normalized();
+  const double sine = std::max(ray_a.cross(ray_b).norm(), kMinRaySine);
+  const double focal_px = 0.25 * (a.K()(0, 0) + a.K()(1, 1) + b.K()(0, 0) + b.K()(1, 1));
+  const double depth_m = std::max(a.depth(X), b.depth(X));
+  return std::max(reprojection_px, 0.5) * depth_m / focal_px / sine;
+}
+
+std::vector<SurfacePoint> triangulatePair(const PinholeCamera& left, const PinholeCamera& right,
+                                          const PairMatches& pair) {
+  if (pair.left_px.size() != pair.right_px.size()) {
+    throw std::invalid_argument("triangulatePair: " + std::to_string(pair.left_px.size()) +
+                                " left and " + std::to_string(pair.right_px.size()) +
+                                " right pixels");
+  }
+  std::vector<SurfacePoint> points;
+  for (size_t m = 0; m < pair.left_px.size(); ++m) {
+    const std::optional<Candidate> candidate =
+        triangulated(left, right, pair.left_px[m], pair.right_px[m], 0);
+    if (!candidate) continue;
+    points.push_back(candidate->point);
+    points.back().views = {pair.left_view, pair.right_view};
+  }
+  return points;
+}
 
 void validate(const SurfacePointConfig& config) {
   if (!(config.max_reprojection_px > 0.0) || !std::isfinite(config.max_reprojection_px)) {

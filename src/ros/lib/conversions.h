@@ -19,12 +19,14 @@
 #include "sift_hull/Correspondences.h"
 #include "sift_hull/Keypoint.h"
 #include "sift_hull/Octomap.h"
+#include "sift_hull/SurfacePoints.h"
 #include "sift_hull/features/matching.h"
 #include "sift_hull/filters/filter.h"
 #include "sift_hull/geometry/camera.h"
 #include "sift_hull/hull/bounding_box.h"
 #include "sift_hull/hull/hull_octomap.h"
 #include "sift_hull/hull/mesh.h"
+#include "sift_hull/refine/surface_points.h"
 
 namespace octomap {
 class OcTree;
@@ -182,6 +184,21 @@ sift_hull::Correspondences correspondencesMessage(const std_msgs::Header& left_h
 /// The matching and filter settings as the JSON object of Correspondences.filter_settings, keyed
 /// by the names of their ROS parameters (the config fields; ransac_ / magsac_ for RobustFitConfig).
 std::string settingsJson(const MatchConfig& matching, const FilterConfigs& filters);
+
+/// A pair's surface points (triangulatePair) and its two cameras (lens distortion dropped: the
+/// message's cameras are pinhole), in the header's frame.
+sift_hull::SurfacePoints surfacePointsMessage(const std_msgs::Header& header,
+                                              const PinholeCamera& left, const PinholeCamera& right,
+                                              const std::vector<SurfacePoint>& points);
+
+/// A SurfacePoints message taken into the world frame by T_W_F (the message's frame in the world):
+/// its two cameras, and its points with views 0 (left) and 1 (right), their depth sigma from the
+/// cameras. False, with `why_not`, for arrays of different lengths, a value that is not finite, a
+/// negative reprojection error, or a camera PinholeCamera refuses (K, R).
+bool surfacePointsFromMessage(const sift_hull::SurfacePoints& message,
+                              const Eigen::Isometry3d& T_W_F, PinholeCamera* left,
+                              PinholeCamera* right, std::vector<SurfacePoint>* points,
+                              std::string* why_not);
 
 }  // namespace ros_conversions
 }  // namespace sift_hull

@@ -294,10 +294,39 @@ HullNodeConfig readHullNodeConfig(const ros::NodeHandle& private_nh) {
   read(private_nh, "rectified", &config.rectified);
   config.diagnostic_period = readDiagnosticPeriod(private_nh, config.diagnostic_period);
   config.recipe = readSilhouetteConfig(private_nh);
+  read(private_nh, "max_surface_points", &config.max_surface_points);
+  read(private_nh, "refine_period_s", &config.refine_period_s);
+  config.surface_points = readSurfacePointConfig(private_nh);
+  config.free_space = readFreeSpaceConfig(private_nh);
+  if (config.max_surface_points < 1) {
+    throw std::invalid_argument("~max_surface_points must be at least 1");
+  }
+  if (!(config.refine_period_s > 0.0) || !std::isfinite(config.refine_period_s)) {
+    throw std::invalid_argument("~refine_period_s must be a number > 0");
+  }
   if (config.queue_size < 1) throw std::invalid_argument("~queue_size must be at least 1");
   if (!std::isfinite(config.pose_timeout_s)) {
     throw std::invalid_argument("~pose_timeout_s must be a number");
   }
+  return config;
+}
+
+FreeSpaceConfig readFreeSpaceConfig(const ros::NodeHandle& private_nh) {
+  FreeSpaceConfig config;
+  read(private_nh, "stop_margin_voxels", &config.stop_margin_voxels);
+  read(private_nh, "min_views", &config.min_views);
+  read(private_nh, "keep_radius_voxels", &config.keep_radius_voxels);
+  read(private_nh, "max_edge_fraction", &config.max_edge_fraction);
+  read(private_nh, "max_slant_deg", &config.max_slant_deg);
+  read(private_nh, "bulge_fraction", &config.bulge_fraction);
+  validate(config);
+  return config;
+}
+
+SurfacePointConfig readSurfacePointConfig(const ros::NodeHandle& private_nh) {
+  SurfacePointConfig config;
+  read(private_nh, "max_reprojection_px", &config.max_reprojection_px);
+  validate(config);
   return config;
 }
 

@@ -25,6 +25,8 @@
 #include "sift_hull/hull/hull_stream.h"
 #include "sift_hull/hull/silhouette.h"
 #include "sift_hull/io/calibration.h"
+#include "sift_hull/refine/free_space.h"
+#include "sift_hull/refine/surface_points.h"
 
 namespace sift_hull {
 namespace ros_params {
@@ -84,10 +86,19 @@ MatcherNodeConfig readMatcherNodeConfig(const ros::NodeHandle& private_nh);
 /// readMatcherNodeConfig, readSiftConfig, readMatchConfig and readFilterConfigs.
 MatcherSettings readMatcherSettings(const ros::NodeHandle& private_nh);
 
-/// ~world_frame, ~queue_size, ~pose_timeout_s, ~from_image, ~diagnostic_period and the
-/// silhouette recipe. octomap_server's ~frame_id is read as ~world_frame; set with a different
-/// ~world_frame, it is an error (std::invalid_argument naming both).
+/// ~world_frame, ~queue_size, ~pose_timeout_s, ~from_image, ~diagnostic_period, the
+/// silhouette recipe, ~max_surface_points, ~refine_period_s and the free-space readers.
+/// octomap_server's ~frame_id is read as ~world_frame; set with a different ~world_frame, it is an
+/// error (std::invalid_argument naming both).
 HullNodeConfig readHullNodeConfig(const ros::NodeHandle& private_nh);
+
+/// ~stop_margin_voxels, ~min_views, ~keep_radius_voxels, ~max_edge_fraction, ~max_slant_deg,
+/// ~bulge_fraction; throws std::invalid_argument for a value FreeSpaceConfig refuses.
+FreeSpaceConfig readFreeSpaceConfig(const ros::NodeHandle& private_nh);
+
+/// ~max_reprojection_px (confirm_radius_voxels confirms points by feature tracks across pairs,
+/// which a SurfacePoints message does not carry: the node leaves it at its default).
+SurfacePointConfig readSurfacePointConfig(const ros::NodeHandle& private_nh);
 
 /// ~bag, ~out_dir (both required: throws std::invalid_argument without them),
 /// ~hull_save_service, ~timeout_s.

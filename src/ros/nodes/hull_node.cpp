@@ -81,6 +81,8 @@ HullNode::HullNode(ros::NodeHandle nh, ros::NodeHandle private_nh, HullNodeConfi
       sync_(config_.queue_size) {
   pose_timer_ = nh_.createWallTimer(ros::WallDuration(0.2),
                                     [this](const ros::WallTimerEvent&) { reportPoseTimeouts(); });
+  refine_timer_ = nh_.createWallTimer(ros::WallDuration(config_.refine_period_s),
+                                      [this](const ros::WallTimerEvent&) { refineIfDue(); });
   advertiseServices();
   subscribe();
 }
@@ -98,6 +100,8 @@ void HullNode::subscribe() {
   pose_gate_.connectInput(pose_filter_);
   sync_.connectInput(pose_gate_, info_sub_);
   sync_.registerCallback(&HullNode::onView, this);
+  surface_points_sub_ = nh_.subscribe("surface_points", static_cast<uint32_t>(config_.queue_size),
+                                      &HullNode::onSurfacePoints, this);
   // camera_info beside the image, wherever remapping put it (image_transport's convention).
   const std::string image_topic = nh_.resolveName(config_.from_image ? "image" : "silhouette");
   info_sub_.subscribe(nh_, image_transport::getCameraInfoTopic(image_topic), config_.queue_size);
@@ -182,6 +186,10 @@ void HullNode::integrate(View& view) {
   redundant_views_ = stream_.redundantViews();
   last_view_stamp_ = view.stamp.toSec();
   if (changed) unpublished_stamp_ = view.stamp;
+  if (stream_.hasHull() && stream_.hullGeneration() != refined_generation_) {
+    std::lock_guard<std::mutex> points_lock(points_mutex_);
+    refine_pending_ = refine_pending_ || !pairs_.empty();  // the points carve the new tree too
+  }
   // Waiting, skipped or redundant: the published hull stands. Views queued behind this one refine
   // the hull at once: each state would cost a conversion the next view replaces, so the hull is
   // published when the queue has drained, or kMaxPublishDelay_s after the last publication under
@@ -204,6 +212,7 @@ void HullNode::reportDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& st
   reportQueue(work_.counts(), "views", &status);
   status.add("views redundant", redundant_views_.load());
   status.add("views refused", refused_views_.load());
+  status.add("free voxels (surface_points)", free_voxels_.load());
   status.add("last view carve ms", last_carve_ms_.load());
   status.add("last view publish ms", last_publish_ms_.load());
   status.add("last view stamp", last_view_stamp_.load());
@@ -254,6 +263,13 @@ bool HullNode::reset(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
                               : octree_         ? octree_->getResolution()
                                                 : 0.1;
   stream_.reset();
+  {
+    std::lock_guard<std::mutex> points_lock(points_mutex_);
+    pairs_.clear();
+    stored_points_ = 0;
+    refine_pending_ = false;
+  }
+  free_voxels_ = 0;
   unpublished_stamp_ = ros::Time();
   cleared_boxes_.clear();
   refused_views_ = 0;

@@ -13,6 +13,7 @@
 #include <tf2_ros/transform_listener.h>
 
 #include <atomic>
+#include <deque>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -28,11 +29,14 @@
 #include "sift_hull/BoundingBoxQuery.h"
 #include "sift_hull/GetOctomap.h"
 #include "sift_hull/Save.h"
+#include "sift_hull/SurfacePoints.h"
 #include "sift_hull/hull/bounding_box.h"
 #include "sift_hull/hull/hull_stream.h"
 #include "sift_hull/hull/mesh.h"
 #include "sift_hull/hull/silhouette.h"
 #include "sift_hull/io/calibration.h"
+#include "sift_hull/refine/free_space.h"
+#include "sift_hull/refine/surface_points.h"
 
 namespace sift_hull {
 
@@ -56,6 +60,14 @@ struct HullNodeConfig {
   SilhouetteConfig recipe;
   /// Seconds of wall time between /diagnostics reports (diagnostic_updater's own parameter).
   double diagnostic_period = 1.0;
+  /// Surface points (`surface_points`) kept for free-space carving; beyond, the oldest pairs'
+  /// points are dropped.
+  int max_surface_points = 200000;
+  /// Wall time between refinements with newly arrived surface points, seconds: each one derives
+  /// the free voxels of every point kept anew.
+  double refine_period_s = 1.0;
+  SurfacePointConfig surface_points;  ///< max_reprojection_px (inside the hull is checked too)
+  FreeSpaceConfig free_space;
 };
 
 /// The hull node: silhouettes (mono8) with the camera_info beside them (the silhouette topic's
@@ -136,6 +148,18 @@ class HullNode {
   bool clearBbx(sift_hull::BoundingBoxQuery::Request& request,
                 sift_hull::BoundingBoxQuery::Response& response);
   void advertiseServices();
+  /// Free-space carving (hull_node_refine.cpp): a pair's surface points, taken into the world
+  /// frame by tf and kept (at most max_surface_points); the hull is refined with every point kept
+  /// at most every refine_period_s, and again after the tree starts anew (a refit of the box).
+  void onSurfacePoints(const sift_hull::SurfacePointsConstPtr& message);
+  void refineIfDue();
+  /// Requires hull_mutex_ and a hull.
+  void refineWithPoints();
+  struct PairPoints {
+    PinholeCamera left, right;
+    std::vector<SurfacePoint> points;  ///< views 0 (left) and 1 (right)
+    ros::Time stamp;
+  };
 
   // Destroyed bottom up: subscriptions and services first, then the worker, then what it uses.
   ros::NodeHandle nh_, private_nh_;
@@ -163,7 +187,13 @@ class HullNode {
   PairingWatch pairing_;  ///< silhouettes and camera_infos that arrive but do not pair
   NodeDiagnostics diagnostics_;
   PoseWaits pose_waits_;
-  ros::WallTimer pose_timer_;
+  ros::WallTimer pose_timer_, refine_timer_;
+  std::mutex points_mutex_;       ///< guards pairs_, stored_points_ and refine_pending_
+  std::deque<PairPoints> pairs_;  ///< the surface points kept, oldest first
+  size_t stored_points_ = 0;
+  bool refine_pending_ = false;
+  uint64_t refined_generation_ = 0;  ///< the stream's hull generation last carved with points
+  std::atomic<size_t> free_voxels_{0};
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
   // Subscribed last, once every callback is in place.
@@ -172,6 +202,7 @@ class HullNode {
   tf2_ros::MessageFilter<sensor_msgs::Image> pose_filter_;
   PoseGate pose_gate_;
   Sync sync_;
+  ros::Subscriber surface_points_sub_;
   ros::ServiceServer reset_srv_, save_srv_, binary_srv_, full_srv_, clear_bbx_srv_;
 };
 

@@ -96,14 +96,16 @@ void MatcherNode::advertise() {
   matches_image_pub_ = transport_.advertise("matches_image", 1, image_changed, image_changed);
   if (settings_.node.calibrated) {
     points_pub_ = nh_.advertise<sensor_msgs::PointCloud2>("points", 1, changed, changed);
+    surface_points_pub_ = nh_.advertise<sift_hull::SurfacePoints>(
+        "surface_points", settings_.node.queue_size, changed, changed);
   }
 }
 
 void MatcherNode::onOutputsChanged() {
   std::lock_guard<std::mutex> lock(connect_mutex_);
-  const bool wanted = correspondences_pub_.getNumSubscribers() > 0 ||
-                      points_pub_.getNumSubscribers() > 0 ||
-                      matches_image_pub_.getNumSubscribers() > 0;
+  const bool wanted =
+      correspondences_pub_.getNumSubscribers() > 0 || points_pub_.getNumSubscribers() > 0 ||
+      surface_points_pub_.getNumSubscribers() > 0 || matches_image_pub_.getNumSubscribers() > 0;
   if (wanted == inputs_subscribed_) return;
   try {
     wanted ? subscribeInputs() : unsubscribeInputs();
@@ -385,6 +387,16 @@ void MatcherNode::publishPoints(const std_msgs::Header& header, const StereoCame
                                 const PutativeMatches& matches, const FilterResult& kept) {
   points_pub_.publish(ros_conversions::pointCloudMessage(
       triangulateMatches(cameras.left, cameras.right, matches, kept.keep), header));
+  if (surface_points_pub_.getNumSubscribers() == 0) return;
+  PairMatches pair;
+  pair.left_view = 0, pair.right_view = 1;
+  for (size_t m = 0; m < matches.matches.size(); ++m) {
+    if (!kept.keep[m]) continue;
+    pair.left_px.emplace_back(matches.left(m).pt.x, matches.left(m).pt.y);
+    pair.right_px.emplace_back(matches.right(m).pt.x, matches.right(m).pt.y);
+  }
+  surface_points_pub_.publish(ros_conversions::surfacePointsMessage(
+      header, cameras.left, cameras.right, triangulatePair(cameras.left, cameras.right, pair)));
 }
 
 }  // namespace sift_hull

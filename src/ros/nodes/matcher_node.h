@@ -161,7 +161,7 @@ class MatcherNode {
   image_transport::ImageTransport transport_;
   std::mutex connect_mutex_;  ///< the outputs' connect callbacks against each other
   bool inputs_subscribed_ = false;
-  ros::Publisher correspondences_pub_, points_pub_;
+  ros::Publisher correspondences_pub_, points_pub_, surface_points_pub_;
   image_transport::Publisher matches_image_pub_;
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
