@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <octomap/OcTree.h>
 #include <ros/ros.h>
+#include <rosgraph_msgs/Log.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 #include <tf2_ros/static_transform_broadcaster.h>
@@ -136,6 +137,29 @@ TEST(HullRefineTest, SurfacePointsCarveTheCupsPocketFromTheOctomapAndNothingOfTh
   const double solid_before = occupiedFraction(*rc::octreeFromMessage(*last), lo, hi, solid);
   EXPECT_GT(pocket_before, 0.9) << "the silhouettes' hull should fill the pocket";
   EXPECT_GT(solid_before, 0.98);
+
+  // Bad messages first: each refused with its reason on /rosout, and the node carries on.
+  std::vector<std::string> errors;
+  ros::Subscriber rosout =
+      nh.subscribe<rosgraph_msgs::Log>("/rosout", 50, [&](const rosgraph_msgs::LogConstPtr& log) {
+        if (log->level == rosgraph_msgs::Log::ERROR) errors.push_back(log->msg);
+      });
+  sift_hull::SurfacePoints unknown_frame = exactPairPoints(views[0], views[1], 16);
+  unknown_frame.header.frame_id = "nowhere";
+  sift_hull::SurfacePoints short_errors = exactPairPoints(views[0], views[1], 16);
+  short_errors.reprojection_px.pop_back();
+  sift_hull::SurfacePoints nan_point = exactPairPoints(views[0], views[1], 16);
+  nan_point.points.front().x = std::nan("");
+  for (const auto* bad : {&unknown_frame, &short_errors, &nan_point}) points_pub.publish(*bad);
+  const auto logged = [&](const std::string& part) {
+    return std::any_of(errors.begin(), errors.end(), [&](const std::string& e) {
+      return e.find("surface points ignored") != std::string::npos &&
+             e.find(part) != std::string::npos;
+    });
+  };
+  EXPECT_TRUE(waitFor([&] {
+    return logged("nowhere") && logged("reprojection errors") && logged("not a finite");
+  })) << "no error for each bad SurfacePoints message";
 
   // Each view with its four nearest (camera centres), as a matcher on those pairs would give them.
   for (int v = 0; v < kViews; ++v) {
