@@ -18,6 +18,7 @@
 #include <iostream>
 #include <limits>
 
+#include "hull_node_fixture.h"
 #include "lib/conversions.h"
 #include "ros_wait.h"
 #include "sift_hull/Octomap.h"
@@ -31,22 +32,20 @@ namespace {
 namespace rc = ros_conversions;
 using test::waitFor;
 
-constexpr int kViews = 20;
+constexpr int kCupViews = 20;
 /// Pairs per view: its nearest views. Points are those both views of a pair see, so that each
 /// view's surface of points covers only what it shares with its partners (the pocket's far walls
 /// from the upper views): more partners, more of the pocket (1: 10 %, 4: 27 %, 8: 28 % of it
 /// carved at depth 7, the same points through the core).
 constexpr int kPartners = 4;
 
-std::string frameOf(int view) { return "camera_" + std::to_string(view); }
+using test::frameOf;
 
+/// The hull rostests' scene (320x240, views on a sphere) with the cup and 20 views.
 SceneConfig cupScene() {
-  SceneConfig config;
+  SceneConfig config = test::sphereSceneConfig();
   config.shape = "cup";
-  config.views = kViews;
-  config.layout = "sphere";
-  config.width_px = 320;
-  config.height_px = 240;
+  config.views = kCupViews;
   return config;
 }
 
@@ -101,7 +100,7 @@ TEST(HullRefineTest, SurfacePointsCarveTheCupsPocketFromTheOctomapAndNothingOfTh
   const std::vector<RenderedView> views = renderScene(cupScene());
   tf2_ros::StaticTransformBroadcaster tf;
   std::vector<geometry_msgs::TransformStamped> poses;
-  for (int v = 0; v < kViews; ++v) {
+  for (int v = 0; v < kCupViews; ++v) {
     poses.push_back(rc::cameraPoseMessage(views[v].view.camera, "world", frameOf(v), {}));
   }
   tf.sendTransform(poses);
@@ -116,7 +115,7 @@ TEST(HullRefineTest, SurfacePointsCarveTheCupsPocketFromTheOctomapAndNothingOfTh
            points_pub.getNumSubscribers() > 0;
   })) << "the hull node did not subscribe";
   ros::Time stamp;
-  for (int v = 0; v < kViews; ++v) {
+  for (int v = 0; v < kCupViews; ++v) {
     std_msgs::Header header;
     header.stamp = stamp = ros::Time::now();
     header.frame_id = frameOf(v);
@@ -162,9 +161,9 @@ TEST(HullRefineTest, SurfacePointsCarveTheCupsPocketFromTheOctomapAndNothingOfTh
   })) << "no error for each bad SurfacePoints message";
 
   // Each view with its four nearest (camera centres), as a matcher on those pairs would give them.
-  for (int v = 0; v < kViews; ++v) {
+  for (int v = 0; v < kCupViews; ++v) {
     std::vector<int> others;
-    for (int w = 0; w < kViews; ++w) {
+    for (int w = 0; w < kCupViews; ++w) {
       if (w != v) others.push_back(w);
     }
     const Eigen::Vector3d centre = views[v].view.camera.centre();
