@@ -215,7 +215,7 @@ TEST(HullSustainedTest, PublishesWhileAFasterStreamLastsAndEndsWithTheHullOfAllV
         ros_conversions::cameraInfoMessage(views[v].view.camera, views[v].mask.size(), header));
     silhouette_pub.publish(ros_conversions::imageMessage(views[v].mask, header));
     ros::spinOnce();
-    (start + ros::WallDuration(0.01 * (v + 1)) - ros::WallTime::now()).sleep();
+    sleepUntilWall(start + ros::WallDuration(0.01 * (v + 1)));
   }
   const ros::WallTime end = ros::WallTime::now();
   const size_t during = maps.size();

@@ -83,7 +83,7 @@ void atTenHertz(HullFeed& feed, const ArrivalLog<sift_hull::Octomap>& octomaps,
   const ros::WallTime start = ros::WallTime::now();
   for (int i = 0; i < run->views; ++i) {
     const ros::WallTime due = start + ros::WallDuration(i / 10.0);
-    if (ros::WallTime::now() < due) (due - ros::WallTime::now()).sleep();
+    sleepUntilWall(due);
     sent.emplace_back(ros::WallTime::now(), feed.publish(i));
   }
   run->rate_published = run->views;
@@ -112,7 +112,7 @@ void overload(HullFeed& feed, const DiagnosticsListener& diagnostics, pid_t pid,
   const ros::WallTime start = ros::WallTime::now();
   for (int k = 0; (ros::WallTime::now() - start).toSec() < 5.0; ++k) {
     const ros::WallTime due = start + ros::WallDuration(k / run->overload_hz);
-    if (ros::WallTime::now() < due) (due - ros::WallTime::now()).sleep();
+    sleepUntilWall(due);
     feed.publish(k);
     ++run->overload_published;
     if (k == static_cast<int>(run->overload_hz)) run->rss_first_mib = residentMiB(pid);

@@ -47,7 +47,7 @@ SendTimes streamPairs(MatcherFeed& feed, pid_t pid, double seconds, MatcherRun* 
   const ros::WallTime start = ros::WallTime::now();
   for (int k = 0; (ros::WallTime::now() - start).toSec() < seconds; ++k) {
     const ros::WallTime due = start + ros::WallDuration(k / run->input_hz);
-    if (ros::WallTime::now() < due) (due - ros::WallTime::now()).sleep();
+    sleepUntilWall(due);
     sent[feed.publish(k)] = ros::WallTime::now();
     const double rss = residentMiB(pid);
     if (run->rss_first_mib == 0.0 && (ros::WallTime::now() - start).toSec() > 1.0) {

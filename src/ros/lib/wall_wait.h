@@ -21,4 +21,12 @@ inline bool waitOnWallClock(const std::function<bool()>& done, double seconds, d
   return done();
 }
 
+/// Sleeps until `due` on the wall clock; returns at once when it has passed. (A negative
+/// ros::WallDuration must never be slept: roscpp takes its seconds as unsigned and sleeps for
+/// decades.)
+inline void sleepUntilWall(const ros::WallTime& due) {
+  const ros::WallDuration left = due - ros::WallTime::now();
+  if (left > ros::WallDuration(0.0)) left.sleep();
+}
+
 }  // namespace sift_hull
