@@ -17,6 +17,7 @@
 #include <functional>
 #include <iostream>
 #include <limits>
+#include <memory>
 
 #include "hull_node_fixture.h"
 #include "lib/conversions.h"
@@ -132,8 +133,9 @@ TEST(HullRefineTest, SurfacePointsCarveTheCupsPocketFromTheOctomapAndNothingOfTh
   };
   const auto solid = [&](const Eigen::Vector3d& X) { return cup.contains(X); };
   const Eigen::Vector3d lo(-0.75, -0.75, -0.65), hi(0.75, 0.75, 0.65);
-  const double pocket_before = occupiedFraction(*rc::octreeFromMessage(*last), lo, hi, pocket);
-  const double solid_before = occupiedFraction(*rc::octreeFromMessage(*last), lo, hi, solid);
+  const std::unique_ptr<octomap::OcTree> carved_by_silhouettes = rc::octreeFromMessage(*last);
+  const double pocket_before = occupiedFraction(*carved_by_silhouettes, lo, hi, pocket);
+  const double solid_before = occupiedFraction(*carved_by_silhouettes, lo, hi, solid);
   EXPECT_GT(pocket_before, 0.9) << "the silhouettes' hull should fill the pocket";
   EXPECT_GT(solid_before, 0.98);
 

@@ -6,34 +6,20 @@
 #include <cmath>
 
 #include "hull/octree_node.h"
+#include "hull/voxel_key.h"
 #include "sift_hull/hull/octree.h"
 
 namespace sift_hull {
 namespace {
 
+using detail::inCube;
 using detail::OctreeNode;
 
-constexpr int kKeyBits = 21;  ///< per axis: limits::kMaxHullDepth is below this
-constexpr uint64_t kKeyMask = (uint64_t{1} << kKeyBits) - 1;
 /// f_free at the corners of free voxels, in the silhouettes' units (pixels); the corners next to
 /// them are held no lower than kWallField_px, so that marching cubes puts the cavity's wall a
 /// quarter of a voxel beyond the free voxels (1 / (1 + 3) of the edge).
 constexpr float kFreeField_px = 1.0f;
 constexpr float kWallField_px = -3.0f;
-
-uint64_t pack(const Eigen::Vector3i& v) {
-  return (static_cast<uint64_t>(v.x()) << (2 * kKeyBits)) |
-         (static_cast<uint64_t>(v.y()) << kKeyBits) | static_cast<uint64_t>(v.z());
-}
-
-Eigen::Vector3i unpack(uint64_t key) {
-  return {static_cast<int>(key >> (2 * kKeyBits)), static_cast<int>((key >> kKeyBits) & kKeyMask),
-          static_cast<int>(key & kKeyMask)};
-}
-
-bool inCube(const Eigen::Vector3i& v, int cells) {
-  return (v.array() >= 0).all() && (v.array() < cells).all();
-}
 
 /// The 26 neighbours' offsets.
 const std::array<Eigen::Vector3i, 26>& neighbourOffsets() {
@@ -59,7 +45,7 @@ bool cornerTouchesFree(const std::unordered_set<uint64_t>& free, const Eigen::Ve
                        int cells) {
   for (int c = 0; c < 8; ++c) {
     const Eigen::Vector3i voxel = corner - cornerOffset(c);
-    if (inCube(voxel, cells) && free.count(pack(voxel)) > 0) return true;
+    if (inCube(voxel, cells) && free.count(detail::voxelKey(voxel)) > 0) return true;
   }
   return false;
 }
@@ -85,7 +71,8 @@ void VisualHull::carveFree(const std::vector<Eigen::Vector3i>& voxels) {
   const int cells = 1 << cube_.depth;
   std::vector<Eigen::Vector3i> added;
   for (const Eigen::Vector3i& voxel : voxels) {
-    if (inCube(voxel, cells) && free_.insert(pack(voxel)).second) added.push_back(voxel);
+    if (inCube(voxel, cells) && free_.insert(detail::voxelKey(voxel)).second)
+      added.push_back(voxel);
   }
   // The closure: a voxel all of whose corners touch free voxels has f_free > 0 all over; it is
   // free too. Adding it changes no corner's state, so the closure needs one pass.
@@ -93,12 +80,12 @@ void VisualHull::carveFree(const std::vector<Eigen::Vector3i>& voxels) {
   for (size_t i = 0; i < given; ++i) {
     for (const Eigen::Vector3i& offset : neighbourOffsets()) {
       const Eigen::Vector3i voxel = added[i] + offset;
-      if (!inCube(voxel, cells) || free_.count(pack(voxel)) > 0) continue;
+      if (!inCube(voxel, cells) || free_.count(detail::voxelKey(voxel)) > 0) continue;
       bool enclosed = true;
       for (int c = 0; c < 8 && enclosed; ++c) {
         enclosed = cornerTouchesFree(free_, voxel + cornerOffset(c), cells);
       }
-      if (enclosed && free_.insert(pack(voxel)).second) added.push_back(voxel);
+      if (enclosed && free_.insert(detail::voxelKey(voxel)).second) added.push_back(voxel);
     }
   }
   applyFree(added);
@@ -114,7 +101,7 @@ void VisualHull::applyFree(const std::vector<Eigen::Vector3i>& voxels) {
   for (const Eigen::Vector3i& voxel : voxels) {
     for (const Eigen::Vector3i& offset : neighbourOffsets()) {
       const Eigen::Vector3i neighbour = voxel + offset;
-      if (!inCube(neighbour, cells) || free_.count(pack(neighbour)) > 0) continue;
+      if (!inCube(neighbour, cells) || free_.count(detail::voxelKey(neighbour)) > 0) continue;
       OctreeNode* leaf = finestLeaf(root_.get(), neighbour, cube_.depth);
       if (leaf != nullptr) leaf->state = CellState::kSurface;
     }
@@ -124,7 +111,7 @@ void VisualHull::applyFree(const std::vector<Eigen::Vector3i>& voxels) {
 std::vector<Eigen::Vector3i> VisualHull::freeVoxels() const {
   std::vector<Eigen::Vector3i> voxels;
   voxels.reserve(free_.size());
-  for (const uint64_t key : free_) voxels.push_back(unpack(key));
+  for (const uint64_t key : free_) voxels.push_back(detail::voxelOfKey(key));
   return voxels;
 }
 

@@ -18,14 +18,10 @@
 #include <unordered_set>
 
 #include "common/parallel.h"
+#include "hull/voxel_key.h"
 
 namespace sift_hull {
 namespace {
-
-uint64_t pack(const Eigen::Vector3i& v) {
-  return (static_cast<uint64_t>(v.x()) << 42) | (static_cast<uint64_t>(v.y()) << 21) |
-         static_cast<uint64_t>(v.z());
-}
 
 /// A view's surface as a depth map over the box of its points' ideal pixels.
 struct ViewSurface {
@@ -237,6 +233,7 @@ std::vector<Eigen::Vector3i> freeVoxels(const VisualHull& hull,
   for (SurfacePoint& point : sorted) std::sort(point.views.begin(), point.views.end());
   const HullCube& cube = hull.cube();
   const double voxel_m = cube.resolution_m;
+  const int cells = 1 << cube.depth;
   std::vector<ViewSurface> surfaces;
   for (uint32_t view = 0; view < cameras.size(); ++view) {
     ViewSurface surface =
@@ -256,8 +253,9 @@ std::vector<Eigen::Vector3i> freeVoxels(const VisualHull& hull,
       const Eigen::Vector3i voxel =
           base +
           Eigen::Vector3i(c % side - reach, c / side % side - reach, c / side / side - reach);
-      if (((voxel.cast<double>().array() + 0.5).matrix() - g).norm() <= config.keep_radius_voxels) {
-        kept.insert(pack(voxel));
+      if (detail::inCube(voxel, cells) &&
+          ((voxel.cast<double>().array() + 0.5).matrix() - g).norm() <= config.keep_radius_voxels) {
+        kept.insert(detail::voxelKey(voxel));
       }
     }
   }
@@ -286,7 +284,7 @@ std::vector<Eigen::Vector3i> freeVoxels(const VisualHull& hull,
       for (size_t s = 0; s < surfaces.size() && empty < needed; ++s) {
         empty += surfaces[s].seesEmpty(centre_W, margin_m) ? 1 : 0;
       }
-      if (empty >= needed && kept.count(pack(voxel)) == 0) found.push_back(voxel);
+      if (empty >= needed && kept.count(detail::voxelKey(voxel)) == 0) found.push_back(voxel);
     }
     if (found.empty()) return;
     std::lock_guard<std::mutex> lock(free_mutex);
