@@ -23,10 +23,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double millisecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
 /// The case's cameras and masks, each mask run-length encoded as soon as it is rendered.
 HullInput renderCase(const SyntheticHullCase& config, double* masks_mib) {
   SceneConfig scene;
@@ -132,8 +128,8 @@ std::string runRow(const std::string& label, const SyntheticHullRun& run) {
       << fixed(run.time.masks_ms, 0) << " | " << fixed(run.time.bbox_ms, 0) << " | "
       << fixed(run.time.distance_ms, 0) << " | " << fixed(run.time.octree_ms, 0) << " | "
       << fixed(run.time.mesh_ms, 0) << " | **" << fixed(run.time.total_ms, 0) << "** | "
-      << fixed(run.peak_mib, 0) << " | " << fixed(run.iou.min, 4) << " / "
-      << fixed(run.iou.mean, 4) << " | " << run.surface_leaves << " |\n";
+      << fixed(run.peak_mib, 0) << " | " << fixed(run.iou.min, 4) << " / " << fixed(run.iou.mean, 4)
+      << " | " << run.surface_leaves << " |\n";
   return out.str();
 }
 
@@ -196,7 +192,8 @@ std::string syntheticMarkdown(const SyntheticHullBench& bench) {
       << c.runs << " runs per setting (the settings alternating), 2 threads, CPU " << cpuModel()
       << ". Times in ms; peak = VmHWM of the process during the runs of that setting, MiB"
       << (bench.peak_reset ? "" : " (could not be reset: the process's peak so far)") << ".\n\n"
-      << "| distance maps | reduction | map error bound mean / max (px) | masks | bbox | distance | octree | mesh | total | peak | "
+      << "| distance maps | reduction | map error bound mean / max (px) | masks | bbox | distance "
+         "| octree | mesh | total | peak | "
          "reproj. IoU min / mean | surface leaves |\n"
       << "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n"
       << runRow("per view (`distance_reduction` 0)", bench.reduced)

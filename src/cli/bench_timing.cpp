@@ -70,6 +70,11 @@ double residentPeakMiB() {
   return 0.0;
 }
 
+double millisecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
 std::string cpuModel() {
   std::ifstream cpuinfo("/proc/cpuinfo");
   std::string line;

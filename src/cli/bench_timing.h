@@ -1,5 +1,6 @@
 #pragma once
 
+#include <chrono>
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -30,6 +31,9 @@ bool resetResidentPeak();
 /// VmHWM of /proc/self/status in MiB: the peak resident memory since the start or since the last
 /// resetResidentPeak(); 0 when unreadable.
 double residentPeakMiB();
+
+/// Wall milliseconds since `start` (steady clock).
+double millisecondsSince(std::chrono::steady_clock::time_point start);
 
 /// The CPU's "model name" in /proc/cpuinfo, or "unknown".
 std::string cpuModel();

@@ -5,17 +5,13 @@
 #include <sstream>
 
 #include "args.h"
+#include "bench_timing.h"
 #include "commands.h"
 #include "sift_hull/synthetic/scene.h"
 
 namespace sift_hull {
 namespace cli {
 namespace {
-
-double millisecondsSince(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
-      .count();
-}
 
 /// "K1,K2,P1,P2" or "K1,K2,P1,P2,K3", OpenCV's order.
 LensDistortion parseDistortion(const std::string& text) {

@@ -11,6 +11,7 @@
 #include <set>
 #include <sstream>
 
+#include "bench_timing.h"
 #include "sift_hull/eval/hull_evaluation.h"
 #include "sift_hull/features/sift.h"
 #include "sift_hull/filters/filter.h"
@@ -23,20 +24,6 @@
 namespace sift_hull {
 namespace cli {
 namespace {
-
-/// Milliseconds since the last lap (or the start).
-class Stopwatch {
- public:
-  double lapMs() {
-    const auto now = std::chrono::steady_clock::now();
-    const double ms = std::chrono::duration<double, std::milli>(now - last_).count();
-    last_ = now;
-    return ms;
-  }
-
- private:
-  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
-};
 
 /// Samples per axis of the comparison with the true solid (--gt-scene).
 constexpr int kSolidSamplesPerAxis = 160;
@@ -225,26 +212,31 @@ nlohmann::json refineWithMatches(const ArgParser& parser, const HullInput& input
     const FreeSpaceConfig free_config = freeSpaceConfigFromArgs(parser);
     const ReprojectionIoU iou_before = reprojectionIoU(result->mesh, result->hull.views());
     json["reprojection_iou_before"] = {{"min", iou_before.min}, {"mean", iou_before.mean}};
-    Stopwatch watch;
+    auto start = std::chrono::steady_clock::now();
+    const auto lapMs = [&start] {
+      const double ms = millisecondsSince(start);
+      start = std::chrono::steady_clock::now();
+      return ms;
+    };
     const std::vector<PairMatches> pairs = matchedPairs(parser, input);
-    const double matching_ms = watch.lapMs();
+    const double matching_ms = lapMs();
     SurfacePointCounts counts;
     const std::vector<SurfacePoint> points =
         surfacePoints(input.cameras, pairs, result->hull, point_config, &counts);
-    const double points_ms = watch.lapMs();
+    const double points_ms = lapMs();
     const double before_m3 = result->hull.stats().occupied_volume_m3;
     const std::vector<Eigen::Vector3i> free =
         freeVoxels(result->hull, input.cameras, points, free_config);
-    const double free_ms = watch.lapMs();
+    const double free_ms = lapMs();
     result->hull.carveFree(free);
-    const double carve_ms = watch.lapMs();
+    const double carve_ms = lapMs();
     result->mesh = result->hull.mesh();
     result->mesh_check = checkMesh(result->mesh);
     json["refine_time_ms"] = {{"matching", matching_ms},
                               {"points", points_ms},
                               {"free_voxels", free_ms},
                               {"carving", carve_ms},
-                              {"mesh", watch.lapMs()}};
+                              {"mesh", lapMs()}};
     size_t matches = 0;
     for (const PairMatches& pair : pairs) matches += pair.left_px.size();
     json["points"] = {{"pairs", pairs.size()},
