@@ -16,6 +16,8 @@
 #include "sift_hull/features/sift.h"
 #include "sift_hull/filters/filter.h"
 #include "sift_hull/io/images.h"
+#include "sift_hull/io/ply.h"
+#include "sift_hull/refine/dense_matching.h"
 #include "sift_hull/refine/free_space.h"
 #include "sift_hull/refine/surface_points.h"
 #include "sift_hull/synthetic/scene.h"
@@ -54,8 +56,96 @@ std::vector<std::pair<uint32_t, uint32_t>> viewPairs(const std::vector<PinholeCa
   return {pairs.begin(), pairs.end()};
 }
 
-/// The kept matches of each pair, SIFT computed once per view.
-std::vector<PairMatches> matchedPairs(const ArgParser& parser, const HullInput& input) {
+DenseMatchConfig denseMatchConfigFromArgs(const ArgParser& parser) {
+  DenseMatchConfig config;
+  config.grid_step_px = parser.getInt("grid-step-px");
+  config.patch_radius_px = parser.getInt("patch-radius-px");
+  config.min_ncc = parser.getDouble("min-ncc");
+  config.min_ncc_margin = parser.getDouble("min-ncc-margin");
+  config.min_patch_std = parser.getDouble("min-patch-std");
+  config.max_round_trip_px = parser.getDouble("max-round-trip-px");
+  validateOptions(config);
+  return config;
+}
+
+/// Each view's image, SIFT features and dense-matching image, read once when first needed.
+class ViewImages {
+ public:
+  ViewImages(std::string folder, const HullInput& input, SiftConfig sift, int patch_radius_px)
+      : folder_(std::move(folder)),
+        input_(input),
+        sift_(sift),
+        patch_radius_px_(patch_radius_px),
+        views_(input.names.size()) {}
+
+  const Features& features(uint32_t view) {
+    View& v = load(view);
+    if (!v.features) v.features = detectSift(v.image, sift_);
+    return *v.features;
+  }
+  const DenseView& dense(uint32_t view) {
+    View& v = load(view);
+    if (v.dense.grey.empty()) {
+      const cv::Mat mask =
+          input_.masks.empty() ? input_.run_length_masks.at(view).decode() : input_.masks.at(view);
+      v.dense = denseMatchingView(v.image, mask, patch_radius_px_);
+    }
+    return v.dense;
+  }
+  cv::Size size(uint32_t view) { return load(view).image.size(); }
+
+ private:
+  struct View {
+    cv::Mat image;
+    DenseView dense;
+    std::optional<Features> features;
+  };
+  View& load(uint32_t view) {
+    View& v = views_.at(view);
+    if (v.image.empty()) v.image = readImage(folder_ + "/" + input_.names[view]);
+    return v;
+  }
+  std::string folder_;
+  const HullInput& input_;
+  SiftConfig sift_;
+  int patch_radius_px_;
+  std::vector<View> views_;
+};
+
+/// The SIFT matches of a pair that its filter keeps, with their keypoint ids.
+PairMatches keptSiftMatches(ViewImages* images, const HullInput& input, uint32_t a, uint32_t b,
+                            const MatchConfig& matching, const MatchFilter& filter) {
+  const Features& left = images->features(a);
+  const Features& right = images->features(b);
+  PutativeMatches putative;
+  putative.matches = matchAlongEpipolarLines(left, right, input.cameras[a], input.cameras[b],
+                                             matching, kGuidedEpipolarPx);
+  putative.left_keypoints = left.keypoints;
+  putative.right_keypoints = right.keypoints;
+  putative.left_image_size = images->size(a);
+  putative.right_image_size = images->size(b);
+  calibratePair(&putative, input.cameras[a], input.cameras[b]);
+  const FilterResult kept = filter.apply(putative);
+  PairMatches pair;
+  pair.left_view = a, pair.right_view = b;
+  for (size_t m = 0; m < putative.matches.size(); ++m) {
+    if (!kept.keep[m]) continue;
+    pair.left_px.emplace_back(putative.left(m).pt.x, putative.left(m).pt.y);
+    pair.right_px.emplace_back(putative.right(m).pt.x, putative.right(m).pt.y);
+    pair.left_keypoint.push_back(putative.matches[m].queryIdx);
+    pair.right_keypoint.push_back(putative.matches[m].trainIdx);
+  }
+  return pair;
+}
+
+/// What matching the pairs found: each pair's kept SIFT matches (with keypoint ids), then each
+/// pair's dense matches (DenseMatchConfig, none when its grid_step_px is 0).
+struct MatchedPairs {
+  std::vector<PairMatches> pairs;
+  size_t view_pairs = 0, sift_matches = 0, dense_matches = 0;
+};
+
+MatchedPairs matchedPairs(const ArgParser& parser, const HullInput& input, const VisualHull& hull) {
   if (!parser.has("images")) throw UsageError("--refine-with-matches needs --images");
   const std::string match_pairs = parser.get("match-pairs");
   if (match_pairs != "neighbours" && match_pairs != "all") {
@@ -73,41 +163,23 @@ std::vector<PairMatches> matchedPairs(const ArgParser& parser, const HullInput& 
   validateOptions(sift);
   MatchConfig matching;
   matching.ratio = parser.getDouble("ratio");
-  std::vector<std::optional<Features>> features(input.cameras.size());
-  std::vector<cv::Size> sizes(input.cameras.size());
-  const auto featuresOf = [&](uint32_t view) -> const Features& {
-    if (!features[view]) {
-      const cv::Mat image = readImage(parser.get("images") + "/" + input.names[view]);
-      sizes[view] = image.size();
-      features[view] = detectSift(image, sift);
-    }
-    return *features[view];
-  };
-  std::vector<PairMatches> pairs;
-  for (const auto& [a, b] : viewPairs(input.cameras, match_pairs == "all")) {
-    const Features& left = featuresOf(a);
-    const Features& right = featuresOf(b);
-    PutativeMatches putative;
-    putative.matches = matchAlongEpipolarLines(left, right, input.cameras[a], input.cameras[b],
-                                               matching, kGuidedEpipolarPx);
-    putative.left_keypoints = left.keypoints;
-    putative.right_keypoints = right.keypoints;
-    putative.left_image_size = sizes[a];
-    putative.right_image_size = sizes[b];
-    calibratePair(&putative, input.cameras[a], input.cameras[b]);
-    const FilterResult kept = filter->apply(putative);
-    PairMatches pair;
-    pair.left_view = a, pair.right_view = b;
-    for (size_t m = 0; m < putative.matches.size(); ++m) {
-      if (!kept.keep[m]) continue;
-      pair.left_px.emplace_back(putative.left(m).pt.x, putative.left(m).pt.y);
-      pair.right_px.emplace_back(putative.right(m).pt.x, putative.right(m).pt.y);
-      pair.left_keypoint.push_back(putative.matches[m].queryIdx);
-      pair.right_keypoint.push_back(putative.matches[m].trainIdx);
-    }
-    pairs.push_back(std::move(pair));
+  const DenseMatchConfig dense = denseMatchConfigFromArgs(parser);
+  ViewImages images(parser.get("images"), input, sift, dense.patch_radius_px);
+  const auto view_pairs = viewPairs(input.cameras, match_pairs == "all");
+  MatchedPairs result;
+  result.view_pairs = view_pairs.size();
+  for (const auto& [a, b] : view_pairs) {
+    result.pairs.push_back(keptSiftMatches(&images, input, a, b, matching, *filter));
+    result.sift_matches += result.pairs.back().left_px.size();
   }
-  return pairs;
+  if (dense.grid_step_px == 0) return result;
+  for (const auto& [a, b] : view_pairs) {
+    result.pairs.push_back(denseMatches(images.dense(a), images.dense(b), input.cameras[a],
+                                        input.cameras[b], a, b, hull, dense,
+                                        hull.config().threads));
+    result.dense_matches += result.pairs.back().left_px.size();
+  }
+  return result;
 }
 
 SurfacePointConfig surfacePointConfigFromArgs(const ArgParser& parser) {
@@ -145,6 +217,7 @@ nlohmann::json solidJson(const SolidComparison& c) {
 void addRefineOptions(ArgParser* parser) {
   const SurfacePointConfig points;
   const FreeSpaceConfig free;
+  const DenseMatchConfig dense;
   parser->addFlag("refine-with-matches",
                   "match calibrated pairs of views (SIFT on --images), triangulate the filtered "
                   "matches and carve the lines of sight to them from the hull");
@@ -161,6 +234,26 @@ void addRefineOptions(ArgParser* parser) {
                     "Lowe's ratio among a keypoint's candidates along its epipolar line "
                     "(--refine-with-matches)",
                     numberText(MatchConfig{}.ratio));
+  parser->addOption("grid-step-px", "PX",
+                    "dense matching along the epipolar lines: every PX-th pixel of a pair's left "
+                    "view searched for in the right one (0: SIFT matches only)",
+                    std::to_string(dense.grid_step_px));
+  parser->addOption("patch-radius-px", "R", "dense matching compares patches of (2 R + 1)^2 pixels",
+                    std::to_string(dense.patch_radius_px));
+  parser->addOption("min-ncc", "C", "smallest normalised cross-correlation of a dense match",
+                    numberText(dense.min_ncc));
+  parser->addOption("min-ncc-margin", "C",
+                    "a dense match's correlation must beat every other peak along its epipolar "
+                    "line by this much",
+                    numberText(dense.min_ncc_margin));
+  parser->addOption("min-patch-std", "S",
+                    "patches flatter than this (grey level's standard deviation, 0..1) are not "
+                    "matched densely",
+                    numberText(dense.min_patch_std));
+  parser->addOption("max-round-trip-px", "PX",
+                    "a dense match searched for back from the right view must end this close to "
+                    "its left pixel",
+                    numberText(dense.max_round_trip_px));
   parser->addOption("max-reprojection-px", "PX",
                     "largest reprojection error of a surface point in either view",
                     numberText(points.max_reprojection_px));
@@ -188,6 +281,9 @@ void addRefineOptions(ArgParser* parser) {
   parser->addOption("keep-radius-voxels", "V",
                     "voxels this close to a surface point are never free",
                     numberText(free.keep_radius_voxels));
+  parser->addOption("out-points", "PLY",
+                    "write the surface points that --refine-with-matches carves with (vertices "
+                    "only)");
   parser->addOption("gt-scene", "DIR",
                     "a scene `sift_hull scene` rendered: compare the hull with its true solid "
                     "(volume IoU, and with --refine-with-matches before and after, false carving)");
@@ -218,12 +314,18 @@ nlohmann::json refineWithMatches(const ArgParser& parser, const HullInput& input
       start = std::chrono::steady_clock::now();
       return ms;
     };
-    const std::vector<PairMatches> pairs = matchedPairs(parser, input);
+    const MatchedPairs matched = matchedPairs(parser, input, result->hull);
+    const std::vector<PairMatches>& pairs = matched.pairs;
     const double matching_ms = lapMs();
     SurfacePointCounts counts;
     const std::vector<SurfacePoint> points =
         surfacePoints(input.cameras, pairs, result->hull, point_config, &counts);
     const double points_ms = lapMs();
+    if (parser.has("out-points")) {
+      TriangleMesh cloud;
+      for (const SurfacePoint& point : points) cloud.vertices_W.push_back(point.X_W.cast<float>());
+      writePly(parser.get("out-points"), cloud);
+    }
     const double before_m3 = result->hull.stats().occupied_volume_m3;
     const std::vector<Eigen::Vector3i> free =
         freeVoxels(result->hull, input.cameras, points, free_config);
@@ -237,10 +339,9 @@ nlohmann::json refineWithMatches(const ArgParser& parser, const HullInput& input
                               {"free_voxels", free_ms},
                               {"carving", carve_ms},
                               {"mesh", lapMs()}};
-    size_t matches = 0;
-    for (const PairMatches& pair : pairs) matches += pair.left_px.size();
-    json["points"] = {{"pairs", pairs.size()},
-                      {"matches_kept", matches},
+    json["points"] = {{"pairs", matched.view_pairs},
+                      {"matches_kept", matched.sift_matches},
+                      {"dense_matches", matched.dense_matches},
                       {"triangulated", counts.triangulated},
                       {"reprojected", counts.reprojected},
                       {"inside_hull", counts.inside_hull},
