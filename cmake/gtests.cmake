@@ -27,6 +27,7 @@ set(SIFT_HULL_CORE_GTESTS
   test_free_carving eval
   test_refine eval
   test_dense_matching eval
+  test_refine_command eval
   test_reduced_distance eval
   test_hull_data eval
   test_hull_stream eval

@@ -164,6 +164,7 @@ int runHull(const std::vector<std::string>& args) {
   if (!parser.parse(args)) return 0;
 
   const HullConfig config = hullConfigFromArgs(parser);
+  checkRefineOptions(parser);
   PoorResults poor(parser.flag("allow-poor"));
   const HullInput input = runLengthViewSetFromArgs(parser);
   for (const std::string& warning :

@@ -145,31 +145,45 @@ struct MatchedPairs {
   size_t view_pairs = 0, sift_matches = 0, dense_matches = 0;
 };
 
-MatchedPairs matchedPairs(const ArgParser& parser, const HullInput& input, const VisualHull& hull) {
-  if (!parser.has("images")) throw UsageError("--refine-with-matches needs --images");
+/// How the pairs are chosen and matched (--match-pairs, --filter, --contrast-threshold, --ratio).
+struct MatchSettings {
+  bool all_pairs = false;
+  std::unique_ptr<MatchFilter> filter;
+  SiftConfig sift;
+  MatchConfig matching;
+};
+
+MatchSettings matchSettingsFromArgs(const ArgParser& parser) {
+  MatchSettings settings;
   const std::string match_pairs = parser.get("match-pairs");
   if (match_pairs != "neighbours" && match_pairs != "all") {
     throw UsageError("--match-pairs must be neighbours or all, not '" + match_pairs + "'");
   }
+  settings.all_pairs = match_pairs == "all";
   const FilterConfigs filter_configs;
-  std::unique_ptr<MatchFilter> filter;
   try {
-    filter = makeFilter(parser.get("filter"), filter_configs);
+    settings.filter = makeFilter(parser.get("filter"), filter_configs);
   } catch (const std::invalid_argument& e) {
     throw UsageError(std::string("--filter: ") + e.what());
   }
-  SiftConfig sift;
-  sift.contrast_threshold = parser.getDouble("contrast-threshold");
-  validateOptions(sift);
-  MatchConfig matching;
-  matching.ratio = parser.getDouble("ratio");
+  settings.sift.contrast_threshold = parser.getDouble("contrast-threshold");
+  validateOptions(settings.sift);
+  settings.matching.ratio = parser.getDouble("ratio");
+  validateOptions(settings.matching);
+  return settings;
+}
+
+MatchedPairs matchedPairs(const ArgParser& parser, const HullInput& input, const VisualHull& hull) {
+  if (!parser.has("images")) throw UsageError("--refine-with-matches needs --images");
+  const MatchSettings settings = matchSettingsFromArgs(parser);
   const DenseMatchConfig dense = denseMatchConfigFromArgs(parser);
-  ViewImages images(parser.get("images"), input, sift, dense.patch_radius_px);
-  const auto view_pairs = viewPairs(input.cameras, match_pairs == "all");
+  ViewImages images(parser.get("images"), input, settings.sift, dense.patch_radius_px);
+  const auto view_pairs = viewPairs(input.cameras, settings.all_pairs);
   MatchedPairs result;
   result.view_pairs = view_pairs.size();
   for (const auto& [a, b] : view_pairs) {
-    result.pairs.push_back(keptSiftMatches(&images, input, a, b, matching, *filter));
+    result.pairs.push_back(
+        keptSiftMatches(&images, input, a, b, settings.matching, *settings.filter));
     result.sift_matches += result.pairs.back().left_px.size();
   }
   if (dense.grid_step_px == 0) return result;
@@ -213,6 +227,15 @@ nlohmann::json solidJson(const SolidComparison& c) {
 }
 
 }  // namespace
+
+void checkRefineOptions(const ArgParser& parser) {
+  if (!parser.flag("refine-with-matches")) return;
+  if (!parser.has("images")) throw UsageError("--refine-with-matches needs --images");
+  static_cast<void>(matchSettingsFromArgs(parser));
+  static_cast<void>(denseMatchConfigFromArgs(parser));
+  static_cast<void>(surfacePointConfigFromArgs(parser));
+  static_cast<void>(freeSpaceConfigFromArgs(parser));
+}
 
 void addRefineOptions(ArgParser* parser) {
   const SurfacePointConfig points;

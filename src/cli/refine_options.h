@@ -12,6 +12,10 @@ namespace cli {
 /// settings under their field names, and --gt-scene.
 void addRefineOptions(ArgParser* parser);
 
+/// With --refine-with-matches: throws UsageError for a bad refinement setting (before the hull is
+/// built).
+void checkRefineOptions(const ArgParser& parser);
+
 /// With --refine-with-matches: SIFT on every view's image (--images), the chosen pairs matched
 /// and filtered, triangulated into consistent surface points, their lines of sight carved from
 /// result->hull and the mesh made again. Returns the JSON it adds to `hull --json` ("points",

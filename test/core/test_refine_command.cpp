@@ -1,0 +1,83 @@
+// `sift_hull hull --refine-with-matches` as users run it: a concave scene on disk, SIFT and dense
+// matches, the JSON's counts and the comparison with the true solid, and refusals of bad settings.
+
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "common/test_data.h"
+#include "sift_hull/io/ply.h"
+#include "sift_hull/synthetic/scene.h"
+
+namespace sift_hull {
+namespace {
+
+/// The cup, 20 views on a sphere at 320x240, written once.
+const std::string& cupScene() {
+  static const std::string directory = [] {
+    SceneConfig config;
+    config.shape = "cup";
+    config.layout = "sphere";
+    config.views = 20;
+    config.width_px = 320;
+    config.height_px = 240;
+    const std::string dir = test::temporaryDirectory() + "/cup";
+    writeScene(dir, config, renderScene(config));
+    return dir;
+  }();
+  return directory;
+}
+
+std::string refine() {
+  const std::string& s = cupScene();
+  return "hull --calib " + s + "/scene_par.txt --images " + s + " --silhouettes " + s +
+         "/masks --max-depth 6 --refine-with-matches --gt-scene " + s + " --json ";
+}
+
+TEST(RefineCommand, CarvesWithSiftAndDenseMatchesAndReportsAgainstTheSolid) {
+  const std::string points_ply = test::temporaryDirectory() + "/points.ply";
+  std::string out, err;
+  ASSERT_EQ(test::runProgram(refine() + "--grid-step-px 4 --out-points " + points_ply, &out, &err),
+            0)
+      << err;
+  const nlohmann::json j = nlohmann::json::parse(out);
+  const nlohmann::json& points = j["points"];
+  EXPECT_EQ(points["pairs"].get<int>(), 22) << out;  // each view with its two nearest
+  EXPECT_GT(points["matches_kept"].get<int>(), 100) << out;
+  EXPECT_GT(points["dense_matches"].get<int>(), 100) << out;
+  EXPECT_GT(points["kept"].get<int>(), 0) << out;
+  EXPECT_LE(points["kept"].get<int>(), points["triangulated"].get<int>()) << out;
+  EXPECT_EQ(readPly(points_ply).vertices_W.size(), points["kept"].get<size_t>());
+  EXPECT_GT(j["carved_volume_m3"].get<double>(), 0.0) << out;
+  EXPECT_LE(j["false_carved_fraction"].get<double>(), 0.005) << out;
+  EXPECT_LE(j["cavity_filled_m3"]["after"].get<double>(),
+            j["cavity_filled_m3"]["before"].get<double>())
+      << out;
+  EXPECT_GE(j["volume_iou_vs_truth"]["after"].get<double>(),
+            j["volume_iou_vs_truth"]["before"].get<double>())
+      << out;
+  EXPECT_TRUE(j["mesh"]["watertight"].get<bool>()) << out;
+  EXPECT_GE(j["reprojection_iou"]["min"].get<double>(), 0.95) << out;
+}
+
+TEST(RefineCommand, RefusesBadSettingsByName) {
+  std::string out, err;
+  const auto refused = [&](const std::string& flags, const std::string& what) {
+    EXPECT_EQ(test::runProgram(refine() + flags, &out, &err), 2) << flags;
+    EXPECT_NE(err.find(what), std::string::npos) << flags << ": " << err;
+  };
+  refused("--grid-step-px -1", "grid_step_px");
+  refused("--patch-radius-px 0", "patch_radius_px");
+  refused("--min-ncc 2", "min_ncc");
+  refused("--min-ncc-margin -1", "min_ncc_margin");
+  refused("--min-patch-std 2", "min_patch_std");
+  refused("--ratio 0", "ratio");
+  refused("--filter none", "--filter");
+  refused("--max-round-trip-px 0", "max_round_trip_px");
+  refused("--match-pairs some", "--match-pairs must be neighbours or all");
+  refused("--min-views 0", "min_views");
+}
+
+}  // namespace
+}  // namespace sift_hull
