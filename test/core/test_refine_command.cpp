@@ -8,22 +8,20 @@
 
 #include "common/test_data.h"
 #include "sift_hull/io/ply.h"
-#include "sift_hull/synthetic/scene.h"
 
 namespace sift_hull {
 namespace {
 
-/// The cup, 20 views on a sphere at 320x240, written once.
+/// The cup, 20 views on a sphere at 320x240, written once by `sift_hull scene`.
 const std::string& cupScene() {
   static const std::string directory = [] {
-    SceneConfig config;
-    config.shape = "cup";
-    config.layout = "sphere";
-    config.views = 20;
-    config.width_px = 320;
-    config.height_px = 240;
     const std::string dir = test::temporaryDirectory() + "/cup";
-    writeScene(dir, config, renderScene(config));
+    std::string out, err;
+    EXPECT_EQ(
+        test::runProgram("scene --shape cup --layout sphere --views 20 --size 320x240 --out " + dir,
+                         &out, &err),
+        0)
+        << err;
     return dir;
   }();
   return directory;
