@@ -16,7 +16,9 @@ set(SIFT_HULL_CORE_GTESTS
   test_ply io
   test_ground_truth_files io
   test_features eval
+  test_nearest_neighbours eval
   test_filters eval
+  test_local_filters eval
   test_evaluation eval
   test_scene eval
   test_cut_shapes eval

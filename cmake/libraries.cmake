@@ -7,7 +7,8 @@
 #   sift_hull_eval<suffix>   synthetic renderer and evaluation; links sift_hull_io
 # Used by the package's CMakeLists.txt and by the sanitizer build (test/sanitize), which makes static
 # variants with other compile flags. Expects OpenCV, Eigen3, octomap, VTK, GLPK (GLPK_INCLUDE_DIR,
-# GLPK_LIBRARY), nlohmann_json and Threads to be found already.
+# GLPK_LIBRARY), OpenBLAS (OPENBLAS_INCLUDE_DIR, OPENBLAS_LIBRARY), nlohmann_json and Threads to be
+# found already.
 include(${CMAKE_CURRENT_LIST_DIR}/sources.cmake)
 
 function(sift_hull_add_libraries)
@@ -26,9 +27,11 @@ function(sift_hull_add_libraries)
   add_library(${core} ${type} ${CORE})
   target_include_directories(${core} PUBLIC
     $<BUILD_INTERFACE:${ARG_ROOT}/include> $<INSTALL_INTERFACE:include> ${OCTOMAP_INCLUDE_DIRS})
-  target_include_directories(${core} PRIVATE ${ARG_ROOT}/src/core ${GLPK_INCLUDE_DIR})
+  target_include_directories(${core} PRIVATE ${ARG_ROOT}/src/core ${GLPK_INCLUDE_DIR}
+    ${OPENBLAS_INCLUDE_DIR})
   target_link_libraries(${core} PUBLIC ${OpenCV_LIBS} Eigen3::Eigen ${OCTOMAP_LIBRARIES}
-    Threads::Threads PRIVATE VTK::CommonCore VTK::CommonDataModel ${GLPK_LIBRARY})
+    Threads::Threads PRIVATE VTK::CommonCore VTK::CommonDataModel ${GLPK_LIBRARY}
+    ${OPENBLAS_LIBRARY})
 
   set(io sift_hull_io${ARG_SUFFIX})
   add_library(${io} ${type} ${IO})

@@ -10,14 +10,18 @@ set(SIFT_HULL_CORE_SOURCES
   src/core/geometry/correspondence.cpp
   src/core/geometry/distortion.cpp
   src/core/features/matching.cpp
+  src/core/features/nearest_neighbours.cpp
   src/core/features/sift.cpp
   src/core/features/triangulation.cpp
   src/core/filters/epipolar.cpp
   src/core/filters/filter.cpp
   src/core/filters/gms.cpp
   src/core/filters/gsc.cpp
+  src/core/filters/guided.cpp
+  src/core/filters/local_consistency.cpp
   src/core/filters/ratio.cpp
   src/core/filters/robust_fit.cpp
+  src/core/filters/spatial_neighbours.cpp
   src/core/hull/bounding_box.cpp
   src/core/hull/distance_kernel.cpp
   src/core/hull/distance_map.cpp
@@ -61,10 +65,13 @@ set(SIFT_HULL_EVAL_SOURCES
   src/core/eval/match_drawing.cpp
   src/core/eval/match_evaluation.cpp
   src/core/eval/mesh_render.cpp
+  src/core/eval/warped_pairs.cpp
 )
 # No contraction into fused multiply-adds: the GSC kernel's sectors must not depend on which vector
 # width the CPU dispatch picks, and the scalar and AVX2 distance look-ups must round alike.
 set(SIFT_HULL_EXACT_FLOAT_SOURCES
   src/core/filters/gsc.cpp
+  src/core/filters/guided.cpp
+  src/core/filters/local_consistency.cpp
   src/core/hull/distance_kernel.cpp
 )

@@ -32,6 +32,7 @@ int runDatasetInfo(const std::vector<std::string>& args);
 int runScene(const std::vector<std::string>& args);
 int runMatch(const std::vector<std::string>& args);
 int runBenchFilters(const std::vector<std::string>& args);
+int runBenchMatching(const std::vector<std::string>& args);
 int runEvaluateFilters(const std::vector<std::string>& args);
 int runHull(const std::vector<std::string>& args);
 int runBenchHull(const std::vector<std::string>& args);

@@ -17,6 +17,8 @@ const Program& offlineProgram() {
            runMatch},
           {"bench-filters", "time every match filter (the paper's Table 1 and an N sweep)",
            runBenchFilters},
+          {"bench-matching", "time SIFT and the descriptor matchers at 1k, 4k and 8k keypoints",
+           runBenchMatching},
           {"evaluate-filters", "precision and recall of every filter on Teddy and graf",
            runEvaluateFilters},
           {"hull", "visual hull of calibrated silhouettes: octree, OctoMap and mesh", runHull},

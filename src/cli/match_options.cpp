@@ -30,9 +30,61 @@ void addMatchingOptions(ArgParser* parser) {
                     "largest descriptor distance kept (SIFT descriptors have norm 512)", "inf");
   parser->addDeprecatedAlias("max-distance", {"max-descriptor-distance"});
   parser->addFlag("cross-check", "keep only mutual nearest neighbours");
-  parser->addOption("backend", "NAME", "brute-force or flann", matching.backend);
+  parser->addOption("backend", "NAME",
+                    "blas (exact, default), brute-force (OpenCV, exact) or flann",
+                    matching.backend);
   parser->addDeprecatedAlias("matcher", {"backend"});
 }
+
+void addLocalFilterOptions(ArgParser* parser, const FilterConfigs& filters) {
+  parser->addOption("lsc-neighbours", "K", "lsc: nearest matches looked at in each image",
+                    numberText(filters.lsc.lsc_neighbours));
+  parser->addOption("lsc-max-relative-error", "E",
+                    "lsc: tolerance as a share of the neighbour's distance",
+                    numberText(filters.lsc.lsc_max_relative_error));
+  parser->addOption("lsc-min-tolerance-px", "PX", "lsc: tolerance floor",
+                    numberText(filters.lsc.lsc_min_tolerance_px));
+  parser->addOption("lsc-min-support", "S", "lsc: share of neighbours that must agree",
+                    numberText(filters.lsc.lsc_min_support));
+  parser->addOption("local-gsc-neighbours", "K", "local_gsc: nearest matches in each image",
+                    numberText(filters.local_gsc.local_gsc_neighbours));
+  parser->addOption("local-gsc-max-histogram-distance", "D",
+                    "local_gsc: largest histogram distance kept",
+                    numberText(filters.local_gsc.local_gsc_max_histogram_distance));
+  const GuidedConfig& guided = filters.guided;
+  parser->addOption("guided-max-transfer-px", "PX", "guided: homography inlier threshold",
+                    numberText(guided.guided_max_transfer_px));
+  parser->addOption("guided-homography-share", "S",
+                    "guided: use H when it explains this share of F's inliers",
+                    numberText(guided.guided_homography_share));
+  parser->addOption("guided-max-models", "N", "guided: motions looked for",
+                    numberText(guided.guided_max_models));
+  parser->addOption("guided-min-model-inliers", "N", "guided: inliers a motion needs",
+                    numberText(guided.guided_min_model_inliers));
+  parser->addOption("guided-min-support", "S", "guided: lsc support a match needs",
+                    numberText(guided.guided_min_support));
+  parser->addOption("guided-max-fit-points", "N", "guided: lsc survivors MAGSAC fits to (sample)",
+                    numberText(guided.guided_max_fit_points));
+}
+
+void localFilterConfigsFromArgs(const ArgParser& parser, FilterConfigs* filters) {
+  filters->lsc.lsc_neighbours = parser.getInt("lsc-neighbours");
+  filters->lsc.lsc_max_relative_error = parser.getDouble("lsc-max-relative-error");
+  filters->lsc.lsc_min_tolerance_px = parser.getDouble("lsc-min-tolerance-px");
+  filters->lsc.lsc_min_support = parser.getDouble("lsc-min-support");
+  filters->local_gsc.local_gsc_neighbours = parser.getInt("local-gsc-neighbours");
+  filters->local_gsc.local_gsc_max_histogram_distance =
+      parser.getDouble("local-gsc-max-histogram-distance");
+  GuidedConfig& guided = filters->guided;
+  guided.guided_max_transfer_px = parser.getDouble("guided-max-transfer-px");
+  guided.guided_homography_share = parser.getDouble("guided-homography-share");
+  guided.guided_max_models = parser.getInt("guided-max-models");
+  guided.guided_min_model_inliers = parser.getInt("guided-min-model-inliers");
+  guided.guided_min_support = parser.getDouble("guided-min-support");
+  guided.guided_max_fit_points = parser.getInt("guided-max-fit-points");
+}
+
+}  // namespace
 
 void addFilterOptions(ArgParser* parser) {
   const FilterConfigs filters;
@@ -56,6 +108,10 @@ void addFilterOptions(ArgParser* parser) {
   parser->addDeprecatedAlias("gms-rotation", {"with-rotation"});
   parser->addFlag("with-scale", "gms: try scaled right grids");
   parser->addDeprecatedAlias("gms-scale", {"with-scale"});
+  parser->addOption("ransac-seed", "N", "ransac: random state", numberText(filters.ransac.seed));
+  parser->addOption("magsac-seed", "N", "magsac (and guided, best): random state",
+                    numberText(filters.magsac.seed));
+  addLocalFilterOptions(parser, filters);
 }
 
 FilterConfigs filterConfigsFromArgs(const ArgParser& parser) {
@@ -69,10 +125,16 @@ FilterConfigs filterConfigsFromArgs(const ArgParser& parser) {
   filters.gms.threshold_factor = parser.getDouble("threshold-factor");
   filters.gms.with_rotation = parser.flag("with-rotation");
   filters.gms.with_scale = parser.flag("with-scale");
+  filters.ransac.seed = parser.getInt("ransac-seed");
+  filters.magsac.seed = parser.getInt("magsac-seed");
+  localFilterConfigsFromArgs(parser, &filters);
+  try {
+    validate(filters);
+  } catch (const std::invalid_argument& error) {
+    throw UsageError(error.what());
+  }
   return filters;
 }
-
-}  // namespace
 
 void addMatchOptions(ArgParser* parser) {
   addSiftOptions(parser);

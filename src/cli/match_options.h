@@ -18,5 +18,11 @@ void addMatchOptions(ArgParser* parser);
 /// Throws UsageError for values the configs reject.
 MatchOptions matchOptionsFromArgs(const ArgParser& parser);
 
+/// The filter-threshold options alone (every FilterConfigs field), for commands that choose their
+/// own SIFT and matching settings.
+void addFilterOptions(ArgParser* parser);
+/// Throws UsageError for values the configs reject.
+FilterConfigs filterConfigsFromArgs(const ArgParser& parser);
+
 }  // namespace cli
 }  // namespace sift_hull

@@ -20,7 +20,9 @@ struct MatchConfig {
   /// Lowe's ratio test: keep when nearest < ratio * second nearest. 1 (or more) turns it off.
   double ratio = 0.8;
   bool cross_check = false;             ///< keep only mutual nearest neighbours
-  std::string backend = "brute-force";  ///< "brute-force" (exact) or "flann" (kd-trees)
+  /// "blas" (exact, by matrix product: exactNearestNeighbours), "brute-force" (exact, OpenCV's
+  /// BFMatcher) or "flann" (approximate, kd-trees).
+  std::string backend = "blas";
 };
 
 /// Throws std::invalid_argument naming the first bad field.

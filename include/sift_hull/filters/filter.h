@@ -9,6 +9,8 @@
 #include "sift_hull/filters/filter_result.h"
 #include "sift_hull/filters/gms.h"
 #include "sift_hull/filters/gsc.h"
+#include "sift_hull/filters/guided.h"
+#include "sift_hull/filters/local_consistency.h"
 #include "sift_hull/filters/ratio.h"
 #include "sift_hull/filters/robust_fit.h"
 
@@ -25,6 +27,9 @@ struct FilterConfigs {
   RobustFitConfig ransac;
   RobustFitConfig magsac;
   GmsConfig gms;
+  LscConfig lsc;
+  LocalGscConfig local_gsc;
+  GuidedConfig guided;
 };
 
 /// Throws std::invalid_argument naming the first bad field.
@@ -39,7 +44,9 @@ class MatchFilter {
   virtual FilterResult apply(const PutativeMatches& input) const = 0;
 };
 
-/// The names makeFilter knows: ratio, epipolar, gsc, ransac, magsac, gms.
+/// The names makeFilter knows: ratio, epipolar, gsc, ransac, magsac, gms, lsc, local_gsc, guided,
+/// best. `best` is the combination measured best (docs/EVALUATION.md), the CLI's and the node's
+/// default: today `guided`.
 const std::vector<std::string>& filterNames();
 
 /// A filter by name; "a+b" composes filters, keeping what all keep (score: how many rejected the

@@ -6,6 +6,8 @@
 #include <optional>
 #include <stdexcept>
 
+#include "sift_hull/features/nearest_neighbours.h"
+
 namespace sift_hull {
 namespace {
 
@@ -39,8 +41,8 @@ std::vector<int> reverseNearest(const cv::Mat& left, const cv::Mat& right,
 void validate(const MatchConfig& config) {
   require(config.max_descriptor_distance > 0.0, "max_descriptor_distance must be > 0");
   require(config.ratio > 0.0, "ratio must be > 0 (1 turns the test off)");
-  require(config.backend == "brute-force" || config.backend == "flann",
-          "backend must be 'brute-force' or 'flann', not '" + config.backend + "'");
+  require(config.backend == "blas" || config.backend == "brute-force" || config.backend == "flann",
+          "backend must be 'blas', 'brute-force' or 'flann', not '" + config.backend + "'");
 }
 
 namespace {
@@ -113,6 +115,27 @@ std::vector<cv::DMatch> matchAlongEpipolarLines(const Features& left, const Feat
   return matches;
 }
 
+namespace {
+
+/// The blas backend: both nearest neighbours and the mutual check from one pass.
+std::vector<cv::DMatch> matchByMatrixProduct(const cv::Mat& left, const cv::Mat& right,
+                                             const MatchConfig& config) {
+  const NearestNeighbours nn = exactNearestNeighbours(left, right, config.cross_check);
+  std::vector<cv::DMatch> matches;
+  for (size_t i = 0; i < nn.forward.size(); ++i) {
+    const TwoNearest& n = nn.forward[i];
+    if (n.best < 0 || n.best_distance > config.max_descriptor_distance) continue;
+    if (config.ratio < 1.0 && n.second >= 0 &&
+        !(n.best_distance < config.ratio * n.second_distance))
+      continue;
+    if (config.cross_check && nn.reverse_nearest[n.best] != static_cast<int>(i)) continue;
+    matches.emplace_back(static_cast<int>(i), n.best, n.best_distance);
+  }
+  return matches;
+}
+
+}  // namespace
+
 std::vector<cv::DMatch> matchDescriptors(const cv::Mat& left, const cv::Mat& right,
                                          const MatchConfig& config) {
   validate(config);
@@ -120,6 +143,7 @@ std::vector<cv::DMatch> matchDescriptors(const cv::Mat& left, const cv::Mat& rig
   if (left.cols != right.cols || left.type() != CV_32F || right.type() != CV_32F) {
     throw std::invalid_argument("matchDescriptors: descriptors must be CV_32F of equal length");
   }
+  if (config.backend == "blas") return matchByMatrixProduct(left, right, config);
   std::vector<std::vector<cv::DMatch>> neighbours;
   makeMatcher(config.backend)->knnMatch(left, right, neighbours, 2);
   std::vector<int> reverse;

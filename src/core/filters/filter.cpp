@@ -87,6 +87,16 @@ std::unique_ptr<MatchFilter> makeSingleFilter(const std::string& name,
   if (name == "gms") {
     return std::make_unique<FunctionFilter<GmsConfig>>(name, filterGms, configs.gms);
   }
+  if (name == "lsc")
+    return std::make_unique<FunctionFilter<LscConfig>>(name, filterLsc, configs.lsc);
+  if (name == "local_gsc") {
+    return std::make_unique<FunctionFilter<LocalGscConfig>>(name, filterLocalGsc,
+                                                            configs.local_gsc);
+  }
+  if (name == "guided" || name == "best") {
+    return std::make_unique<FunctionFilter<GuidedFilterConfig>>(
+        name, filterGuided, GuidedFilterConfig{configs.guided, configs.lsc, configs.magsac});
+  }
   std::ostringstream known;
   for (const std::string& each : filterNames()) known << " " << each;
   throw std::invalid_argument("unknown filter '" + name + "' (known:" + known.str() + ")");
@@ -115,11 +125,14 @@ void validate(const FilterConfigs& configs) {
           "gms.grid_cells must be in [3, " + std::to_string(limits::kMaxGmsGridCells) + "]");
   require(configs.gms.threshold_factor > 0.0 && std::isfinite(configs.gms.threshold_factor),
           "gms.threshold_factor must be finite and > 0");
+  validate(configs.lsc);
+  validate(configs.local_gsc);
+  validate(configs.guided);
 }
 
 const std::vector<std::string>& filterNames() {
-  static const std::vector<std::string> names = {"ratio",  "epipolar", "gsc",
-                                                 "ransac", "magsac",   "gms"};
+  static const std::vector<std::string> names = {
+      "ratio", "epipolar", "gsc", "ransac", "magsac", "gms", "lsc", "local_gsc", "guided", "best"};
   return names;
 }
 
