@@ -61,11 +61,11 @@ set(SIFT_HULL_EVAL_SOURCES
   src/core/synthetic/shape.cpp
   src/core/synthetic/synthetic_matches.cpp
   src/core/synthetic/texture.cpp
+  src/core/synthetic/warped_pairs.cpp
   src/core/eval/hull_evaluation.cpp
   src/core/eval/match_drawing.cpp
   src/core/eval/match_evaluation.cpp
   src/core/eval/mesh_render.cpp
-  src/core/eval/warped_pairs.cpp
 )
 # No contraction into fused multiply-adds: the GSC kernel's sectors must not depend on which vector
 # width the CPU dispatch picks, and the scalar and AVX2 distance look-ups must round alike.

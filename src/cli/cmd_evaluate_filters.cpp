@@ -9,10 +9,10 @@
 #include "commands.h"
 #include "match_eval.h"
 #include "pair_data.h"
-#include "sift_hull/eval/warped_pairs.h"
 #include "sift_hull/features/labelled_matches.h"
 #include "sift_hull/filters/filter.h"
 #include "sift_hull/synthetic/scene.h"
+#include "sift_hull/synthetic/warped_pairs.h"
 
 namespace sift_hull {
 namespace cli {

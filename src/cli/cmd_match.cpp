@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <chrono>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
@@ -6,6 +7,7 @@
 #include "commands.h"
 #include "match_eval.h"
 #include "match_options.h"
+#include "match_table.h"
 #include "sift_hull/eval/match_drawing.h"
 #include "sift_hull/features/labelled_matches.h"
 #include "sift_hull/filters/filter.h"
@@ -93,10 +95,23 @@ std::optional<PairTruth> pairTruth(const ArgParser& parser, const std::string& l
                     {scene.views[b].camera, scene.depths[b]});
 }
 
-/// The filters named with --filter, else every one the input allows.
+/// Every filter the input allows (epipolar only when calibrated).
+std::vector<std::string> applicableFilters(bool calibrated) {
+  std::vector<std::string> names;
+  for (const std::string& name : filterNames()) {
+    if (name != "epipolar" || calibrated) names.push_back(name);
+  }
+  return names;
+}
+
+/// The filters named with --filter ("all": every one the input allows), else kDefaultFilter.
 /// Throws UsageError for a name makeFilter refuses, and for epipolar without calibration.
 std::vector<std::string> chosenFilters(const ArgParser& parser, bool calibrated) {
   std::vector<std::string> names = parser.getAll("filter");
+  if (names.empty()) return {kDefaultFilter};
+  if (std::find(names.begin(), names.end(), "all") != names.end()) {
+    return applicableFilters(calibrated);
+  }
   for (const std::string& name : names) {
     try {
       makeFilter(name, FilterConfigs());
@@ -107,10 +122,6 @@ std::vector<std::string> chosenFilters(const ArgParser& parser, bool calibrated)
       throw UsageError("--filter " + name +
                        ": epipolar needs calibration (--calib, --rectified or --gt-scene)");
     }
-  }
-  if (!names.empty()) return names;
-  for (const std::string& name : filterNames()) {
-    if (name != "epipolar" || calibrated) names.push_back(name);
   }
   return names;
 }
@@ -124,7 +135,9 @@ std::string describe(const nlohmann::json& result, const std::vector<std::string
     text << " (" << truth["correct"] << " correct, " << truth["wrong"] << " wrong, "
          << truth["unknown"] << " without ground truth)";
   }
-  text << "\n";
+  const nlohmann::json& ms = result["time_ms"];
+  text << "\nSIFT " << ms["sift_left"] << " ms (left), " << ms["sift_right"]
+       << " ms (right); matching " << ms["matching"] << " ms\n";
   for (const std::string& name : order) {
     const nlohmann::json& run = result["filters"][name];
     text << "  " << name << ": kept " << run["kept"] << " in " << run["time_ms"] << " ms";
@@ -161,31 +174,55 @@ void writeHistogramFigure(const std::string& path, const PutativeMatches& input,
 }
 
 /// Runs each chosen filter in the order given; fills result["filters"] and `order` (the filters'
-/// names as run) and returns the first filter's run.
-std::optional<FilterRun> runFilters(const ArgParser& parser, const PutativeMatches& input,
-                                    const FilterConfigs& configs,
-                                    const std::vector<MatchTruth>* truth, nlohmann::json* result,
-                                    std::vector<std::string>* order) {
-  std::optional<FilterRun> first;
+/// names as run) and returns the runs.
+std::vector<FilterRun> runFilters(const ArgParser& parser, const PutativeMatches& input,
+                                  const FilterConfigs& configs,
+                                  const std::vector<MatchTruth>* truth, nlohmann::json* result,
+                                  std::vector<std::string>* order) {
+  std::vector<FilterRun> runs;
   for (const std::string& name : chosenFilters(parser, input.F_right_left.has_value())) {
     FilterRun run = timedRun(*makeFilter(name, configs), input);
     (*result)["filters"][run.name] = filterRunJson(run, truth);
     if (std::find(order->begin(), order->end(), run.name) == order->end()) {
       order->push_back(run.name);
+      runs.push_back(std::move(run));
     }
-    if (!first) first = std::move(run);
   }
-  return first;
+  return runs;
+}
+
+/// SIFT of both images (timed each) and the descriptor matching (timed): matchImages in steps.
+PutativeMatches timedMatch(const cv::Mat& left, const cv::Mat& right, const MatchOptions& options,
+                           nlohmann::json* time_ms) {
+  const auto start = std::chrono::steady_clock::now();
+  Features a = detectSift(left, options.sift);
+  const auto left_done = std::chrono::steady_clock::now();
+  Features b = detectSift(right, options.sift);
+  const auto right_done = std::chrono::steady_clock::now();
+  PutativeMatches input;
+  input.matches = matchDescriptors(a.descriptors, b.descriptors, options.matching);
+  const auto ms = [](auto from, auto to) {
+    return std::chrono::duration<double, std::milli>(to - from).count();
+  };
+  *time_ms = {{"sift_left", ms(start, left_done)},
+              {"sift_right", ms(left_done, right_done)},
+              {"matching", ms(right_done, std::chrono::steady_clock::now())}};
+  input.left_keypoints = std::move(a.keypoints), input.right_keypoints = std::move(b.keypoints);
+  input.left_image_size = left.size(), input.right_image_size = right.size();
+  return input;
 }
 
 void addMatchCommandOptions(ArgParser* parser) {
   parser->addPositional("LEFT", "left image");
   parser->addPositional("RIGHT", "right image");
-  parser->addOption("filter", "NAME", "a filter to run; repeat for several");
+  parser->addOption("filter", "NAME", "a filter to run (default best; all: every one); repeat");
   addMatchOptions(parser);
   addPairOptions(parser);
   parser->addOption("out-image", "PNG", "draw the first filter's kept (green) and removed (red)");
   parser->addOption("out-histograms", "PNG", "draw GSC histograms of a kept and a removed match");
+  parser->addOption("out-matches", "FILE",
+                    "one row per putative: points, sizes, angles, descriptor distance, each "
+                    "filter's keep and score (.csv or .json)");
   parser->addFlag("json", "print the result as one JSON object");
 }
 
@@ -194,16 +231,18 @@ void addMatchCommandOptions(ArgParser* parser) {
 int runMatch(const std::vector<std::string>& args) {
   ArgParser parser("match",
                    "Matches SIFT features of two images and filters the putative matches with\n"
-                   "each --filter (ratio, epipolar, gsc, ransac, magsac, gms, or a+b to keep what\n"
-                   "both keep; default: all that apply), scoring them against ground truth when\n"
-                   "one is given.");
+                   "each --filter (best, guided, lsc, local_gsc, gsc, ratio, epipolar, ransac,\n"
+                   "magsac, gms, a+b to keep what both keep, or all; default: best), scoring them\n"
+                   "against ground truth when one is given.");
   addMatchCommandOptions(&parser);
   if (!parser.parse(args)) return 0;
   const MatchOptions options = matchOptionsFromArgs(parser);
+  if (parser.has("out-matches")) checkMatchTablePath(parser.get("out-matches"));
   const std::string left_path = parser.get("LEFT"), right_path = parser.get("RIGHT");
   const cv::Mat left = readImage(left_path), right = readImage(right_path);
 
-  PutativeMatches input = matchImages(left, right, options.sift, options.matching);
+  nlohmann::json time_ms;
+  PutativeMatches input = timedMatch(left, right, options, &time_ms);
   calibrate(parser, left_path, right_path, &input);
   const std::optional<PairTruth> truth = pairTruth(parser, left_path, right_path);
   const std::vector<MatchTruth> judged = truth ? truth->judge(input) : std::vector<MatchTruth>();
@@ -212,13 +251,17 @@ int runMatch(const std::vector<std::string>& args) {
   nlohmann::json result = {{"putative", input.matches.size()},
                            {"left_keypoints", input.left_keypoints.size()},
                            {"right_keypoints", input.right_keypoints.size()},
+                           {"time_ms", time_ms},
                            {"filters", nlohmann::json::object()}};
   if (truth) result["ground_truth"] = truthJson(truth->kind, judged);
   std::vector<std::string> order;
-  const std::optional<FilterRun> first =
+  const std::vector<FilterRun> runs =
       runFilters(parser, input, options.filters, truth_or_null, &result, &order);
-  if (parser.has("out-image") && first) {
-    writeImage(parser.get("out-image"), drawMatchDecisions(left, right, input, first->result));
+  if (parser.has("out-image") && !runs.empty()) {
+    writeImage(parser.get("out-image"), drawMatchDecisions(left, right, input, runs[0].result));
+  }
+  if (parser.has("out-matches")) {
+    writeMatchTable(parser.get("out-matches"), input, runs, truth_or_null);
   }
   if (parser.has("out-histograms")) {
     writeHistogramFigure(parser.get("out-histograms"), input, options.filters, truth_or_null);

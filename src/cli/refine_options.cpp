@@ -248,7 +248,7 @@ void addRefineOptions(ArgParser* parser) {
                     "pairs to match: each view with its two nearest (camera centres), or all",
                     "neighbours");
   parser->addOption("filter", "NAME", "match filter for --refine-with-matches (makeFilter names)",
-                    "gsc");
+                    kDefaultFilter);
   parser->addOption("contrast-threshold", "T",
                     "SIFT's contrast threshold for --refine-with-matches (SiftConfig's default: "
                     "0.04; lower finds more features)",

@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
@@ -11,6 +13,11 @@
 
 namespace sift_hull {
 namespace {
+
+std::string fileText(const std::string& path) {
+  std::ifstream in(path);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
 
 using CommandOutput = test::WrittenSceneSuite;
 
@@ -46,6 +53,55 @@ TEST_F(CommandOutput, ListsTheFiltersInTheOrderGiven) {
   ASSERT_NE(gms, std::string::npos) << out;
   EXPECT_LT(ransac, gsc) << out;
   EXPECT_LT(gsc, gms) << out;
+}
+
+TEST_F(CommandOutput, MatchRunsBestByDefaultAndTimesSiftAndMatching) {
+  const std::string pair = *scene_ + "/view_0000.png " + *scene_ + "/view_0001.png";
+  std::string out, err;
+  ASSERT_EQ(test::runProgram("match " + pair + " --json", &out, &err), 0) << err;
+  const nlohmann::json result = nlohmann::json::parse(out);
+  ASSERT_EQ(result["filters"].size(), 1u) << out;
+  EXPECT_TRUE(result["filters"].contains("best")) << out;
+  for (const char* key : {"sift_left", "sift_right", "matching"})
+    EXPECT_GT(result["time_ms"][key].get<double>(), 0.0) << key;
+  ASSERT_EQ(test::runProgram("match " + pair + " --json --filter all", &out, &err), 0) << err;
+  EXPECT_GE(nlohmann::json::parse(out)["filters"].size(), 9u) << "every filter but epipolar";
+}
+
+TEST_F(CommandOutput, WritesOneRowPerPutativeAsCsvAndJson) {
+  const std::string pair = *scene_ + "/view_0000.png " + *scene_ + "/view_0001.png";
+  const std::string dir = test::temporaryDirectory();
+  std::string out, err;
+  ASSERT_EQ(test::runProgram("match " + pair + " --gt-scene " + *scene_ + " --json --filter gsc " +
+                                 "--filter best --out-matches " + dir + "/m.csv",
+                             &out, &err),
+            0)
+      << err;
+  const nlohmann::json result = nlohmann::json::parse(out);
+  std::istringstream csv(fileText(dir + "/m.csv"));
+  std::string header, line;
+  std::getline(csv, header);
+  EXPECT_EQ(header,
+            "match,left_x,left_y,left_size,left_angle,right_x,right_y,right_size,right_angle,"
+            "descriptor_distance,truth,gsc_keep,gsc_score,best_keep,best_score");
+  size_t rows = 0, kept = 0;
+  while (std::getline(csv, line)) {
+    ++rows;
+    kept += line.find(",correct,") != std::string::npos ||
+            line.find(",wrong,") != std::string::npos ||
+            line.find(",unknown,") != std::string::npos;
+  }
+  EXPECT_EQ(rows, result["putative"].get<size_t>());
+  EXPECT_EQ(kept, rows) << "every row carries its truth";
+  ASSERT_EQ(test::runProgram("match " + pair + " --out-matches " + dir + "/m.json", &out, &err), 0);
+  const nlohmann::json table = nlohmann::json::parse(fileText(dir + "/m.json"));
+  ASSERT_EQ(table.size(), rows);
+  size_t best_kept = 0;
+  for (const auto& row : table) best_kept += row["best_keep"].get<int>();
+  EXPECT_GT(best_kept, rows / 2);
+  EXPECT_TRUE(table[0].contains("descriptor_distance"));
+  EXPECT_EQ(test::runProgram("match " + pair + " --out-matches " + dir + "/m.txt", &out, &err), 2);
+  EXPECT_NE(err.find("must end in .csv or .json"), std::string::npos) << err;
 }
 
 TEST_F(CommandOutput, PrintsOnlyJsonWithJson) {

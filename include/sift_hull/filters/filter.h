@@ -49,6 +49,10 @@ class MatchFilter {
 /// default: today `guided`.
 const std::vector<std::string>& filterNames();
 
+/// The filter the CLI (`match`, `hull --refine-with-matches`) and the matcher node run unless
+/// told otherwise.
+inline constexpr const char* kDefaultFilter = "best";
+
 /// A filter by name; "a+b" composes filters, keeping what all keep (score: how many rejected the
 /// match). Throws std::invalid_argument for an unknown name.
 std::unique_ptr<MatchFilter> makeFilter(const std::string& spec, const FilterConfigs& configs);

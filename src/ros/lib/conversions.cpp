@@ -250,7 +250,29 @@ nlohmann::json toJson(const GscConfig& config) {
 nlohmann::json toJson(const RobustFitConfig& config, const std::string& prefix) {
   return {{prefix + "_max_epipolar_px", config.max_epipolar_px},
           {prefix + "_confidence", config.confidence},
-          {prefix + "_max_iterations", config.max_iterations}};
+          {prefix + "_max_iterations", config.max_iterations},
+          {prefix + "_seed", config.seed}};
+}
+
+nlohmann::json toJson(const LscConfig& config) {
+  return {{"lsc_neighbours", config.lsc_neighbours},
+          {"lsc_max_relative_error", config.lsc_max_relative_error},
+          {"lsc_min_tolerance_px", config.lsc_min_tolerance_px},
+          {"lsc_min_support", config.lsc_min_support}};
+}
+
+nlohmann::json toJson(const LocalGscConfig& config) {
+  return {{"local_gsc_neighbours", config.local_gsc_neighbours},
+          {"local_gsc_max_histogram_distance", config.local_gsc_max_histogram_distance}};
+}
+
+nlohmann::json toJson(const GuidedConfig& config) {
+  return {{"guided_max_transfer_px", config.guided_max_transfer_px},
+          {"guided_homography_share", config.guided_homography_share},
+          {"guided_max_models", config.guided_max_models},
+          {"guided_min_model_inliers", config.guided_min_model_inliers},
+          {"guided_min_support", config.guided_min_support},
+          {"guided_max_fit_points", config.guided_max_fit_points}};
 }
 
 nlohmann::json toJson(const GmsConfig& config) {
@@ -266,7 +288,8 @@ std::string settingsJson(const MatchConfig& matching, const FilterConfigs& filte
   nlohmann::json json = toJson(matching);
   for (const nlohmann::json& part :
        {toJson(filters.epipolar), toJson(filters.gsc), toJson(filters.ransac, "ransac"),
-        toJson(filters.magsac, "magsac"), toJson(filters.gms)}) {
+        toJson(filters.magsac, "magsac"), toJson(filters.gms), toJson(filters.lsc),
+        toJson(filters.local_gsc), toJson(filters.guided)}) {
     json.update(part);
   }
   return json.dump();

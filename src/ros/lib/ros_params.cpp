@@ -205,6 +205,34 @@ RobustFitConfig readRobustFitConfig(const ros::NodeHandle& private_nh, const std
   readRenamed(private_nh, prefix + "_confidence", "robust_confidence", &config.confidence);
   readRenamed(private_nh, prefix + "_max_iterations", "robust_max_iterations",
               &config.max_iterations);
+  read(private_nh, prefix + "_seed", &config.seed);
+  return config;
+}
+
+LscConfig readLscConfig(const ros::NodeHandle& private_nh) {
+  LscConfig config;
+  read(private_nh, "lsc_neighbours", &config.lsc_neighbours);
+  read(private_nh, "lsc_max_relative_error", &config.lsc_max_relative_error);
+  read(private_nh, "lsc_min_tolerance_px", &config.lsc_min_tolerance_px);
+  read(private_nh, "lsc_min_support", &config.lsc_min_support);
+  return config;
+}
+
+LocalGscConfig readLocalGscConfig(const ros::NodeHandle& private_nh) {
+  LocalGscConfig config;
+  read(private_nh, "local_gsc_neighbours", &config.local_gsc_neighbours);
+  read(private_nh, "local_gsc_max_histogram_distance", &config.local_gsc_max_histogram_distance);
+  return config;
+}
+
+GuidedConfig readGuidedConfig(const ros::NodeHandle& private_nh) {
+  GuidedConfig config;
+  read(private_nh, "guided_max_transfer_px", &config.guided_max_transfer_px);
+  read(private_nh, "guided_homography_share", &config.guided_homography_share);
+  read(private_nh, "guided_max_models", &config.guided_max_models);
+  read(private_nh, "guided_min_model_inliers", &config.guided_min_model_inliers);
+  read(private_nh, "guided_min_support", &config.guided_min_support);
+  read(private_nh, "guided_max_fit_points", &config.guided_max_fit_points);
   return config;
 }
 
@@ -224,6 +252,9 @@ FilterConfigs readFilterConfigs(const ros::NodeHandle& private_nh) {
   configs.ransac = readRobustFitConfig(private_nh, "ransac");
   configs.magsac = readRobustFitConfig(private_nh, "magsac");
   configs.gms = readGmsConfig(private_nh);
+  configs.lsc = readLscConfig(private_nh);
+  configs.local_gsc = readLocalGscConfig(private_nh);
+  configs.guided = readGuidedConfig(private_nh);
   validate(configs);
   return configs;
 }

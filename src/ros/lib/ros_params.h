@@ -67,7 +67,8 @@ EpipolarConfig readEpipolarConfig(const ros::NodeHandle& private_nh);
 /// Deprecated: ~gsc_max_histogram_distance, ~gsc_threads.
 GscConfig readGscConfig(const ros::NodeHandle& private_nh);
 
-/// ~<prefix>_max_epipolar_px, ~<prefix>_confidence, ~<prefix>_max_iterations, prefix "ransac" or
+/// ~<prefix>_max_epipolar_px, ~<prefix>_confidence, ~<prefix>_max_iterations, ~<prefix>_seed,
+/// prefix "ransac" or
 /// "magsac" (the FilterConfigs member). Deprecated: ~robust_confidence and ~robust_max_iterations,
 /// which set both instances unless the instance's own name is set.
 RobustFitConfig readRobustFitConfig(const ros::NodeHandle& private_nh, const std::string& prefix);
@@ -76,7 +77,17 @@ RobustFitConfig readRobustFitConfig(const ros::NodeHandle& private_nh, const std
 /// Deprecated: ~gms_grid_cells, ~gms_threshold_factor, ~gms_with_rotation, ~gms_with_scale.
 GmsConfig readGmsConfig(const ros::NodeHandle& private_nh);
 
-/// The filter readers above: epipolar, gsc, ransac, magsac, gms.
+/// ~lsc_neighbours, ~lsc_max_relative_error, ~lsc_min_tolerance_px, ~lsc_min_support.
+LscConfig readLscConfig(const ros::NodeHandle& private_nh);
+
+/// ~local_gsc_neighbours, ~local_gsc_max_histogram_distance.
+LocalGscConfig readLocalGscConfig(const ros::NodeHandle& private_nh);
+
+/// ~guided_max_transfer_px, ~guided_homography_share, ~guided_max_models,
+/// ~guided_min_model_inliers, ~guided_min_support, ~guided_max_fit_points.
+GuidedConfig readGuidedConfig(const ros::NodeHandle& private_nh);
+
+/// The filter readers above: epipolar, gsc, ransac, magsac, gms, lsc, local_gsc, guided.
 FilterConfigs readFilterConfigs(const ros::NodeHandle& private_nh);
 
 /// ~filters, ~queue_size, ~max_waiting_pairs, ~workers, ~approximate_sync, ~calibrated,

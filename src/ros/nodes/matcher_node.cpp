@@ -143,6 +143,12 @@ void MatcherNode::serveReconfigure() {
   config.magsac_max_epipolar_px = settings_.filters.magsac.max_epipolar_px;
   config.max_epipolar_px = settings_.filters.epipolar.max_epipolar_px;
   config.threshold_factor = settings_.filters.gms.threshold_factor;
+  config.lsc_max_relative_error = settings_.filters.lsc.lsc_max_relative_error;
+  config.lsc_min_support = settings_.filters.lsc.lsc_min_support;
+  config.local_gsc_max_histogram_distance =
+      settings_.filters.local_gsc.local_gsc_max_histogram_distance;
+  config.guided_max_transfer_px = settings_.filters.guided.guided_max_transfer_px;
+  config.guided_min_support = settings_.filters.guided.guided_min_support;
   reconfigure_ = std::make_unique<dynamic_reconfigure::Server<sift_hull::MatcherConfig>>(
       reconfigure_mutex_, private_nh_);
   reconfigure_->updateConfig(config);
@@ -161,6 +167,12 @@ void MatcherNode::onReconfigure(sift_hull::MatcherConfig& config, uint32_t) {
   changed.filters.magsac.max_epipolar_px = config.magsac_max_epipolar_px;
   changed.filters.epipolar.max_epipolar_px = config.max_epipolar_px;
   changed.filters.gms.threshold_factor = config.threshold_factor;
+  changed.filters.lsc.lsc_max_relative_error = config.lsc_max_relative_error;
+  changed.filters.lsc.lsc_min_support = config.lsc_min_support;
+  changed.filters.local_gsc.local_gsc_max_histogram_distance =
+      config.local_gsc_max_histogram_distance;
+  changed.filters.guided.guided_max_transfer_px = config.guided_max_transfer_px;
+  changed.filters.guided.guided_min_support = config.guided_min_support;
   std::shared_ptr<const Pipeline> replacement;
   try {
     validate(changed.matching);

@@ -40,7 +40,7 @@ namespace sift_hull {
 struct MatcherNodeConfig {
   /// Filters to run, by makeFilter name ("gsc", "magsac", "epipolar+gsc", ...). The epipolar
   /// filter needs `calibrated`.
-  std::vector<std::string> filters = {"gsc"};
+  std::vector<std::string> filters = {kDefaultFilter};
   int queue_size = 10;  ///< images waiting for their partner
   /// Paired images waiting for a worker; when more come, the oldest pair is dropped (counted in
   /// /diagnostics), so a stream faster than matching costs neither memory nor latency.

@@ -4,7 +4,7 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
-#include "sift_hull/eval/match_evaluation.h"
+#include "sift_hull/features/labelled_matches.h"
 #include "sift_hull/features/matching.h"
 
 namespace sift_hull {
@@ -26,10 +26,10 @@ WarpedPair rotationZoomPair(double rotation_deg, double scale);
 /// rotation, scale and shift, so that no single F or H explains the pair.
 WarpedPair twoMotionPair();
 
-/// Correct when the right point is within max_homography_error_px of H x_left for the left
+/// Correct when the right point is within max_error_px of H x_left for the left
 /// point's region and that region is what the right image shows there; otherwise wrong (moved out
 /// of the image or hidden by the other region).
 std::vector<MatchTruth> judgeByMotions(const PutativeMatches& input, const WarpedPair& pair,
-                                       const TruthTolerances& tolerances = {});
+                                       double max_error_px = 3.0);
 
 }  // namespace sift_hull

@@ -1,4 +1,4 @@
-#include "sift_hull/eval/warped_pairs.h"
+#include "sift_hull/synthetic/warped_pairs.h"
 
 #include <Eigen/Dense>
 #include <cmath>
@@ -65,7 +65,7 @@ WarpedPair twoMotionPair() {
 }
 
 std::vector<MatchTruth> judgeByMotions(const PutativeMatches& input, const WarpedPair& pair,
-                                       const TruthTolerances& tolerances) {
+                                       double max_error_px) {
   std::vector<MatchTruth> truth(input.matches.size(), MatchTruth::kWrong);
   for (size_t m = 0; m < input.matches.size(); ++m) {
     if (!input.hasFinitePositions(m)) continue;
@@ -80,7 +80,7 @@ std::vector<MatchTruth> judgeByMotions(const PutativeMatches& input, const Warpe
     if (ex < 0 || ey < 0 || ex >= pair.right_owner.cols || ey >= pair.right_owner.rows) continue;
     if (pair.right_owner.at<uint8_t>(ey, ex) != region + 1) continue;
     const double error = (expected - Eigen::Vector2d(b.x, b.y)).norm();
-    if (error <= tolerances.max_homography_error_px) truth[m] = MatchTruth::kCorrect;
+    if (error <= max_error_px) truth[m] = MatchTruth::kCorrect;
   }
   return truth;
 }
