@@ -17,6 +17,7 @@ set(SIFT_HULL_CORE_GTESTS
   test_ground_truth_files io
   test_features eval
   test_nearest_neighbours eval
+  test_feature_cache core
   test_filters eval
   test_local_filters eval
   test_evaluation eval

@@ -19,7 +19,7 @@ struct MatchConfig {
   double max_descriptor_distance = std::numeric_limits<double>::infinity();
   /// Lowe's ratio test: keep when nearest < ratio * second nearest. 1 (or more) turns it off.
   double ratio = 0.8;
-  bool cross_check = false;             ///< keep only mutual nearest neighbours
+  bool cross_check = false;  ///< keep only mutual nearest neighbours
   /// "blas" (exact, by matrix product: exactNearestNeighbours), "brute-force" (exact, OpenCV's
   /// BFMatcher) or "flann" (approximate, kd-trees).
   std::string backend = "blas";
@@ -62,7 +62,11 @@ std::vector<cv::DMatch> matchAlongEpipolarLines(const Features& left, const Feat
                                                 const PinholeCamera& right_camera,
                                                 const MatchConfig& config, double max_epipolar_px);
 
-/// Detects, describes and matches: the putative matches of two images.
+/// Matches described images: the putative matches of the two feature sets (copied in).
+PutativeMatches matchFeatures(const Features& left, const Features& right, cv::Size left_size,
+                              cv::Size right_size, const MatchConfig& matching);
+
+/// Detects and describes both images (the right one on a second thread) and matches them.
 PutativeMatches matchImages(const cv::Mat& left_image, const cv::Mat& right_image,
                             const SiftConfig& sift, const MatchConfig& matching);
 

@@ -1,6 +1,7 @@
 #include "sift_hull/features/matching.h"
 
 #include <cmath>
+#include <future>
 #include <limits>
 #include <opencv2/features2d.hpp>
 #include <optional>
@@ -160,11 +161,30 @@ std::vector<cv::DMatch> matchDescriptors(const cv::Mat& left, const cv::Mat& rig
   return matches;
 }
 
+PutativeMatches matchFeatures(const Features& left, const Features& right, cv::Size left_size,
+                              cv::Size right_size, const MatchConfig& matching) {
+  PutativeMatches result;
+  result.matches = matchDescriptors(left.descriptors, right.descriptors, matching);
+  result.left_keypoints = left.keypoints;
+  result.right_keypoints = right.keypoints;
+  result.left_image_size = left_size;
+  result.right_image_size = right_size;
+  return result;
+}
+
 PutativeMatches matchImages(const cv::Mat& left_image, const cv::Mat& right_image,
                             const SiftConfig& sift, const MatchConfig& matching) {
   validate(matching);
-  Features left = detectSift(left_image, sift);
-  Features right = detectSift(right_image, sift);
+  std::future<Features> right_features =
+      std::async(std::launch::async, [&] { return detectSift(right_image, sift); });
+  Features left;
+  try {
+    left = detectSift(left_image, sift);
+  } catch (...) {
+    right_features.wait();  // the other thread reads the caller's image: let it finish first
+    throw;
+  }
+  Features right = right_features.get();
   PutativeMatches result;
   result.matches = matchDescriptors(left.descriptors, right.descriptors, matching);
   result.left_keypoints = std::move(left.keypoints);

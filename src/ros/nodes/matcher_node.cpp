@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <future>
 
 #include "lib/conversions.h"
 #include "lib/node_diagnostics.h"
@@ -125,6 +126,8 @@ std::shared_ptr<const MatcherNode::Pipeline> MatcherNode::pipeline() const {
 void MatcherNode::reportDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& status) {
   reportQueue(work_.counts(), "pairs", &status);
   status.add("last pair ms", last_pair_ms_.load());
+  status.add("images described", features_.misses());
+  status.add("features reused", features_.hits());
   const std::string unpaired = pairing_.problem(PairingWatch::Clock::now());
   if (!unpaired.empty()) {
     status.mergeSummary(diagnostic_msgs::DiagnosticStatus::WARN, unpaired);
@@ -362,6 +365,19 @@ void MatcherNode::matchPair(Pair& pair) {
   last_pair_ms_ = (ros::WallTime::now() - start).toSec() * 1e3;
 }
 
+PutativeMatches MatcherNode::matchDescribed(const Pipeline& pipeline, const cv::Mat& left,
+                                            const cv::Mat& right) {
+  const auto describe = [&](const cv::Mat& image) {
+    return features_.get(imageKey(image),
+                         [&] { return detectSift(image, pipeline.settings.sift); });
+  };
+  // The right image on a second thread; the future's destructor waits for it, also on a throw.
+  auto right_features = std::async(std::launch::async, describe, std::cref(right));
+  const std::shared_ptr<const Features> left_features = describe(left);
+  return matchFeatures(*left_features, *right_features.get(), left.size(), right.size(),
+                       pipeline.settings.matching);
+}
+
 void MatcherNode::process(const Pipeline& pipeline, const sensor_msgs::ImageConstPtr& left,
                           const sensor_msgs::ImageConstPtr& right, const StereoCameras* cameras) {
   std::string why_not;
@@ -372,8 +388,7 @@ void MatcherNode::process(const Pipeline& pipeline, const sensor_msgs::ImageCons
     log_.error("matcher: pair ignored: ", why_not);
     return;
   }
-  PutativeMatches matches =
-      matchImages(left_image, right_image, pipeline.settings.sift, pipeline.settings.matching);
+  PutativeMatches matches = matchDescribed(pipeline, left_image, right_image);
   if (matches.left_keypoints.size() < 2 || matches.right_keypoints.size() < 2) {
     log_.error("matcher: pair ignored: ", "fewer than two keypoints in an image (" +
                                               std::to_string(matches.left_keypoints.size()) +

@@ -28,6 +28,7 @@
 #include "lib/work_queue.h"
 #include "sift_hull/Correspondences.h"
 #include "sift_hull/MatcherConfig.h"
+#include "sift_hull/features/feature_cache.h"
 #include "sift_hull/features/matching.h"
 #include "sift_hull/features/sift.h"
 #include "sift_hull/filters/filter.h"
@@ -141,6 +142,9 @@ class MatcherNode {
   void waitForTransform(const std::string& target, const std::string& source,
                         const ros::Time& stamp) const;
   void matchPair(Pair& pair);
+  /// SIFT of both images (through features_, the right one on a second thread), then matching.
+  PutativeMatches matchDescribed(const Pipeline& pipeline, const cv::Mat& left,
+                                 const cv::Mat& right);
   void process(const Pipeline& pipeline, const sensor_msgs::ImageConstPtr& left,
                const sensor_msgs::ImageConstPtr& right, const StereoCameras* cameras);
   std::shared_ptr<const Pipeline> pipeline() const;
@@ -166,6 +170,9 @@ class MatcherNode {
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
   std::atomic<double> last_pair_ms_{0.0};
+  /// Each image's features for the next pair it is in (keyed by its pixels): frame to frame and
+  /// the (k, k+1) pairs of a stereo sequence describe an image once.
+  FeatureCache features_{8};
   WorkQueue<Pair> work_;
   PairingWatch pairing_;  ///< images (and camera_infos) that arrive but do not pair
   NodeDiagnostics diagnostics_;
