@@ -94,6 +94,8 @@ void addFilterOptions(ArgParser* parser) {
                     numberText(filters.gsc.max_histogram_distance));
   parser->addDeprecatedAlias("gsc-max-distance", {"max-histogram-distance"});
   parser->addOption("threads", "N", "gsc: threads (0: all)", numberText(filters.gsc.threads));
+  parser->addOption("max-support", "M", "gsc: histograms over M sampled matches (0: all, exact)",
+                    numberText(filters.gsc.max_support));
   parser->addOption("ransac-max-epipolar-px", "PX", "ransac: inlier threshold",
                     numberText(filters.ransac.max_epipolar_px));
   parser->addOption("magsac-max-epipolar-px", "PX", "magsac: inlier threshold",
@@ -119,6 +121,7 @@ FilterConfigs filterConfigsFromArgs(const ArgParser& parser) {
   filters.epipolar.max_epipolar_px = parser.getDouble("max-epipolar-px");
   filters.gsc.max_histogram_distance = parser.getDouble("max-histogram-distance");
   filters.gsc.threads = parser.getInt("threads");
+  filters.gsc.max_support = parser.getInt("max-support");
   filters.ransac.max_epipolar_px = parser.getDouble("ransac-max-epipolar-px");
   filters.magsac.max_epipolar_px = parser.getDouble("magsac-max-epipolar-px");
   filters.gms.grid_cells = parser.getInt("grid-cells");

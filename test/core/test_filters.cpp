@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <algorithm>
+#include <iostream>
 #include <random>
 
 #include "sift_hull/features/labelled_matches.h"
@@ -132,6 +134,41 @@ TEST(GscReference, AgreesOnRandomMatchesAcrossBlocksAndThreads) {
                           "match " + std::to_string(m));
   }
   EXPECT_EQ(threaded.score, single.score);
+}
+
+/// The sampled gsc from its definition: the histograms over the sample the filter draws (the
+/// valid matches shuffled by mt19937(1), the first M), coincident sample points left out.
+double referenceSampledDistance(const PutativeMatches& input, size_t m, size_t support) {
+  std::vector<size_t> chosen(input.matches.size());
+  for (size_t i = 0; i < chosen.size(); ++i) chosen[i] = i;
+  std::shuffle(chosen.begin(), chosen.end(), std::mt19937(1));
+  chosen.resize(support);
+  std::vector<cv::KeyPoint> left, right;
+  for (size_t c : chosen) left.push_back(input.left(c)), right.push_back(input.right(c));
+  left.push_back(input.left(m)), right.push_back(input.right(m));
+  return GscHistograms{referenceHistogram(left, left.size() - 1),
+                       referenceHistogram(right, right.size() - 1)}
+      .distance();
+}
+
+TEST(GscSampled, EqualsItsReferenceAndKeepsNearlyEveryExactDecision) {
+  SyntheticMatchConfig config;
+  config.inliers = 1400;  // 2000 matches with 30 % outliers
+  const LabelledMatches synthetic = syntheticMatches(config);
+  GscConfig sampled;
+  sampled.max_support = 256;
+  const FilterResult fast = filterGsc(synthetic.putative, sampled);
+  for (size_t m = 0; m < synthetic.truth.size(); m += 13) {
+    EXPECT_NEAR(fast.score[m], referenceSampledDistance(synthetic.putative, m, 256), 1e-12) << m;
+  }
+  const FilterResult exact = filterGsc(synthetic.putative, GscConfig());
+  size_t same = 0;
+  for (size_t m = 0; m < exact.keep.size(); ++m) same += exact.keep[m] == fast.keep[m];
+  std::cout << same << " of " << exact.keep.size() << " decisions as the exact gsc (M = 256)\n";
+  EXPECT_GE(same, 0.97 * exact.keep.size());
+  EXPECT_EQ(filterGsc(synthetic.putative, sampled).score, fast.score) << "a fixed sample";
+  sampled.max_support = 5000;  // more than the matches: the exact filter
+  EXPECT_EQ(filterGsc(synthetic.putative, sampled).score, exact.score);
 }
 
 TEST(GscReference, SectorOfEachBorderDirection) {

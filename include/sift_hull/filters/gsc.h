@@ -13,6 +13,10 @@ namespace sift_hull {
 struct GscConfig {
   double max_histogram_distance = 0.2;
   int threads = 0;  ///< 0 uses all hardware threads
+  /// 0: the exact filter (every other match in each histogram). M > 0: each histogram over a
+  /// fixed random sample of M matches (the same matches in both images, so that a correct match
+  /// sees the same sampled points left and right), O(N M) instead of O(N^2).
+  int max_support = 0;
 };
 
 FilterResult filterGsc(const PutativeMatches& input, const GscConfig& config);

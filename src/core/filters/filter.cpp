@@ -125,6 +125,8 @@ void validate(const FilterConfigs& configs) {
           "gms.grid_cells must be in [3, " + std::to_string(limits::kMaxGmsGridCells) + "]");
   require(configs.gms.threshold_factor > 0.0 && std::isfinite(configs.gms.threshold_factor),
           "gms.threshold_factor must be finite and > 0");
+  require(configs.gsc.max_support >= 0 && configs.gsc.max_support <= 1000000,
+          "gsc.max_support must be in [0, 1000000] (0: exact)");
   validate(configs.lsc);
   validate(configs.local_gsc);
   validate(configs.guided);

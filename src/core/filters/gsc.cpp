@@ -17,7 +17,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
+#include <random>
 #include <thread>
+#include <unordered_map>
 
 #include "common/parallel.h"
 
@@ -201,6 +204,61 @@ std::vector<double> histogramDistances(const PolarPoints& left, const PolarPoint
   return distances;
 }
 
+/// The histogram around an arbitrary centre over the points of `sample` (its padding and the
+/// sample points at the centre itself, `coincident` of them, left out).
+GscHistogram histogramOver(const PolarPoints& sample, float xi, float yi, float c, float s,
+                           uint32_t coincident) {
+  LabelCounts counts;
+  countLabels(sample.x.data(), sample.y.data(), sample.x.size(), xi, yi, c, s, &counts);
+  counts[kPaddingLabel] -= static_cast<uint32_t>(sample.x.size() - sample.count);
+  counts[labelOfKeypoint(xi, yi, c, s)] -= coincident;
+  const uint32_t others = static_cast<uint32_t>(sample.count) - coincident;
+  GscHistogram histogram{};
+  if (others == 0) return histogram;
+  for (int label = 0; label < kGscSectors; ++label) {
+    histogram[kSectorOfLabel[label]] = static_cast<double>(counts[label]) / others;
+  }
+  return histogram;
+}
+
+/// How many points of `sample` sit exactly at each point of `all`.
+std::vector<uint32_t> coincidentWithSample(const PolarPoints& all, const PolarPoints& sample) {
+  std::unordered_map<uint64_t, uint32_t> at;
+  const auto key = [](float x, float y) {
+    uint32_t a, b;
+    std::memcpy(&a, &x, 4), std::memcpy(&b, &y, 4);
+    return (uint64_t(a) << 32) | b;
+  };
+  for (size_t j = 0; j < sample.count; ++j) ++at[key(sample.x[j], sample.y[j])];
+  std::vector<uint32_t> result(all.count);
+  for (size_t i = 0; i < all.count; ++i) {
+    const auto found = at.find(key(all.x[i], all.y[i]));
+    result[i] = found == at.end() ? 0 : found->second;
+  }
+  return result;
+}
+
+/// The sampled filter: every match's histograms over the same M sampled matches left and right.
+std::vector<double> sampledDistances(const PutativeMatches& input, const std::vector<size_t>& valid,
+                                     size_t support, int threads) {
+  std::vector<size_t> chosen(valid);
+  std::shuffle(chosen.begin(), chosen.end(), std::mt19937(1));  // fixed: the same every call
+  chosen.resize(support);
+  const auto [left, right] = polarPointsOf(input, valid);
+  const auto [left_sample, right_sample] = polarPointsOf(input, chosen);
+  const std::vector<uint32_t> left_at = coincidentWithSample(left, left_sample);
+  const std::vector<uint32_t> right_at = coincidentWithSample(right, right_sample);
+  std::vector<double> distances(left.count);
+  detail::parallelFor(left.count, threads, [&](size_t i) {
+    distances[i] =
+        histogramDistance(histogramOver(left_sample, left.x[i], left.y[i], left.cos_angle[i],
+                                        left.sin_angle[i], left_at[i]),
+                          histogramOver(right_sample, right.x[i], right.y[i], right.cos_angle[i],
+                                        right.sin_angle[i], right_at[i]));
+  });
+  return distances;
+}
+
 }  // namespace
 
 double GscHistograms::distance() const { return histogramDistance(left, right); }
@@ -208,9 +266,15 @@ double GscHistograms::distance() const { return histogramDistance(left, right); 
 FilterResult filterGsc(const PutativeMatches& input, const GscConfig& config) {
   FilterResult result = FilterResult::keepingNone(input.matches.size());
   const std::vector<size_t> valid = validMatches(input);
-  const auto [left, right] = polarPointsOf(input, valid);
-  const std::vector<double> distances =
-      histogramDistances(left, right, threadCount(config.threads, valid.size()));
+  const int threads = threadCount(config.threads, valid.size());
+  const size_t support = static_cast<size_t>(std::max(config.max_support, 0));
+  std::vector<double> distances;
+  if (support > 0 && support < valid.size()) {
+    distances = sampledDistances(input, valid, support, threads);
+  } else {
+    const auto [left, right] = polarPointsOf(input, valid);
+    distances = histogramDistances(left, right, threads);
+  }
   for (size_t v = 0; v < valid.size(); ++v) {
     result.score[valid[v]] = distances[v];
     result.keep[valid[v]] = distances[v] <= config.max_histogram_distance;

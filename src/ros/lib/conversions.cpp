@@ -244,7 +244,9 @@ nlohmann::json toJson(const EpipolarConfig& config) {
 }
 
 nlohmann::json toJson(const GscConfig& config) {
-  return {{"max_histogram_distance", config.max_histogram_distance}, {"threads", config.threads}};
+  return {{"max_histogram_distance", config.max_histogram_distance},
+          {"threads", config.threads},
+          {"max_support", config.max_support}};
 }
 
 nlohmann::json toJson(const RobustFitConfig& config, const std::string& prefix) {

@@ -196,6 +196,7 @@ GscConfig readGscConfig(const ros::NodeHandle& private_nh) {
   readRenamed(private_nh, "max_histogram_distance", "gsc_max_histogram_distance",
               &config.max_histogram_distance);
   readRenamed(private_nh, "threads", "gsc_threads", &config.threads);
+  read(private_nh, "max_support", &config.max_support);
   return config;
 }
 

@@ -63,7 +63,7 @@ MatchConfig readMatchConfig(const ros::NodeHandle& private_nh);
 /// ~max_epipolar_px.
 EpipolarConfig readEpipolarConfig(const ros::NodeHandle& private_nh);
 
-/// ~max_histogram_distance, ~threads.
+/// ~max_histogram_distance, ~threads, ~max_support.
 /// Deprecated: ~gsc_max_histogram_distance, ~gsc_threads.
 GscConfig readGscConfig(const ros::NodeHandle& private_nh);
 
