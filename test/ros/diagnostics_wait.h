@@ -5,6 +5,8 @@
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <ros/ros.h>
 
+#include <cmath>
+#include <cstdlib>
 #include <functional>
 #include <mutex>
 #include <string>
@@ -36,6 +38,32 @@ inline std::string warningOf(ros::NodeHandle& nh, const std::string& task, const
     if (warning.find(text) != std::string::npos) return warning;
   }
   return "";
+}
+
+/// The value of `key` in the /diagnostics status whose name holds `task`, once `accept` takes it,
+/// at most `deadline_s` of wall time; NaN after the deadline.
+inline double diagnosticValue(ros::NodeHandle& nh, const std::string& task, const std::string& key,
+                              const std::function<bool(double)>& accept, double deadline_s = 20.0) {
+  std::mutex mutex;
+  double value = std::nan("");
+  ros::Subscriber diagnostics = nh.subscribe<diagnostic_msgs::DiagnosticArray>(
+      "/diagnostics", 20, [&](const diagnostic_msgs::DiagnosticArrayConstPtr& array) {
+        std::lock_guard<std::mutex> lock(mutex);
+        for (const diagnostic_msgs::DiagnosticStatus& status : array->status) {
+          if (status.name.find(task) == std::string::npos) continue;
+          for (const diagnostic_msgs::KeyValue& pair : status.values) {
+            if (pair.key == key) value = std::atof(pair.value.c_str());
+          }
+        }
+      });
+  const ros::WallTime start = ros::WallTime::now();
+  while ((ros::WallTime::now() - start).toSec() < deadline_s) {
+    ros::WallDuration(0.1).sleep();
+    ros::spinOnce();
+    std::lock_guard<std::mutex> lock(mutex);
+    if (!std::isnan(value) && accept(value)) return value;
+  }
+  return std::nan("");
 }
 
 }  // namespace test

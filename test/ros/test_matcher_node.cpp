@@ -255,6 +255,13 @@ TEST_F(FrameToFrameMatcherTest, MatchesEachFrameWithThePreviousOne) {
   frame_pub_.publish(bgrImage(left_.image, third, "camera"));
   ASSERT_TRUE(waitFor([&] { return last_->right_header.stamp == third; }));
   EXPECT_EQ(last_->header.stamp, second);
+  // Each image was described once: the second frame served two pairs, and the third has the
+  // first one's pixels (2 of the 4 lookups hit the cache, 2 images described).
+  EXPECT_EQ(
+      test::diagnosticValue(nh_, "matcher", "features reused", [](double v) { return v >= 2; }),
+      2.0);
+  EXPECT_EQ(test::diagnosticValue(nh_, "matcher", "images described", [](double) { return true; }),
+            2.0);
 }
 
 /// The same pair with camera_info and the right camera's pose relative to the left in tf.

@@ -4,8 +4,12 @@
 
 #include <algorithm>
 #include <limits>
+#include <mutex>
 #include <opencv2/core/hal/intrin.hpp>
 #include <stdexcept>
+#include <thread>
+
+#include "common/parallel.h"
 
 namespace sift_hull {
 namespace {
@@ -93,6 +97,45 @@ void scanRow(const float* row, int n, int first, int query, Running* running, fl
   }
 }
 
+/// Each reference's nearest query among one thread's queries (squared distance, index).
+struct Reverse {
+  explicit Reverse(int references) : best(references, kInf), index(references, -1) {}
+  std::vector<float> best;
+  std::vector<int> index;
+};
+
+/// One block of queries against every reference block: a matrix product, then the scans.
+void scanQueryBlock(const cv::Mat& q, const cv::Mat& r, int q0, std::vector<float>* block,
+                    Running* running, Reverse* reverse) {
+  const int bq = std::min(kQueryBlock, q.rows - q0), d = q.cols;
+  for (int r0 = 0; r0 < r.rows; r0 += kReferenceBlock) {
+    const int br = std::min(kReferenceBlock, r.rows - r0);
+    cblas_sgemm(CblasRowMajor, CblasNoTrans, CblasTrans, bq, br, d, 1.0f, q.ptr<float>(q0), d,
+                r.ptr<float>(r0), d, 0.0f, block->data(), br);
+    for (int i = 0; i < bq; ++i) {
+      scanRow(block->data() + static_cast<size_t>(i) * br, br, r0, q0 + i, &running[q0 + i],
+              reverse ? reverse->best.data() + r0 : nullptr,
+              reverse ? reverse->index.data() + r0 : nullptr);
+    }
+  }
+}
+
+/// The threads' nearest queries merged: the smallest distance, the lower index among equals.
+std::vector<int> mergeReverse(const std::vector<Reverse>& parts) {
+  std::vector<int> nearest(parts.front().index);
+  std::vector<float> best(parts.front().best);
+  for (size_t t = 1; t < parts.size(); ++t) {
+    for (size_t j = 0; j < nearest.size(); ++j) {
+      const float v = parts[t].best[j];
+      const int i = parts[t].index[j];
+      if (i >= 0 && (v < best[j] || (v == best[j] && i < nearest[j]) || nearest[j] < 0)) {
+        best[j] = v, nearest[j] = i;
+      }
+    }
+  }
+  return nearest;
+}
+
 float l2(const cv::Mat& a, int i, const cv::Mat& b, int j) {
   return static_cast<float>(cv::norm(a.row(i), b.row(j), cv::NORM_L2));
 }
@@ -125,28 +168,27 @@ NearestNeighbours exactNearestNeighbours(const cv::Mat& queries, const cv::Mat& 
     throw std::invalid_argument(
         "exactNearestNeighbours: descriptors must be CV_32F, equal columns");
   }
+  // OpenBLAS's own threads would spin between calls and compete with the caller's work (SIFT of
+  // the next image): one BLAS thread per call, the blocks on threads of ours.
+  static std::once_flag single_threaded_blas;
+  std::call_once(single_threaded_blas, [] { openblas_set_num_threads(1); });
   const cv::Mat q = augmented(queries, false), r = augmented(references, true);
-  const int nq = q.rows, nr = r.rows, d = q.cols;
+  const int nq = q.rows, nr = r.rows;
   std::vector<Running> running(static_cast<size_t>(nq));
-  std::vector<float> reverse_best(with_reverse ? nr : 0, kInf);
-  std::vector<int> reverse_index(with_reverse ? nr : 0, -1);
-  std::vector<float> block(static_cast<size_t>(kQueryBlock) * kReferenceBlock);
-  for (int q0 = 0; q0 < nq; q0 += kQueryBlock) {
-    const int bq = std::min(kQueryBlock, nq - q0);
-    for (int r0 = 0; r0 < nr; r0 += kReferenceBlock) {
-      const int br = std::min(kReferenceBlock, nr - r0);
-      cblas_sgemm(CblasRowMajor, CblasNoTrans, CblasTrans, bq, br, d, 1.0f, q.ptr<float>(q0), d,
-                  r.ptr<float>(r0), d, 0.0f, block.data(), br);
-      for (int i = 0; i < bq; ++i) {
-        scanRow(block.data() + static_cast<size_t>(i) * br, br, r0, q0 + i, &running[q0 + i],
-                with_reverse ? reverse_best.data() + r0 : nullptr,
-                with_reverse ? reverse_index.data() + r0 : nullptr);
-      }
+  const int blocks = (nq + kQueryBlock - 1) / kQueryBlock;
+  const int threads = std::max(1, std::min<int>(std::thread::hardware_concurrency(), blocks));
+  std::vector<Reverse> reverse(with_reverse ? threads : 0, Reverse(nr));
+  // Query blocks are dealt to the threads in turn, so that thread t sees its queries in order.
+  detail::parallelFor(static_cast<size_t>(threads), threads, [&](size_t t) {
+    std::vector<float> block(static_cast<size_t>(kQueryBlock) * kReferenceBlock);
+    for (int b = static_cast<int>(t); b < blocks; b += threads) {
+      scanQueryBlock(q, r, b * kQueryBlock, &block, running.data(),
+                     with_reverse ? &reverse[t] : nullptr);
     }
-  }
+  });
+  if (with_reverse) result.reverse_nearest = mergeReverse(reverse);
   result.forward.reserve(static_cast<size_t>(nq));
   for (int i = 0; i < nq; ++i) result.forward.push_back(finish(running[i], queries, i, references));
-  result.reverse_nearest = std::move(reverse_index);
   return result;
 }
 
