@@ -107,6 +107,22 @@ void expectDefaultMatcher(const ros::NodeHandle& nh) {
   EXPECT_EQ(f.gms.threshold_factor, g.gms.threshold_factor);
   EXPECT_EQ(f.gms.with_rotation, g.gms.with_rotation);
   EXPECT_EQ(f.gms.with_scale, g.gms.with_scale);
+  EXPECT_EQ(f.gsc.max_support, g.gsc.max_support);
+  EXPECT_EQ(f.ransac.seed, g.ransac.seed);
+  EXPECT_EQ(f.magsac.seed, g.magsac.seed);
+  EXPECT_EQ(f.lsc.lsc_neighbours, g.lsc.lsc_neighbours);
+  EXPECT_EQ(f.lsc.lsc_max_relative_error, g.lsc.lsc_max_relative_error);
+  EXPECT_EQ(f.lsc.lsc_min_tolerance_px, g.lsc.lsc_min_tolerance_px);
+  EXPECT_EQ(f.lsc.lsc_min_support, g.lsc.lsc_min_support);
+  EXPECT_EQ(f.local_gsc.local_gsc_neighbours, g.local_gsc.local_gsc_neighbours);
+  EXPECT_EQ(f.local_gsc.local_gsc_max_histogram_distance,
+            g.local_gsc.local_gsc_max_histogram_distance);
+  EXPECT_EQ(f.guided.guided_max_transfer_px, g.guided.guided_max_transfer_px);
+  EXPECT_EQ(f.guided.guided_homography_share, g.guided.guided_homography_share);
+  EXPECT_EQ(f.guided.guided_max_models, g.guided.guided_max_models);
+  EXPECT_EQ(f.guided.guided_min_model_inliers, g.guided.guided_min_model_inliers);
+  EXPECT_EQ(f.guided.guided_min_support, g.guided.guided_min_support);
+  EXPECT_EQ(f.guided.guided_max_fit_points, g.guided.guided_max_fit_points);
 }
 
 TEST(ParameterReaders, TheParameterFilesRestateTheStructDefaults) {
