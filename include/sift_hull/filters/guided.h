@@ -24,7 +24,7 @@ struct GuidedConfig {
   double guided_min_support = 0.1;
   /// MAGSAC fits its models to at most this many of lsc's survivors (a random sample drawn with
   /// magsac_seed), so that its time does not grow with N; every match is judged afterwards.
-  int guided_max_fit_points = 500;
+  int guided_max_fit_points = 200;
 };
 
 /// Everything the guided filter uses: its own settings, lsc's and MAGSAC's.

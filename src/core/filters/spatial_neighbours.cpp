@@ -96,30 +96,104 @@ void offerRing(const Grid& grid, const std::vector<cv::Point2f>& points, int i, 
   }
 }
 
+/// How far point p is from the outside of the block of cells within Chebyshev distance `ring` of
+/// its cell (cx, cy): no unseen point is nearer. Sides at the grid's edge have nothing beyond.
+float reach(const Grid& grid, const cv::Point2f& p, int cx, int cy, int ring) {
+  constexpr float kFar = std::numeric_limits<float>::infinity();
+  const float x0 = grid.min_x + (cx - ring) * grid.cell, y0 = grid.min_y + (cy - ring) * grid.cell;
+  const float side = (2 * ring + 1) * grid.cell;
+  const float left = cx - ring <= 0 ? kFar : p.x - x0;
+  const float right = cx + ring >= grid.columns - 1 ? kFar : x0 + side - p.x;
+  const float top = cy - ring <= 0 ? kFar : p.y - y0;
+  const float bottom = cy + ring >= grid.rows - 1 ? kFar : y0 + side - p.y;
+  return std::min(std::min(left, right), std::min(top, bottom));
+}
+
+/// The general search, ring after ring, for the points the 3x3 block does not settle.
+void ringSearch(const Grid& grid, const std::vector<cv::Point2f>& points, int i, Nearest* nearest) {
+  nearest->clear();
+  const int cx = grid.cellX(points[i].x), cy = grid.cellY(points[i].y);
+  const int max_ring = std::max(grid.columns, grid.rows);
+  for (int ring = 0; ring <= max_ring; ++ring) {
+    offerRing(grid, points, i, cx, cy, ring, nearest);
+    const float r = reach(grid, points[i], cx, cy, ring);
+    if (nearest->full() && nearest->worst() < r * r) break;
+  }
+}
+
+/// The points of the 3x3 block of cells around (cx, cy).
+void gatherBlock(const Grid& grid, const std::vector<cv::Point2f>& points, int cx, int cy,
+                 std::vector<int>* block) {
+  block->clear();
+  for (int y = std::max(0, cy - 1); y <= std::min(grid.rows - 1, cy + 1); ++y) {
+    for (int x = std::max(0, cx - 1); x <= std::min(grid.columns - 1, cx + 1); ++x) {
+      const int c = y * grid.columns + x;
+      block->insert(block->end(), grid.order.begin() + grid.start[c],
+                    grid.order.begin() + grid.start[c + 1]);
+    }
+  }
+}
+
+}  // namespace
+
+namespace {
+
+/// The k nearest of a block's candidates (squared distances d2, indices), by (d2, index): the
+/// k-th smallest distance by selection on plain floats, then the candidates up to it.
+void selectNearest(const std::vector<float>& d2, const std::vector<int>& index, size_t k,
+                   std::vector<float>* scratch, std::vector<std::pair<float, int>>* chosen) {
+  chosen->clear();
+  if (k >= d2.size()) {
+    for (size_t j = 0; j < d2.size(); ++j) chosen->emplace_back(d2[j], index[j]);
+  } else {
+    scratch->assign(d2.begin(), d2.end());
+    std::nth_element(scratch->begin(), scratch->begin() + (k - 1), scratch->end());
+    const float kth = (*scratch)[k - 1];
+    for (size_t j = 0; j < d2.size(); ++j) {
+      if (d2[j] <= kth) chosen->emplace_back(d2[j], index[j]);
+    }
+  }
+  std::sort(chosen->begin(), chosen->end());
+  if (chosen->size() > k) chosen->resize(k);
+}
+
 }  // namespace
 
 SpatialNeighbours::SpatialNeighbours(const std::vector<cv::Point2f>& points, size_t k)
     : k_(k), neighbours_(points.size() * k, -1) {
   if (k == 0 || points.empty()) return;
   const Grid grid = makeGrid(points, k);
-  const int max_ring = std::max(grid.columns, grid.rows);
   Nearest nearest(k);
-  for (size_t i = 0; i < points.size(); ++i) {
-    if (!finite(points[i])) continue;
-    nearest.clear();
-    const int cx = grid.cellX(points[i].x), cy = grid.cellY(points[i].y);
-    for (int ring = 0; ring <= max_ring; ++ring) {
-      offerRing(grid, points, static_cast<int>(i), cx, cy, ring, &nearest);
-      // Points beyond this ring lie outside the block of cells searched so far.
-      const float x0 = grid.min_x + (cx - ring) * grid.cell,
-                  y0 = grid.min_y + (cy - ring) * grid.cell;
-      const float side = (2 * ring + 1) * grid.cell;
-      const float reach = std::min(std::min(points[i].x - x0, x0 + side - points[i].x),
-                                   std::min(points[i].y - y0, y0 + side - points[i].y));
-      if (nearest.full() && nearest.worst() < reach * reach) break;
-    }
-    for (size_t n = 0; n < nearest.items().size(); ++n) {
-      neighbours_[i * k + n] = nearest.items()[n].second;
+  std::vector<int> block, others;
+  std::vector<float> bx, by, d2, scratch;
+  std::vector<std::pair<float, int>> chosen;
+  for (int cy = 0; cy < grid.rows; ++cy) {
+    for (int cx = 0; cx < grid.columns; ++cx) {
+      const int c = cy * grid.columns + cx;
+      if (grid.start[c] == grid.start[c + 1]) continue;
+      gatherBlock(grid, points, cx, cy, &block);
+      bx.resize(block.size()), by.resize(block.size());
+      for (size_t b = 0; b < block.size(); ++b)
+        bx[b] = points[block[b]].x, by[b] = points[block[b]].y;
+      for (int s = grid.start[c]; s < grid.start[c + 1]; ++s) {
+        const int i = grid.order[s];
+        const cv::Point2f p = points[i];
+        d2.clear(), others.clear();
+        for (size_t b = 0; b < block.size(); ++b) {
+          if (block[b] == i) continue;
+          const float dx = bx[b] - p.x, dy = by[b] - p.y;
+          d2.push_back(dx * dx + dy * dy), others.push_back(block[b]);
+        }
+        selectNearest(d2, others, k, &scratch, &chosen);
+        const float r = reach(grid, p, cx, cy, 1);
+        int* out = neighbours_.data() + size_t(i) * k;
+        if (chosen.size() == k ? chosen.back().first < r * r : r == INFINITY) {
+          for (size_t n = 0; n < chosen.size(); ++n) out[n] = chosen[n].second;
+          continue;
+        }
+        ringSearch(grid, points, i, &nearest);
+        for (size_t n = 0; n < nearest.items().size(); ++n) out[n] = nearest.items()[n].second;
+      }
     }
   }
 }
