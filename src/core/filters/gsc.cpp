@@ -244,8 +244,13 @@ std::vector<double> sampledDistances(const PutativeMatches& input, const std::ve
   std::vector<size_t> chosen(valid);
   std::shuffle(chosen.begin(), chosen.end(), std::mt19937(1));  // fixed: the same every call
   chosen.resize(support);
-  const auto [left, right] = polarPointsOf(input, valid);
-  const auto [left_sample, right_sample] = polarPointsOf(input, chosen);
+  // Plain references, not structured bindings: a lambda may not capture those before C++20.
+  const std::pair<PolarPoints, PolarPoints> all = polarPointsOf(input, valid);
+  const std::pair<PolarPoints, PolarPoints> sample = polarPointsOf(input, chosen);
+  const PolarPoints& left = all.first;
+  const PolarPoints& right = all.second;
+  const PolarPoints& left_sample = sample.first;
+  const PolarPoints& right_sample = sample.second;
   const std::vector<uint32_t> left_at = coincidentWithSample(left, left_sample);
   const std::vector<uint32_t> right_at = coincidentWithSample(right, right_sample);
   std::vector<double> distances(left.count);
