@@ -21,6 +21,7 @@ set(SIFT_HULL_CORE_GTESTS
   test_filters eval
   test_local_filters eval
   test_evaluation eval
+  test_evaluation_commands eval
   test_scene eval
   test_cut_shapes eval
   test_scene_backgrounds eval

@@ -17,6 +17,7 @@
 #include <iostream>
 #include <map>
 #include <mutex>
+#include <opencv2/core.hpp>
 #include <sstream>
 #include <thread>
 
@@ -129,7 +130,17 @@ struct MatcherRun {
 
 struct StereoStream {
   std::vector<sensor_msgs::Image> frames;  ///< the scene's views; pair k is frames k and k + 1
+  std::vector<cv::Mat> images;             ///< the same views as images
 };
+
+/// What one SIFT of a stream frame costs in this process (the node's default SiftConfig): the
+/// floor under the node's time per pair, which describes at least one new image per pair.
+struct SiftCost {
+  double one_thread_ms = 0.0, all_threads_ms = 0.0;
+  double keypoints = 0.0;  ///< median per frame
+};
+
+SiftCost measureSift(const StereoStream& stream);
 
 /// The synthetic scene's 16 views at 640x480, as image messages.
 StereoStream stereoStream();

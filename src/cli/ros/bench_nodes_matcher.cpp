@@ -1,6 +1,7 @@
 // bench-nodes, the matcher: a 640x480 stereo stream at a given rate and number of workers.
 
 #include "bench_nodes.h"
+#include "sift_hull/features/sift.h"
 
 namespace sift_hull {
 namespace cli {
@@ -11,8 +12,27 @@ StereoStream stereoStream() {
   StereoStream stream;
   for (const RenderedView& view : renderScene(config)) {
     stream.frames.push_back(ros_conversions::imageMessage(view.image, std_msgs::Header()));
+    stream.images.push_back(view.image);
   }
   return stream;
+}
+
+SiftCost measureSift(const StereoStream& stream) {
+  SiftCost cost;
+  std::vector<double> keypoints;
+  const size_t frames = std::min<size_t>(stream.images.size(), 4);
+  for (size_t f = 0; f < frames; ++f) {
+    keypoints.push_back(double(detectSift(stream.images[f]).keypoints.size()));
+  }
+  cost.keypoints = median(keypoints);
+  const int threads = cv::getNumThreads();
+  size_t next = 0;
+  const auto one = [&] { detectSift(stream.images[next++ % frames]); };
+  cv::setNumThreads(1);
+  cost.one_thread_ms = medianMs(one, 1500.0, 5);
+  cv::setNumThreads(threads);
+  cost.all_threads_ms = medianMs(one, 1500.0, 5);
+  return cost;
 }
 
 class MatcherFeed {

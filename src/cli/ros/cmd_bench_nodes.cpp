@@ -75,19 +75,47 @@ nlohmann::json targetsJson(const std::vector<MatcherRun>& matcher,
           {"hull_views_dropped_at_10_hz==0", {{"measured", dropped}, {"met", dropped == 0.0}}}};
 }
 
+nlohmann::json siftJson(const SiftCost& sift) {
+  const double cores = std::thread::hardware_concurrency();
+  return {{"keypoints_per_frame", sift.keypoints},
+          {"one_thread_ms", sift.one_thread_ms},
+          {"all_threads_ms", sift.all_threads_ms},
+          // Each answered pair needs one new SIFT at least (its other image cached), two at most.
+          {"pairs_per_s_at_most", cores * 1e3 / std::max(sift.one_thread_ms, 1e-9)},
+          {"pairs_per_s_at_most_without_cache",
+           cores * 1e3 / std::max(2.0 * sift.one_thread_ms, 1e-9)}};
+}
+
+std::string siftMarkdown(const nlohmann::json& sift) {
+  if (sift.is_null()) return "";
+  std::ostringstream out;
+  out << "SIFT of one of these frames in this process ("
+      << fixed(sift["keypoints_per_frame"].get<double>(), 0)
+      << " keypoints, the node's SIFT settings): " << fixed(sift["one_thread_ms"].get<double>(), 1)
+      << " ms on one thread, " << fixed(sift["all_threads_ms"].get<double>(), 1)
+      << " ms on all. A pair needs one new SIFT when its other image is cached, two when not, so "
+      << "the cores answer at most " << fixed(sift["pairs_per_s_at_most"].get<double>(), 1)
+      << " pairs/s (" << fixed(sift["pairs_per_s_at_most_without_cache"].get<double>(), 1)
+      << " without the cache) before matching, filtering and transport.\n\n";
+  return out.str();
+}
+
 std::string markdownReport(const std::vector<MatcherRun>& matcher,
-                           const std::vector<HullRun>& hulls, const nlohmann::json& targets) {
+                           const std::vector<HullRun>& hulls, const nlohmann::json& targets,
+                           const nlohmann::json& sift) {
   std::ostringstream out;
   out << "Written by `sift_hull_ros bench-nodes --write docs/BENCHMARKS.md` on " << todayUtc()
       << ", CPU " << cpuModel() << " (/proc/cpuinfo), " << std::thread::hardware_concurrency()
       << " hardware threads. The nodes run as processes "
       << "of their own against a ROS master of their own; this program publishes their input and "
       << "subscribes their output over TCP, as `rosbag play` and rviz would.\n\n"
-      << "Matcher node, 640x480 synthetic stereo pairs (the scene's views k and k+1), filter gsc, "
+      << "Matcher node, 640x480 synthetic stereo pairs (the scene's views k and k+1), its "
+      << "default filter (" << kDefaultFilter << "), "
       << "one pair at a time waiting (`~max_waiting_pairs` 2). Answered per second counts from "
       << "the first pair sent to the last answer; latency is from sending a pair to receiving its "
       << "correspondences (median); dropped is the node's own count (/diagnostics); memory is "
       << "the node's resident set after 1 s / at the end / at most.\n\n"
+      << siftMarkdown(sift)
       << "| workers | input Hz | sent | answered | answered / s | latency ms | dropped | "
          "memory MiB |\n|---|---|---|---|---|---|---|---|\n";
   for (const MatcherRun& r : matcher) {
@@ -152,6 +180,8 @@ int runBenchNodes(const std::vector<std::string>& args) {
   ros::AsyncSpinner spinner(2);
   spinner.start();
   const StereoStream stream = stereoStream();
+  nlohmann::json sift;
+  if (!parser.flag("hull-only")) sift = siftJson(measureSift(stream));
   std::vector<MatcherRun> matcher;
   for (int workers : {1, 2}) {
     for (double hz : {10.0, 30.0}) {
@@ -167,12 +197,13 @@ int runBenchNodes(const std::vector<std::string>& args) {
 
   nlohmann::json json = {{"cpu", cpuModel()},
                          {"hardware_threads", std::thread::hardware_concurrency()},
+                         {"sift", sift},
                          {"matcher", nlohmann::json::array()},
                          {"hull", nlohmann::json::array()},
                          {"targets", targetsJson(matcher, hulls)}};
   for (const MatcherRun& r : matcher) json["matcher"].push_back(matcherJson(r));
   for (const HullRun& r : hulls) json["hull"].push_back(hullJson(r));
-  const std::string report = markdownReport(matcher, hulls, json["targets"]);
+  const std::string report = markdownReport(matcher, hulls, json["targets"], json["sift"]);
   if (parser.has("write")) replaceMarkedSection(parser.get("write"), "bench-nodes", report);
   printResult(parser.flag("json"), json, report);
   return 0;

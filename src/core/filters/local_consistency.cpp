@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <future>
 #include <stdexcept>
 #include <string>
 
@@ -111,6 +112,22 @@ std::vector<int> unionOfNeighbours(const SpatialNeighbours& a, const SpatialNeig
   return set;
 }
 
+/// Both images' K nearest neighbours; the right image's on a second thread when there are enough
+/// matches to pay for starting one.
+struct BothNeighbours {
+  SpatialNeighbours left, right;
+};
+
+BothNeighbours neighboursInBoth(const LocalMatches& local, size_t k) {
+  constexpr size_t kMinMatchesForThread = 1000;
+  if (local.index.size() < kMinMatchesForThread) {
+    return {SpatialNeighbours(local.left, k), SpatialNeighbours(local.right, k)};
+  }
+  auto right = std::async(std::launch::async, [&] { return SpatialNeighbours(local.right, k); });
+  SpatialNeighbours left(local.left, k);
+  return {std::move(left), right.get()};
+}
+
 }  // namespace
 
 void validate(const LscConfig& config) {
@@ -135,10 +152,9 @@ FilterResult filterLsc(const PutativeMatches& input, const LscConfig& config) {
   validate(config);
   FilterResult result = FilterResult::keepingNone(input.matches.size());
   const LocalMatches local = localMatches(input);
-  const size_t k = static_cast<size_t>(config.lsc_neighbours);
-  const SpatialNeighbours in_left(local.left, k), in_right(local.right, k);
+  const BothNeighbours near = neighboursInBoth(local, static_cast<size_t>(config.lsc_neighbours));
   for (size_t i = 0; i < local.index.size(); ++i) {
-    const double support = lscSupport(local, in_left, in_right, i, config);
+    const double support = lscSupport(local, near.left, near.right, i, config);
     result.score[local.index[i]] = support;
     result.keep[local.index[i]] = support >= config.lsc_min_support;
   }
@@ -149,10 +165,10 @@ FilterResult filterLocalGsc(const PutativeMatches& input, const LocalGscConfig& 
   validate(config);
   FilterResult result = FilterResult::keepingNone(input.matches.size());
   const LocalMatches local = localMatches(input);
-  const size_t k = static_cast<size_t>(config.local_gsc_neighbours);
-  const SpatialNeighbours in_left(local.left, k), in_right(local.right, k);
+  const BothNeighbours near =
+      neighboursInBoth(local, static_cast<size_t>(config.local_gsc_neighbours));
   for (size_t i = 0; i < local.index.size(); ++i) {
-    const std::vector<int> set = unionOfNeighbours(in_left, in_right, i);
+    const std::vector<int> set = unionOfNeighbours(near.left, near.right, i);
     if (set.empty()) continue;
     const GscHistograms h{
         sectorHistogram(local.left, set, local.left[i], local.left_angle_rad[i]),
