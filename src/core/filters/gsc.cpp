@@ -17,10 +17,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 #include <random>
 #include <thread>
-#include <unordered_map>
 
 #include "common/parallel.h"
 
@@ -121,7 +119,8 @@ std::vector<uint32_t> coincidentCounts(const std::vector<float>& x, const std::v
   return result;
 }
 
-PolarPoints polarPoints(const std::vector<const cv::KeyPoint*>& keypoints) {
+PolarPoints polarPoints(const std::vector<const cv::KeyPoint*>& keypoints,
+                        bool with_coincident = true) {
   PolarPoints points;
   points.count = keypoints.size();
   const size_t padded = (points.count + kPadding - 1) / kPadding * kPadding;
@@ -134,7 +133,7 @@ PolarPoints polarPoints(const std::vector<const cv::KeyPoint*>& keypoints) {
     points.y[i] = keypoints[i]->pt.y;
     unitDirection(keypoints[i]->angle, &points.cos_angle[i], &points.sin_angle[i]);
   }
-  points.coincident = coincidentCounts(points.x, points.y, points.count);
+  if (with_coincident) points.coincident = coincidentCounts(points.x, points.y, points.count);
   return points;
 }
 
@@ -221,45 +220,44 @@ GscHistogram histogramOver(const PolarPoints& sample, float xi, float yi, float 
   return histogram;
 }
 
-/// How many points of `sample` sit exactly at each point of `all`.
-std::vector<uint32_t> coincidentWithSample(const PolarPoints& all, const PolarPoints& sample) {
-  std::unordered_map<uint64_t, uint32_t> at;
-  const auto key = [](float x, float y) {
-    uint32_t a, b;
-    std::memcpy(&a, &x, 4), std::memcpy(&b, &y, 4);
-    return (uint64_t(a) << 32) | b;
-  };
-  for (size_t j = 0; j < sample.count; ++j) ++at[key(sample.x[j], sample.y[j])];
-  std::vector<uint32_t> result(all.count);
-  for (size_t i = 0; i < all.count; ++i) {
-    const auto found = at.find(key(all.x[i], all.y[i]));
-    result[i] = found == at.end() ? 0 : found->second;
+/// How many points of `sample` sit exactly at (x, y); the NaN padding never does. Branch-free
+/// so that it vectorises like countLabels.
+__attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default"))) uint32_t
+coincidentInSample(const PolarPoints& sample, float x, float y) {
+  const float* sx = sample.x.data();
+  const float* sy = sample.y.data();
+  uint32_t count = 0;
+  for (size_t j = 0; j < sample.x.size(); ++j) {
+    count += static_cast<uint32_t>(sx[j] == x) & static_cast<uint32_t>(sy[j] == y);
   }
-  return result;
+  return count;
+}
+
+/// The histogram around a keypoint over the sample's points.
+GscHistogram histogramOfKeypoint(const PolarPoints& sample, const cv::KeyPoint& keypoint) {
+  float c = 0.f, s = 0.f;
+  unitDirection(keypoint.angle, &c, &s);
+  const float x = keypoint.pt.x, y = keypoint.pt.y;
+  return histogramOver(sample, x, y, c, s, coincidentInSample(sample, x, y));
 }
 
 /// The sampled filter: every match's histograms over the same M sampled matches left and right.
+/// Only the sample is prepared up front; each match's own work (its direction, the sample points
+/// at its position, both histograms) runs on the threads.
 std::vector<double> sampledDistances(const PutativeMatches& input, const std::vector<size_t>& valid,
                                      size_t support, int threads) {
   std::vector<size_t> chosen(valid);
   std::shuffle(chosen.begin(), chosen.end(), std::mt19937(1));  // fixed: the same every call
   chosen.resize(support);
-  // Plain references, not structured bindings: a lambda may not capture those before C++20.
-  const std::pair<PolarPoints, PolarPoints> all = polarPointsOf(input, valid);
-  const std::pair<PolarPoints, PolarPoints> sample = polarPointsOf(input, chosen);
-  const PolarPoints& left = all.first;
-  const PolarPoints& right = all.second;
-  const PolarPoints& left_sample = sample.first;
-  const PolarPoints& right_sample = sample.second;
-  const std::vector<uint32_t> left_at = coincidentWithSample(left, left_sample);
-  const std::vector<uint32_t> right_at = coincidentWithSample(right, right_sample);
-  std::vector<double> distances(left.count);
-  detail::parallelFor(left.count, threads, [&](size_t i) {
-    distances[i] =
-        histogramDistance(histogramOver(left_sample, left.x[i], left.y[i], left.cos_angle[i],
-                                        left.sin_angle[i], left_at[i]),
-                          histogramOver(right_sample, right.x[i], right.y[i], right.cos_angle[i],
-                                        right.sin_angle[i], right_at[i]));
+  std::vector<const cv::KeyPoint*> left_chosen, right_chosen;
+  for (size_t m : chosen)
+    left_chosen.push_back(&input.left(m)), right_chosen.push_back(&input.right(m));
+  const PolarPoints left_sample = polarPoints(left_chosen, false);
+  const PolarPoints right_sample = polarPoints(right_chosen, false);
+  std::vector<double> distances(valid.size());
+  detail::parallelFor(valid.size(), threads, [&](size_t i) {
+    distances[i] = histogramDistance(histogramOfKeypoint(left_sample, input.left(valid[i])),
+                                     histogramOfKeypoint(right_sample, input.right(valid[i])));
   });
   return distances;
 }
