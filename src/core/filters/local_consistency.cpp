@@ -113,14 +113,14 @@ std::vector<int> unionOfNeighbours(const SpatialNeighbours& a, const SpatialNeig
 }
 
 /// Both images' K nearest neighbours; the right image's on a second thread when there are enough
-/// matches to pay for starting one.
+/// matches to pay for starting one and OpenCV may use more than one (cv::setNumThreads).
 struct BothNeighbours {
   SpatialNeighbours left, right;
 };
 
 BothNeighbours neighboursInBoth(const LocalMatches& local, size_t k) {
   constexpr size_t kMinMatchesForThread = 1000;
-  if (local.index.size() < kMinMatchesForThread) {
+  if (local.index.size() < kMinMatchesForThread || cv::getNumThreads() <= 1) {
     return {SpatialNeighbours(local.left, k), SpatialNeighbours(local.right, k)};
   }
   auto right = std::async(std::launch::async, [&] { return SpatialNeighbours(local.right, k); });
