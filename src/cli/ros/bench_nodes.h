@@ -125,6 +125,7 @@ struct MatcherRun {
   double input_hz = 0.0;
   int published = 0, answered = 0;
   double answered_per_s = 0.0, latency_ms = 0.0, dropped = 0.0;
+  double described = 0.0, reused = 0.0;  ///< the node's feature cache: images described, reused
   double rss_first_mib = 0.0, rss_last_mib = 0.0, rss_max_mib = 0.0;
 };
 

@@ -122,6 +122,8 @@ MatcherRun runMatcher(RosHarness& harness, const StereoStream& stream, int worke
       10.0);
   run.rss_last_mib = residentMiB(pid);
   run.dropped = diagnostics.value("pairs dropped");
+  run.described = diagnostics.value("images described");
+  run.reused = diagnostics.value("features reused");
   summariseAnswers(sent, answers, &run);
   harness.stopNode(pid);
   return run;

@@ -21,6 +21,8 @@ nlohmann::json matcherJson(const MatcherRun& r) {
           {"answered_per_s", r.answered_per_s},
           {"latency_median_ms", r.latency_ms},
           {"dropped", r.dropped},
+          {"images_described", r.described},
+          {"features_reused", r.reused},
           {"rss_first_mib", r.rss_first_mib},
           {"rss_last_mib", r.rss_last_mib},
           {"rss_max_mib", r.rss_max_mib}};
@@ -113,15 +115,18 @@ std::string markdownReport(const std::vector<MatcherRun>& matcher,
       << "default filter (" << kDefaultFilter << "), "
       << "one pair at a time waiting (`~max_waiting_pairs` 2). Answered per second counts from "
       << "the first pair sent to the last answer; latency is from sending a pair to receiving its "
-      << "correspondences (median); dropped is the node's own count (/diagnostics); memory is "
+      << "correspondences (median); dropped is the node's own count (/diagnostics), described / "
+      << "reused its feature cache's (images given to SIFT, images whose features were taken "
+      << "from the cache, the warm-up included); memory is "
       << "the node's resident set after 1 s / at the end / at most.\n\n"
       << siftMarkdown(sift)
       << "| workers | input Hz | sent | answered | answered / s | latency ms | dropped | "
-         "memory MiB |\n|---|---|---|---|---|---|---|---|\n";
+         "described / reused | memory MiB |\n|---|---|---|---|---|---|---|---|---|\n";
   for (const MatcherRun& r : matcher) {
     out << "| " << r.workers << " | " << fixed(r.input_hz, 0) << " | " << r.published << " | "
         << r.answered << " | " << fixed(r.answered_per_s, 1) << " | " << fixed(r.latency_ms, 0)
-        << " | " << fixed(r.dropped, 0) << " | " << fixed(r.rss_first_mib, 0) << " / "
+        << " | " << fixed(r.dropped, 0) << " | " << fixed(r.described, 0) << " / "
+        << fixed(r.reused, 0) << " | " << fixed(r.rss_first_mib, 0) << " / "
         << fixed(r.rss_last_mib, 0) << " / " << fixed(r.rss_max_mib, 0) << " |\n";
   }
   out << "\nHull node, one view at a time (the next sent once /diagnostics counts the view "
