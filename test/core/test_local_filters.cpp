@@ -168,6 +168,20 @@ TEST(LocalFilters, SameDecisionsAfterRotatingAndZoomingTheRightImage) {
   }
 }
 
+TEST(Guided, SameDecisionsAfterRotatingTheRightImage) {
+  // Its thresholds are in pixels (transfer error, epipolar distance), so only rotations, which
+  // keep distances, must leave its decisions alone; rounding moves a few borderline ones.
+  const LabelledMatches input = synthetic(0.3, 9);
+  const auto filter = makeFilter("best", FilterConfigs());
+  const FilterResult before = filter->apply(input.putative);
+  for (double deg : {90.0, 37.0, -120.0}) {
+    const FilterResult after = filter->apply(transformRight(input.putative, deg, 1.0));
+    std::cout << "best rotated " << deg << ": " << differing(before, after) << " of "
+              << input.truth.size() << " decisions differ\n";
+    EXPECT_LE(differing(before, after), input.truth.size() / 100) << "rotated " << deg;  // 0
+  }
+}
+
 // ---- local_gsc ---------------------------------------------------------------------------------
 
 TEST(LocalGsc, SeparatesInliersAtThirtyPercentOutliers) {
