@@ -137,12 +137,12 @@ std::string summaryMarkdown(const nlohmann::json& summary) {
     pairs = std::max(pairs, value["pairs"].get<size_t>());
   }
   md << "\nMean F1 over the " << pairs << " pairs (a filter that keeps nothing scores 0):";
+  const char* separator = " ";
   for (const auto& [name, value] : summary["mean_f1"].items()) {
-    md << ' ' << name << ' ' << cell(value["mean"]);
+    md << separator << name << ' ' << cell(value["mean"]);
     if (value["pairs"].get<size_t>() < pairs) md << " (the " << value["pairs"] << " calibrated)";
-    md << ',';
+    separator = ", ";
   }
-  md.seekp(-1, std::ios_base::cur);
   md << ".\n\n";
   if (summary.contains("targets")) md << targetsMarkdown(summary["targets"]);
   return md.str();

@@ -172,15 +172,16 @@ std::vector<size_t> validMatches(const PutativeMatches& input) {
   return valid;
 }
 
-/// The valid matches' left and right points.
+/// The given matches' left and right points (with their coincident counts unless told not to).
 std::pair<PolarPoints, PolarPoints> polarPointsOf(const PutativeMatches& input,
-                                                  const std::vector<size_t>& valid) {
+                                                  const std::vector<size_t>& matches,
+                                                  bool with_coincident = true) {
   std::vector<const cv::KeyPoint*> left, right;
-  for (size_t m : valid) {
+  for (size_t m : matches) {
     left.push_back(&input.left(m));
     right.push_back(&input.right(m));
   }
-  return {polarPoints(left), polarPoints(right)};
+  return {polarPoints(left, with_coincident), polarPoints(right, with_coincident)};
 }
 
 /// Below this many valid matches one thread is faster than starting more.
@@ -249,15 +250,12 @@ std::vector<double> sampledDistances(const PutativeMatches& input, const std::ve
   std::vector<size_t> chosen(valid);
   std::shuffle(chosen.begin(), chosen.end(), std::mt19937(1));  // fixed: the same every call
   chosen.resize(support);
-  std::vector<const cv::KeyPoint*> left_chosen, right_chosen;
-  for (size_t m : chosen)
-    left_chosen.push_back(&input.left(m)), right_chosen.push_back(&input.right(m));
-  const PolarPoints left_sample = polarPoints(left_chosen, false);
-  const PolarPoints right_sample = polarPoints(right_chosen, false);
+  // The sample's own coincident counts are not needed: coincidentInSample counts per match.
+  const std::pair<PolarPoints, PolarPoints> sample = polarPointsOf(input, chosen, false);
   std::vector<double> distances(valid.size());
   detail::parallelFor(valid.size(), threads, [&](size_t i) {
-    distances[i] = histogramDistance(histogramOfKeypoint(left_sample, input.left(valid[i])),
-                                     histogramOfKeypoint(right_sample, input.right(valid[i])));
+    distances[i] = histogramDistance(histogramOfKeypoint(sample.first, input.left(valid[i])),
+                                     histogramOfKeypoint(sample.second, input.right(valid[i])));
   });
   return distances;
 }
