@@ -189,6 +189,7 @@ std::vector<std::string> filterList(const std::string& text) {
     }
     names.push_back(name);
   }
+  if (names.empty()) throw UsageError("--filters: no filter named (give at least one)");
   return names;
 }
 

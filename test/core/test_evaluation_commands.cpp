@@ -104,6 +104,8 @@ TEST(EvaluateFiltersCommand, ScoresTheChosenFiltersWithTheGivenThresholds) {
   // Every neighbour must agree: lsc keeps far fewer than with its default.
   EXPECT_LT(result["pairs"][2]["filters"]["lsc"]["recall"].get<double>(), 0.8);
   EXPECT_EQ(test::runProgram("evaluate-filters --data /nonexistent --filters nope", &out, &err), 2);
+  EXPECT_EQ(test::runProgram("evaluate-filters --data /nonexistent --filters ''", &out, &err), 2);
+  EXPECT_NE(err.find("no filter named"), std::string::npos) << err;
   EXPECT_EQ(test::runProgram("evaluate-filters --data /nonexistent --lsc-neighbours 0", &out, &err),
             2);
 }
