@@ -23,6 +23,9 @@ set(SIFT_HULL_CORE_SOURCES
   src/core/filters/ratio.cpp
   src/core/filters/robust_fit.cpp
   src/core/filters/spatial_neighbours.cpp
+  src/core/filters/two_view_fit.cpp
+  src/core/filters/two_view_models.cpp
+  src/core/filters/vote_ransac.cpp
   src/core/hull/bounding_box.cpp
   src/core/hull/distance_kernel.cpp
   src/core/hull/distance_map.cpp

@@ -48,7 +48,8 @@ EvaluationPair warpedEvaluationPair(const std::string& name, const WarpedPair& w
 
 /// The filters whose answer depends on a random state.
 bool randomised(const std::string& name) {
-  return name == "ransac" || name == "magsac" || name == "guided" || name == "best";
+  return name == "ransac" || name == "magsac" || name == "guided" || name == "vote_ransac" ||
+         name == "best";
 }
 
 constexpr int kSeeds = 5;

@@ -65,6 +65,15 @@ void addLocalFilterOptions(ArgParser* parser, const FilterConfigs& filters) {
                     numberText(guided.guided_min_support));
   parser->addOption("guided-max-fit-points", "N", "guided: lsc survivors MAGSAC fits to (sample)",
                     numberText(guided.guided_max_fit_points));
+  const VoteRansacConfig& vote = filters.vote_ransac;
+  parser->addOption("vote-ransac-max-angle-deg", "DEG",
+                    "vote_ransac: half width of the rotation vote",
+                    numberText(vote.vote_ransac_max_angle_deg));
+  parser->addOption("vote-ransac-max-scale-ratio", "S",
+                    "vote_ransac: half width of the scale vote (factor)",
+                    numberText(vote.vote_ransac_max_scale_ratio));
+  parser->addOption("vote-ransac-max-fit-points", "N", "vote_ransac: putatives fitted (sample)",
+                    numberText(vote.vote_ransac_max_fit_points));
 }
 
 void localFilterConfigsFromArgs(const ArgParser& parser, FilterConfigs* filters) {
@@ -82,6 +91,10 @@ void localFilterConfigsFromArgs(const ArgParser& parser, FilterConfigs* filters)
   guided.guided_min_model_inliers = parser.getInt("guided-min-model-inliers");
   guided.guided_min_support = parser.getDouble("guided-min-support");
   guided.guided_max_fit_points = parser.getInt("guided-max-fit-points");
+  VoteRansacConfig& vote = filters->vote_ransac;
+  vote.vote_ransac_max_angle_deg = parser.getDouble("vote-ransac-max-angle-deg");
+  vote.vote_ransac_max_scale_ratio = parser.getDouble("vote-ransac-max-scale-ratio");
+  vote.vote_ransac_max_fit_points = parser.getInt("vote-ransac-max-fit-points");
 }
 
 }  // namespace
@@ -111,7 +124,7 @@ void addFilterOptions(ArgParser* parser) {
   parser->addFlag("with-scale", "gms: try scaled right grids");
   parser->addDeprecatedAlias("gms-scale", {"with-scale"});
   parser->addOption("ransac-seed", "N", "ransac: random state", numberText(filters.ransac.seed));
-  parser->addOption("magsac-seed", "N", "magsac (and guided, best): random state",
+  parser->addOption("magsac-seed", "N", "magsac (and guided, vote_ransac, best): random state",
                     numberText(filters.magsac.seed));
   addLocalFilterOptions(parser, filters);
 }

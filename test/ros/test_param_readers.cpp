@@ -123,6 +123,9 @@ void expectDefaultMatcher(const ros::NodeHandle& nh) {
   EXPECT_EQ(f.guided.guided_min_model_inliers, g.guided.guided_min_model_inliers);
   EXPECT_EQ(f.guided.guided_min_support, g.guided.guided_min_support);
   EXPECT_EQ(f.guided.guided_max_fit_points, g.guided.guided_max_fit_points);
+  EXPECT_EQ(f.vote_ransac.vote_ransac_max_angle_deg, g.vote_ransac.vote_ransac_max_angle_deg);
+  EXPECT_EQ(f.vote_ransac.vote_ransac_max_scale_ratio, g.vote_ransac.vote_ransac_max_scale_ratio);
+  EXPECT_EQ(f.vote_ransac.vote_ransac_max_fit_points, g.vote_ransac.vote_ransac_max_fit_points);
 }
 
 TEST(ParameterReaders, TheParameterFilesRestateTheStructDefaults) {

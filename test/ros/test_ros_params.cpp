@@ -23,6 +23,12 @@ TEST(MatcherReconfigure, DefaultsEqualTheConfigStructs) {
   EXPECT_EQ(cfg.magsac_max_epipolar_px, filters.magsac.max_epipolar_px);
   EXPECT_EQ(cfg.max_epipolar_px, filters.epipolar.max_epipolar_px);
   EXPECT_EQ(cfg.threshold_factor, filters.gms.threshold_factor);
+  EXPECT_EQ(cfg.guided_max_transfer_px, filters.guided.guided_max_transfer_px);
+  EXPECT_EQ(cfg.guided_min_support, filters.guided.guided_min_support);
+  EXPECT_EQ(cfg.lsc_max_relative_error, filters.lsc.lsc_max_relative_error);
+  EXPECT_EQ(cfg.lsc_min_support, filters.lsc.lsc_min_support);
+  EXPECT_EQ(cfg.vote_ransac_max_angle_deg, filters.vote_ransac.vote_ransac_max_angle_deg);
+  EXPECT_EQ(cfg.vote_ransac_max_scale_ratio, filters.vote_ransac.vote_ransac_max_scale_ratio);
 }
 
 }  // namespace

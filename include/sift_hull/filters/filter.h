@@ -13,6 +13,7 @@
 #include "sift_hull/filters/local_consistency.h"
 #include "sift_hull/filters/ratio.h"
 #include "sift_hull/filters/robust_fit.h"
+#include "sift_hull/filters/vote_ransac.h"
 
 namespace sift_hull {
 
@@ -30,6 +31,7 @@ struct FilterConfigs {
   LscConfig lsc;
   LocalGscConfig local_gsc;
   GuidedConfig guided;
+  VoteRansacConfig vote_ransac;
 };
 
 /// Throws std::invalid_argument naming the first bad field.
@@ -45,8 +47,8 @@ class MatchFilter {
 };
 
 /// The names makeFilter knows: ratio, epipolar, gsc, ransac, magsac, gms, lsc, local_gsc, guided,
-/// best. `best` is the combination measured best (docs/EVALUATION.md), the CLI's and the node's
-/// default: today `guided`.
+/// vote_ransac, best. `best` is the combination measured best (docs/EVALUATION.md), the CLI's and
+/// the node's default: today `vote_ransac`.
 const std::vector<std::string>& filterNames();
 
 /// The filter the CLI (`match`, `hull --refine-with-matches`) and the matcher node run unless

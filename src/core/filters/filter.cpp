@@ -93,9 +93,14 @@ std::unique_ptr<MatchFilter> makeSingleFilter(const std::string& name,
     return std::make_unique<FunctionFilter<LocalGscConfig>>(name, filterLocalGsc,
                                                             configs.local_gsc);
   }
-  if (name == "guided" || name == "best") {
+  if (name == "guided") {
     return std::make_unique<FunctionFilter<GuidedFilterConfig>>(
         name, filterGuided, GuidedFilterConfig{configs.guided, configs.lsc, configs.magsac});
+  }
+  if (name == "vote_ransac" || name == "best") {
+    return std::make_unique<FunctionFilter<VoteRansacFilterConfig>>(
+        name, filterVoteRansac,
+        VoteRansacFilterConfig{configs.vote_ransac, configs.guided, configs.magsac});
   }
   std::ostringstream known;
   for (const std::string& each : filterNames()) known << " " << each;
@@ -130,11 +135,12 @@ void validate(const FilterConfigs& configs) {
   validate(configs.lsc);
   validate(configs.local_gsc);
   validate(configs.guided);
+  validate(configs.vote_ransac);
 }
 
 const std::vector<std::string>& filterNames() {
   static const std::vector<std::string> names = {
-      "ratio", "epipolar", "gsc", "ransac", "magsac", "gms", "lsc", "local_gsc", "guided", "best"};
+      "ratio", "epipolar", "gsc", "ransac", "magsac", "gms", "lsc", "local_gsc", "guided", "vote_ransac", "best"};
   return names;
 }
 

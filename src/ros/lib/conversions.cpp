@@ -277,6 +277,12 @@ nlohmann::json toJson(const GuidedConfig& config) {
           {"guided_max_fit_points", config.guided_max_fit_points}};
 }
 
+nlohmann::json toJson(const VoteRansacConfig& config) {
+  return {{"vote_ransac_max_angle_deg", config.vote_ransac_max_angle_deg},
+          {"vote_ransac_max_scale_ratio", config.vote_ransac_max_scale_ratio},
+          {"vote_ransac_max_fit_points", config.vote_ransac_max_fit_points}};
+}
+
 nlohmann::json toJson(const GmsConfig& config) {
   return {{"grid_cells", config.grid_cells},
           {"threshold_factor", config.threshold_factor},
@@ -291,7 +297,7 @@ std::string settingsJson(const MatchConfig& matching, const FilterConfigs& filte
   for (const nlohmann::json& part :
        {toJson(filters.epipolar), toJson(filters.gsc), toJson(filters.ransac, "ransac"),
         toJson(filters.magsac, "magsac"), toJson(filters.gms), toJson(filters.lsc),
-        toJson(filters.local_gsc), toJson(filters.guided)}) {
+        toJson(filters.local_gsc), toJson(filters.guided), toJson(filters.vote_ransac)}) {
     json.update(part);
   }
   return json.dump();

@@ -237,6 +237,14 @@ GuidedConfig readGuidedConfig(const ros::NodeHandle& private_nh) {
   return config;
 }
 
+VoteRansacConfig readVoteRansacConfig(const ros::NodeHandle& private_nh) {
+  VoteRansacConfig config;
+  read(private_nh, "vote_ransac_max_angle_deg", &config.vote_ransac_max_angle_deg);
+  read(private_nh, "vote_ransac_max_scale_ratio", &config.vote_ransac_max_scale_ratio);
+  read(private_nh, "vote_ransac_max_fit_points", &config.vote_ransac_max_fit_points);
+  return config;
+}
+
 GmsConfig readGmsConfig(const ros::NodeHandle& private_nh) {
   GmsConfig config;
   readRenamed(private_nh, "grid_cells", "gms_grid_cells", &config.grid_cells);
@@ -256,6 +264,7 @@ FilterConfigs readFilterConfigs(const ros::NodeHandle& private_nh) {
   configs.lsc = readLscConfig(private_nh);
   configs.local_gsc = readLocalGscConfig(private_nh);
   configs.guided = readGuidedConfig(private_nh);
+  configs.vote_ransac = readVoteRansacConfig(private_nh);
   validate(configs);
   return configs;
 }

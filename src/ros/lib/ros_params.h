@@ -87,7 +87,11 @@ LocalGscConfig readLocalGscConfig(const ros::NodeHandle& private_nh);
 /// ~guided_min_model_inliers, ~guided_min_support, ~guided_max_fit_points.
 GuidedConfig readGuidedConfig(const ros::NodeHandle& private_nh);
 
-/// The filter readers above: epipolar, gsc, ransac, magsac, gms, lsc, local_gsc, guided.
+/// ~vote_ransac_max_angle_deg, ~vote_ransac_max_scale_ratio, ~vote_ransac_max_fit_points.
+VoteRansacConfig readVoteRansacConfig(const ros::NodeHandle& private_nh);
+
+/// The filter readers above: epipolar, gsc, ransac, magsac, gms, lsc, local_gsc, guided,
+/// vote_ransac.
 FilterConfigs readFilterConfigs(const ros::NodeHandle& private_nh);
 
 /// ~filters, ~queue_size, ~max_waiting_pairs, ~workers, ~approximate_sync, ~calibrated,

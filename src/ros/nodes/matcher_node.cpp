@@ -152,6 +152,8 @@ void MatcherNode::serveReconfigure() {
       settings_.filters.local_gsc.local_gsc_max_histogram_distance;
   config.guided_max_transfer_px = settings_.filters.guided.guided_max_transfer_px;
   config.guided_min_support = settings_.filters.guided.guided_min_support;
+  config.vote_ransac_max_angle_deg = settings_.filters.vote_ransac.vote_ransac_max_angle_deg;
+  config.vote_ransac_max_scale_ratio = settings_.filters.vote_ransac.vote_ransac_max_scale_ratio;
   reconfigure_ = std::make_unique<dynamic_reconfigure::Server<sift_hull::MatcherConfig>>(
       reconfigure_mutex_, private_nh_);
   reconfigure_->updateConfig(config);
@@ -176,6 +178,8 @@ void MatcherNode::onReconfigure(sift_hull::MatcherConfig& config, uint32_t) {
       config.local_gsc_max_histogram_distance;
   changed.filters.guided.guided_max_transfer_px = config.guided_max_transfer_px;
   changed.filters.guided.guided_min_support = config.guided_min_support;
+  changed.filters.vote_ransac.vote_ransac_max_angle_deg = config.vote_ransac_max_angle_deg;
+  changed.filters.vote_ransac.vote_ransac_max_scale_ratio = config.vote_ransac_max_scale_ratio;
   std::shared_ptr<const Pipeline> replacement;
   try {
     validate(changed.matching);

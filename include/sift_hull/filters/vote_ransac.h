@@ -1,0 +1,50 @@
+#pragma once
+
+#include "sift_hull/features/matching.h"
+#include "sift_hull/filters/filter_result.h"
+#include "sift_hull/filters/guided.h"
+#include "sift_hull/filters/robust_fit.h"
+
+namespace sift_hull {
+
+/// The voted LO-RANSAC filter ("vote_ransac"): what SIFT gives each match, its rotation
+/// (angle_right - angle_left) and scale ratio (size_right / size_left), chooses where the robust
+/// fit draws its samples; the motions it finds then judge every putative match.
+/// 1. Up to vote_ransac_max_fit_points of the putatives (a random sample drawn with magsac_seed)
+///    are the fit set.
+/// 2. Vote: the rotation that the most matches of the fit set share within
+///    vote_ransac_max_angle_deg, then among those the scale ratio the most share within a factor
+///    vote_ransac_max_scale_ratio. Minimal samples are drawn from these matches only, so few are
+///    mismatches and few iterations suffice; both modes are found from the data, so the choice is
+///    invariant to rotating and zooming either image.
+/// 3. LO-RANSAC (two_view_models.h) for a fundamental matrix (7 points) and a homography (4
+///    points), scored over the whole fit set; the homography is chosen when it explains at least
+///    guided_homography_share of F's inliers (planes, pure rotations).
+/// 4. Again on what the motions found so far leave unexplained, up to guided_max_models motions,
+///    each with at least guided_min_model_inliers inliers and 4 times as many as it explains when
+///    the left and right points are paired at random (a model that only fits noise does not).
+///    A further motion is looked for only while the rotations left over still cluster: their
+///    strongest window holds at least twice its share of evenly spread rotations.
+/// 5. Every putative is judged: kept when a motion explains it (symmetric epipolar distance <=
+///    magsac_max_epipolar_px, transfer error <= guided_max_transfer_px both ways).
+/// Score: the smallest residual over the motions, px (NaN when none was found: none kept).
+/// Its time hardly grows with N beyond the fit set: step 5 is one residual per match.
+struct VoteRansacConfig {
+  double vote_ransac_max_angle_deg = 30.0;   ///< half width of the rotation vote's window, deg
+  double vote_ransac_max_scale_ratio = 2.0;  ///< half width of the scale vote's window (factor)
+  int vote_ransac_max_fit_points = 500;      ///< size of the fit set (a random sample)
+};
+
+/// Everything the filter uses: its vote, the motion settings it shares with guided and the fit
+/// settings it shares with magsac (threshold, confidence, iterations, seed).
+struct VoteRansacFilterConfig {
+  VoteRansacConfig vote_ransac;
+  GuidedConfig guided;
+  RobustFitConfig magsac;
+};
+
+/// Throws std::invalid_argument naming the first bad field.
+void validate(const VoteRansacConfig& config);
+FilterResult filterVoteRansac(const PutativeMatches& input, const VoteRansacFilterConfig& config);
+
+}  // namespace sift_hull

@@ -1,0 +1,232 @@
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "sift_hull/filters/two_view_models.h"
+
+namespace sift_hull {
+namespace {
+
+/// The pairs in Hartley-normalised coordinates (double), with the transforms that undo it.
+struct Normalised {
+  Eigen::MatrixX2d left, right;
+  Eigen::Matrix3d T_left, T_right;
+};
+
+Normalised normalise(const PointPairs& pairs) {
+  Normalised n;
+  n.T_left = hartleyNormalisation(pairs.left_x, pairs.left_y);
+  n.T_right = hartleyNormalisation(pairs.right_x, pairs.right_y);
+  n.left.resize(Eigen::Index(pairs.size()), 2), n.right.resize(Eigen::Index(pairs.size()), 2);
+  for (size_t i = 0; i < pairs.size(); ++i) {
+    const Eigen::Index r = Eigen::Index(i);
+    n.left.row(r) = (n.T_left * Eigen::Vector3d(pairs.left_x[i], pairs.left_y[i], 1.0)).head<2>();
+    n.right.row(r) =
+        (n.T_right * Eigen::Vector3d(pairs.right_x[i], pairs.right_y[i], 1.0)).head<2>();
+  }
+  return n;
+}
+
+/// A model found in normalised coordinates, in pixels.
+TwoViewModel inPixels(const Eigen::Matrix3d& M, const Normalised& n, bool homography) {
+  TwoViewModel model;
+  model.homography = homography;
+  model.matrix = homography ? Eigen::Matrix3d(n.T_right.inverse() * M * n.T_left)
+                            : Eigen::Matrix3d(n.T_right.transpose() * M * n.T_left);
+  const double norm = model.matrix.norm();
+  if (norm > 0.0 && std::isfinite(norm)) model.matrix /= norm;
+  return model;
+}
+
+/// A hypothesis' truncated quadratic score (lower is better) and inlier count among `counted`.
+struct Score {
+  double cost = std::numeric_limits<double>::infinity();
+  size_t inliers_counted = 0;
+};
+
+/// Sums the truncated squares (8 partial sums, so that it vectorises) and counts the inliers
+/// among the pairs `counted` marks.
+__attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default"))) void
+truncatedScore(const float* r2, const uint8_t* counted, size_t n, float t2, double* cost,
+               size_t* inliers) {
+  float partial[8] = {};
+  uint32_t count[8] = {};
+  size_t i = 0;
+  for (; i + 8 <= n; i += 8) {
+    for (int k = 0; k < 8; ++k) {
+      partial[k] += std::min(r2[i + k], t2);
+      count[k] += (r2[i + k] <= t2) & counted[i + k];
+    }
+  }
+  double sum = 0.0;
+  size_t total = 0;
+  for (; i < n; ++i) sum += std::min(r2[i], t2), total += (r2[i] <= t2) & counted[i];
+  for (int k = 0; k < 8; ++k) sum += partial[k], total += count[k];
+  *cost = sum, *inliers = total;
+}
+
+/// `counted`: 1 for the pairs whose inliers are counted.
+Score scoreOf(const std::vector<float>& r2, float t2, const std::vector<uint8_t>& counted) {
+  Score score;
+  truncatedScore(r2.data(), counted.data(), r2.size(), t2, &score.cost, &score.inliers_counted);
+  return score;
+}
+
+std::vector<uint8_t> countedMask(const std::vector<int>& sample_from, size_t size) {
+  std::vector<uint8_t> mask(size, sample_from.empty() ? 1 : 0);
+  for (int i : sample_from) mask[size_t(i)] = 1;
+  return mask;
+}
+
+/// m distinct entries of `from` (all indices when empty), drawn uniformly.
+void drawSample(const std::vector<int>& from, size_t total, int m, std::mt19937* random,
+                int* sample) {
+  const size_t pool = from.empty() ? total : from.size();
+  std::uniform_int_distribution<size_t> pick(0, pool - 1);
+  for (int k = 0; k < m;) {
+    const size_t p = pick(*random);
+    const int index = from.empty() ? static_cast<int>(p) : from[p];
+    if (std::find(sample, sample + k, index) == sample + k) sample[k++] = index;
+  }
+}
+
+/// The first entry of `sample` (drawn already) and its m - 1 nearest others in the left image
+/// among `from` (all pairs when empty).
+void nearestSample(const PointPairs& pairs, const std::vector<int>& from, int m, int* sample) {
+  const size_t pool = from.empty() ? pairs.size() : from.size();
+  const float x = pairs.left_x[size_t(sample[0])], y = pairs.left_y[size_t(sample[0])];
+  std::vector<std::pair<float, int>> near;
+  near.reserve(pool);
+  for (size_t p = 0; p < pool; ++p) {
+    const int i = from.empty() ? static_cast<int>(p) : from[p];
+    if (i == sample[0]) continue;
+    const float dx = pairs.left_x[size_t(i)] - x, dy = pairs.left_y[size_t(i)] - y;
+    near.emplace_back(dx * dx + dy * dy, i);
+  }
+  std::partial_sort(near.begin(), near.begin() + (m - 1), near.end());
+  for (int k = 1; k < m; ++k) sample[k] = near[size_t(k - 1)].second;
+}
+
+/// The minimal solver's models for the sample (normalised coordinates).
+std::vector<Eigen::Matrix3d> solveMinimal(const Normalised& n, const int* sample,
+                                          bool homography) {
+  if (homography) {
+    Eigen::Matrix<double, 4, 2> l, r;
+    for (int k = 0; k < 4; ++k) l.row(k) = n.left.row(sample[k]), r.row(k) = n.right.row(sample[k]);
+    Eigen::Matrix3d H;
+    if (!fourPointHomography(l, r, &H)) return {};
+    return {H};
+  }
+  Eigen::Matrix<double, 7, 2> l, r;
+  for (int k = 0; k < 7; ++k) l.row(k) = n.left.row(sample[k]), r.row(k) = n.right.row(sample[k]);
+  return sevenPointFundamental(l, r);
+}
+
+/// The local optimisation refits to at most this many inliers (evenly spread over them), so that
+/// its cost does not grow with N.
+constexpr size_t kMaxRefitPoints = 1024;
+
+/// Weighted least squares over the inliers; for F the Sampson weights of the previous model.
+bool refit(const Normalised& n, std::vector<int> inliers, const Eigen::Matrix3d& previous,
+           bool homography, Eigen::Matrix3d* M) {
+  if (inliers.size() > kMaxRefitPoints) {
+    std::vector<int> spread(kMaxRefitPoints);
+    for (size_t k = 0; k < kMaxRefitPoints; ++k) {
+      spread[k] = inliers[k * inliers.size() / kMaxRefitPoints];
+    }
+    inliers.swap(spread);
+  }
+  const Eigen::Index count = Eigen::Index(inliers.size());
+  Eigen::MatrixX2d l(count, 2), r(count, 2);
+  Eigen::VectorXd w = Eigen::VectorXd::Ones(count);
+  for (Eigen::Index k = 0; k < count; ++k) {
+    l.row(k) = n.left.row(inliers[size_t(k)]), r.row(k) = n.right.row(inliers[size_t(k)]);
+    if (homography) continue;
+    const Eigen::Vector3d a = previous * Eigen::Vector3d(l(k, 0), l(k, 1), 1.0);
+    const Eigen::Vector3d b = previous.transpose() * Eigen::Vector3d(r(k, 0), r(k, 1), 1.0);
+    const double g = a.head<2>().squaredNorm() + b.head<2>().squaredNorm();
+    w(k) = g > 1e-12 ? 1.0 / g : 1e12;
+  }
+  w /= w.maxCoeff();
+  return homography ? leastSquaresHomography(l, r, w, M) : leastSquaresFundamental(l, r, w, M);
+}
+
+std::vector<int> inliersOf(const std::vector<float>& r2, float t2) {
+  std::vector<int> inliers;
+  for (size_t i = 0; i < r2.size(); ++i) {
+    if (r2[i] <= t2) inliers.push_back(static_cast<int>(i));
+  }
+  return inliers;
+}
+
+/// The current best hypothesis, in normalised coordinates and in pixels, with its score.
+struct Best {
+  Eigen::Matrix3d normalised;
+  TwoViewModel model;
+  Score score;
+};
+
+/// Local optimisation: refits to the inliers of a threshold that shrinks from twice the inlier
+/// threshold to it (so that a model fitted to part of a motion can reach the rest of it), keeping
+/// each refit whose score improves.
+void optimiseLocally(const PointPairs& pairs, const Normalised& n, const TwoViewFitSettings& s,
+                     const std::vector<uint8_t>& counted, Best* best) {
+  const float t2 = static_cast<float>(s.max_residual_px * s.max_residual_px);
+  const size_t minimum = s.homography ? 4 : 8;
+  std::vector<float> r2;
+  for (float widen : {4.0f, 2.25f, 1.0f, 1.0f}) {  // squared: 2, 1.5, 1 and 1 times the threshold
+    squaredResiduals(best->model, pairs, &r2);
+    const std::vector<int> inliers = inliersOf(r2, widen * t2);
+    Eigen::Matrix3d M;
+    if (inliers.size() < minimum || !refit(n, inliers, best->normalised, s.homography, &M)) return;
+    const TwoViewModel candidate = inPixels(M, n, s.homography);
+    squaredResiduals(candidate, pairs, &r2);
+    const Score score = scoreOf(r2, t2, counted);
+    if (score.cost < best->score.cost) *best = Best{M, candidate, score};
+  }
+}
+
+}  // namespace
+
+TwoViewFit fitTwoViewModel(const PointPairs& pairs, const std::vector<int>& sample_from,
+                           const TwoViewFitSettings& settings, std::mt19937* random) {
+  TwoViewFit fit;
+  const int m = settings.homography ? 4 : 7;
+  const size_t pool = sample_from.empty() ? pairs.size() : sample_from.size();
+  if (pool < size_t(m) || pairs.size() < size_t(m) + 1) return fit;
+  const Normalised n = normalise(pairs);
+  const float t2 = static_cast<float>(settings.max_residual_px * settings.max_residual_px);
+  const std::vector<uint8_t> counted = countedMask(sample_from, pairs.size());
+  Best best;
+  std::vector<float> r2;
+  int sample[7];
+  int needed = settings.max_iterations;
+  for (; fit.iterations < needed; ++fit.iterations) {
+    drawSample(sample_from, pairs.size(), settings.local_samples ? 1 : m, random, sample);
+    if (settings.local_samples) nearestSample(pairs, sample_from, m, sample);
+    for (const Eigen::Matrix3d& M : solveMinimal(n, sample, settings.homography)) {
+      const TwoViewModel candidate = inPixels(M, n, settings.homography);
+      squaredResiduals(candidate, pairs, &r2);
+      const Score score = scoreOf(r2, t2, counted);
+      if (!(score.cost < best.score.cost)) continue;
+      best = Best{M, candidate, score};
+      // LO-RANSAC: every new best is refined at once, and the refined support sets the count.
+      if (best.score.inliers_counted >= settings.min_inliers_to_refine) {
+        optimiseLocally(pairs, n, settings, counted, &best);
+      }
+      needed = std::max(fit.iterations + 1,
+                        ransacIterations(double(best.score.inliers_counted) / double(pool), m,
+                                         settings.confidence, settings.max_iterations));
+    }
+  }
+  if (!std::isfinite(best.score.cost)) return fit;
+  squaredResiduals(best.model, pairs, &r2);
+  fit.found = true;
+  fit.model = best.model;
+  fit.inliers = inliersOf(r2, t2);
+  fit.cost = best.score.cost;
+  return fit;
+}
+
+}  // namespace sift_hull

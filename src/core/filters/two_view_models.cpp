@@ -1,0 +1,275 @@
+#include "sift_hull/filters/two_view_models.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace sift_hull {
+namespace {
+
+using Vector9d = Eigen::Matrix<double, 9, 1>;
+
+Eigen::Matrix3d fromRowMajor(const Vector9d& f) {
+  Eigen::Matrix3d M;
+  M << f(0), f(1), f(2), f(3), f(4), f(5), f(6), f(7), f(8);
+  return M;
+}
+
+/// The row of x_r^T F x_l = 0 in F's nine row-major entries.
+Vector9d epipolarRow(double lx, double ly, double rx, double ry) {
+  Vector9d a;
+  a << rx * lx, rx * ly, rx, ry * lx, ry * ly, ry, lx, ly, 1.0;
+  return a;
+}
+
+/// The two DLT rows of r ~ H l in H's nine row-major entries.
+void homographyRows(double lx, double ly, double rx, double ry, Vector9d* a, Vector9d* b) {
+  *a << -lx, -ly, -1.0, 0.0, 0.0, 0.0, rx * lx, rx * ly, rx;
+  *b << 0.0, 0.0, 0.0, -lx, -ly, -1.0, ry * lx, ry * ly, ry;
+}
+
+/// Real roots of c3 x^3 + c2 x^2 + c1 x + c0, each polished by two Newton steps.
+std::vector<double> realCubicRoots(double c3, double c2, double c1, double c0) {
+  std::vector<double> roots;
+  const double largest = std::max({std::abs(c3), std::abs(c2), std::abs(c1), std::abs(c0)});
+  if (!(largest > 0.0) || !std::isfinite(largest)) return roots;
+  if (std::abs(c3) < 1e-12 * largest) {  // quadratic
+    if (std::abs(c2) < 1e-12 * largest) {
+      if (std::abs(c1) > 0.0) roots.push_back(-c0 / c1);
+      return roots;
+    }
+    const double disc = c1 * c1 - 4.0 * c2 * c0;
+    if (disc < 0.0) return roots;
+    const double q = -0.5 * (c1 + std::copysign(std::sqrt(disc), c1));
+    roots.push_back(q / c2);
+    if (q != 0.0) roots.push_back(c0 / q);
+  } else {
+    const double b = c2 / c3, c = c1 / c3, d = c0 / c3;
+    const double q = (b * b - 3.0 * c) / 9.0, r = (2.0 * b * b * b - 9.0 * b * c + 27.0 * d) / 54.0;
+    if (r * r < q * q * q) {
+      const double theta = std::acos(std::clamp(r / std::sqrt(q * q * q), -1.0, 1.0));
+      const double s = -2.0 * std::sqrt(q);
+      for (int k = 0; k < 3; ++k) roots.push_back(s * std::cos((theta + 2.0 * M_PI * k) / 3.0) - b / 3.0);
+    } else {
+      const double a = -std::copysign(std::cbrt(std::abs(r) + std::sqrt(r * r - q * q * q)), r);
+      roots.push_back(a + (a == 0.0 ? 0.0 : q / a) - b / 3.0);
+    }
+  }
+  for (double& x : roots) {
+    for (int step = 0; step < 2; ++step) {
+      const double f = ((c3 * x + c2) * x + c1) * x + c0, df = (3.0 * c3 * x + 2.0 * c2) * x + c1;
+      if (df != 0.0) x -= f / df;
+    }
+  }
+  return roots;
+}
+
+/// Whether three points are (nearly) on one line, relative to their spread.
+bool collinear(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c) {
+  const Eigen::Vector2d u = b - a, v = c - a;
+  const double area = std::abs(u.x() * v.y() - u.y() * v.x());
+  return area <= 1e-9 * std::max(1e-300, u.squaredNorm() + v.squaredNorm());
+}
+
+bool anyThreeCollinear(const Eigen::Matrix<double, 4, 2>& p) {
+  for (int skip = 0; skip < 4; ++skip) {
+    int k[3], n = 0;
+    for (int i = 0; i < 4; ++i) {
+      if (i != skip) k[n++] = i;
+    }
+    if (collinear(p.row(k[0]).transpose(), p.row(k[1]).transpose(), p.row(k[2]).transpose())) {
+      return true;
+    }
+  }
+  return false;
+}
+
+/// The sum of w a a^T over weighted rows a, accumulated in its upper triangle.
+class NormalEquations {
+ public:
+  void add(const Vector9d& a, double w) {
+    for (int r = 0; r < 9; ++r) {
+      const double wa = w * a(r);
+      for (int c = r; c < 9; ++c) sum_[r][c] += wa * a(c);
+    }
+  }
+  Vector9d smallestEigenvector() const {
+    Eigen::Matrix<double, 9, 9> normal;
+    for (int r = 0; r < 9; ++r) {
+      for (int c = r; c < 9; ++c) normal(r, c) = normal(c, r) = sum_[r][c];
+    }
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 9, 9>> solver(normal);
+    return solver.eigenvectors().col(0);
+  }
+
+ private:
+  double sum_[9][9] = {};
+};
+
+Eigen::Matrix3d rankTwo(const Eigen::Matrix3d& F) {
+  Eigen::JacobiSVD<Eigen::Matrix3d> svd(F, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Vector3d s = svd.singularValues();
+  s(2) = 0.0;
+  return svd.matrixU() * s.asDiagonal() * svd.matrixV().transpose();
+}
+
+bool finiteMatrix(const Eigen::Matrix3d& M) { return M.allFinite() && M.norm() > 0.0; }
+
+}  // namespace
+
+void PointPairs::push(float lx, float ly, float rx, float ry) {
+  left_x.push_back(lx), left_y.push_back(ly), right_x.push_back(rx), right_y.push_back(ry);
+}
+
+double modelResidual(const TwoViewModel& model, double lx, double ly, double rx, double ry) {
+  const Eigen::Matrix3d& M = model.matrix;
+  const Eigen::Vector3d l(lx, ly, 1.0), r(rx, ry, 1.0);
+  if (!model.homography) {
+    const Eigen::Vector3d line_r = M * l, line_l = M.transpose() * r;
+    const double e = std::abs(r.dot(line_r));
+    const double n = std::min(line_r.head<2>().squaredNorm(), line_l.head<2>().squaredNorm());
+    return n > 0.0 ? e / std::sqrt(n) : std::numeric_limits<double>::infinity();
+  }
+  const Eigen::Vector3d forward = M * l, backward = M.inverse() * r;
+  const double f = (forward.hnormalized() - r.head<2>()).norm();
+  const double b = (backward.hnormalized() - l.head<2>()).norm();
+  return std::isfinite(f) && std::isfinite(b) ? std::max(f, b)
+                                              : std::numeric_limits<double>::infinity();
+}
+
+__attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default"))) void
+fundamentalResiduals(const float* m, const float* lx, const float* ly, const float* rx,
+                     const float* ry, size_t n, float* out) {
+  for (size_t i = 0; i < n; ++i) {
+    const float a = m[0] * lx[i] + m[1] * ly[i] + m[2];
+    const float b = m[3] * lx[i] + m[4] * ly[i] + m[5];
+    const float c = m[6] * lx[i] + m[7] * ly[i] + m[8];
+    const float d = m[0] * rx[i] + m[3] * ry[i] + m[6];
+    const float e = m[1] * rx[i] + m[4] * ry[i] + m[7];
+    const float error = rx[i] * a + ry[i] * b + c;
+    const float norm = std::min(a * a + b * b, d * d + e * e);
+    out[i] = norm > 0.f ? error * error / norm : std::numeric_limits<float>::infinity();
+  }
+}
+
+__attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default"))) void
+homographyResiduals(const float* h, const float* g, const float* lx, const float* ly,
+                    const float* rx, const float* ry, size_t n, float* out) {
+  for (size_t i = 0; i < n; ++i) {
+    const float w = h[6] * lx[i] + h[7] * ly[i] + h[8];
+    const float u = (h[0] * lx[i] + h[1] * ly[i] + h[2]) / w - rx[i];
+    const float v = (h[3] * lx[i] + h[4] * ly[i] + h[5]) / w - ry[i];
+    const float wb = g[6] * rx[i] + g[7] * ry[i] + g[8];
+    const float ub = (g[0] * rx[i] + g[1] * ry[i] + g[2]) / wb - lx[i];
+    const float vb = (g[3] * rx[i] + g[4] * ry[i] + g[5]) / wb - ly[i];
+    const float r2 = std::max(u * u + v * v, ub * ub + vb * vb);
+    out[i] = r2 == r2 ? r2 : std::numeric_limits<float>::infinity();  // NaN: undefined
+  }
+}
+
+void squaredResiduals(const TwoViewModel& model, const PointPairs& pairs, std::vector<float>* out) {
+  out->resize(pairs.size());
+  float m[9], g[9];
+  const Eigen::Matrix3d inverse = model.homography ? Eigen::Matrix3d(model.matrix.inverse())
+                                                   : Eigen::Matrix3d::Zero();
+  for (int k = 0; k < 9; ++k) {
+    m[k] = static_cast<float>(model.matrix(k / 3, k % 3));
+    g[k] = static_cast<float>(inverse(k / 3, k % 3));
+  }
+  if (model.homography) {
+    homographyResiduals(m, g, pairs.left_x.data(), pairs.left_y.data(), pairs.right_x.data(),
+                        pairs.right_y.data(), pairs.size(), out->data());
+  } else {
+    fundamentalResiduals(m, pairs.left_x.data(), pairs.left_y.data(), pairs.right_x.data(),
+                         pairs.right_y.data(), pairs.size(), out->data());
+  }
+}
+
+std::vector<Eigen::Matrix3d> sevenPointFundamental(const Eigen::Matrix<double, 7, 2>& left,
+                                                   const Eigen::Matrix<double, 7, 2>& right) {
+  Eigen::Matrix<double, 9, 7> At;
+  for (int i = 0; i < 7; ++i) At.col(i) = epipolarRow(left(i, 0), left(i, 1), right(i, 0), right(i, 1));
+  const Eigen::HouseholderQR<Eigen::Matrix<double, 9, 7>> qr(At);
+  const Eigen::Matrix<double, 9, 7> R = qr.matrixQR().triangularView<Eigen::Upper>();
+  if (std::abs(R(6, 6)) <= 1e-10 * std::abs(R(0, 0))) return {};  // rank below 7
+  const Eigen::Matrix<double, 9, 9> Q = qr.householderQ();
+  const Eigen::Matrix3d F1 = fromRowMajor(Q.col(7)), F2 = fromRowMajor(Q.col(8));
+  // det(a F1 + (1 - a) F2) = c3 a^3 + c2 a^2 + c1 a + c0, from its values at 0, 1, -1 and 2.
+  const double d0 = F2.determinant(), d1 = F1.determinant();
+  const double dm = (2.0 * F2 - F1).determinant(), d2 = (2.0 * F1 - F2).determinant();
+  const double c0 = d0, c2 = 0.5 * (d1 + dm) - d0, odd = 0.5 * (d1 - dm);  // odd = c3 + c1
+  const double c3 = (d2 - c0 - 4.0 * c2 - 2.0 * odd) / 6.0, c1 = odd - c3;
+  std::vector<Eigen::Matrix3d> solutions;
+  for (double a : realCubicRoots(c3, c2, c1, c0)) {
+    const Eigen::Matrix3d F = a * F1 + (1.0 - a) * F2;
+    if (finiteMatrix(F)) solutions.push_back(F / F.norm());
+  }
+  return solutions;
+}
+
+bool fourPointHomography(const Eigen::Matrix<double, 4, 2>& left,
+                         const Eigen::Matrix<double, 4, 2>& right, Eigen::Matrix3d* H) {
+  if (anyThreeCollinear(left) || anyThreeCollinear(right)) return false;
+  Eigen::Matrix<double, 9, 8> At;
+  for (int i = 0; i < 4; ++i) {
+    Vector9d a, b;
+    homographyRows(left(i, 0), left(i, 1), right(i, 0), right(i, 1), &a, &b);
+    At.col(2 * i) = a, At.col(2 * i + 1) = b;
+  }
+  const Eigen::HouseholderQR<Eigen::Matrix<double, 9, 8>> qr(At);
+  const Eigen::Matrix<double, 9, 9> Q = qr.householderQ();
+  *H = fromRowMajor(Q.col(8));
+  return finiteMatrix(*H) && std::abs(H->determinant()) > 1e-12 * std::pow(H->norm(), 3);
+}
+
+bool leastSquaresFundamental(const Eigen::MatrixX2d& left, const Eigen::MatrixX2d& right,
+                             const Eigen::VectorXd& weights, Eigen::Matrix3d* F) {
+  if (left.rows() < 8) return false;
+  NormalEquations normal;
+  for (Eigen::Index i = 0; i < left.rows(); ++i) {
+    normal.add(epipolarRow(left(i, 0), left(i, 1), right(i, 0), right(i, 1)), weights(i));
+  }
+  *F = rankTwo(fromRowMajor(normal.smallestEigenvector()));
+  return finiteMatrix(*F);
+}
+
+bool leastSquaresHomography(const Eigen::MatrixX2d& left, const Eigen::MatrixX2d& right,
+                            const Eigen::VectorXd& weights, Eigen::Matrix3d* H) {
+  if (left.rows() < 4) return false;
+  NormalEquations normal;
+  for (Eigen::Index i = 0; i < left.rows(); ++i) {
+    Vector9d a, b;
+    homographyRows(left(i, 0), left(i, 1), right(i, 0), right(i, 1), &a, &b);
+    normal.add(a, weights(i)), normal.add(b, weights(i));
+  }
+  *H = fromRowMajor(normal.smallestEigenvector());
+  return finiteMatrix(*H) && std::abs(H->determinant()) > 1e-12 * std::pow(H->norm(), 3);
+}
+
+Eigen::Matrix3d hartleyNormalisation(const std::vector<float>& x, const std::vector<float>& y) {
+  double cx = 0.0, cy = 0.0;
+  for (size_t i = 0; i < x.size(); ++i) cx += x[i], cy += y[i];
+  const double n = std::max<double>(1.0, double(x.size()));
+  cx /= n, cy /= n;
+  double spread = 0.0;
+  for (size_t i = 0; i < x.size(); ++i) {
+    const double dx = x[i] - cx, dy = y[i] - cy;
+    spread += std::sqrt(dx * dx + dy * dy);
+  }
+  spread /= n;
+  const double s = spread > 0.0 && std::isfinite(spread) ? std::sqrt(2.0) / spread : 1.0;
+  Eigen::Matrix3d T;
+  T << s, 0.0, -s * cx, 0.0, s, -s * cy, 0.0, 0.0, 1.0;
+  return T;
+}
+
+int ransacIterations(double w, int m, double confidence, int cap) {
+  const double all_inliers = std::pow(std::clamp(w, 0.0, 1.0), m);
+  if (all_inliers <= 0.0) return cap;
+  if (all_inliers >= 1.0) return 1;
+  const double needed = std::log(1.0 - confidence) / std::log1p(-all_inliers);
+  return static_cast<int>(std::clamp(std::ceil(needed), 1.0, double(cap)));
+}
+
+}  // namespace sift_hull

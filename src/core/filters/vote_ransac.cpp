@@ -1,0 +1,357 @@
+#include "sift_hull/filters/vote_ransac.h"
+
+#include <algorithm>
+#include <cstdint>
+#include <cstring>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "sift_hull/filters/two_view_models.h"
+
+namespace sift_hull {
+namespace {
+
+void require(bool condition, const std::string& message) {
+  if (!condition) throw std::invalid_argument("filter config: " + message);
+}
+
+/// A further motion must explain this share of its voted pool: the clear majority of the cluster
+/// its matches voted for (mismatches of a repeated texture can agree with an F on half of one).
+constexpr double kFurtherMotionShare = 2.0 / 3.0;
+/// A local sample is clean about as often as a global sample of two matches: its seed must lie on
+/// the motion and its neighbourhood must not straddle another.
+constexpr int kLocalSampleWeight = 2;
+
+/// The matches the motions are fitted to, with what each one votes for (NaN: no vote).
+struct FitSet {
+  PointPairs pairs;
+  std::vector<float> rotation_deg;  ///< angle_right - angle_left in [0, 360)
+  std::vector<float> log2_scale;    ///< log2(size_right / size_left)
+};
+
+float rotationOf(const cv::KeyPoint& l, const cv::KeyPoint& r) {
+  if (!std::isfinite(l.angle) || !std::isfinite(r.angle) || l.angle < 0.f || r.angle < 0.f) {
+    return NAN;  // OpenCV's -1: no orientation
+  }
+  const double d = std::fmod(double(r.angle) - double(l.angle), 360.0);
+  return static_cast<float>(d < 0.0 ? d + 360.0 : d);
+}
+
+float log2ScaleOf(const cv::KeyPoint& l, const cv::KeyPoint& r) {
+  if (!(l.size > 0.f) || !(r.size > 0.f)) return NAN;
+  const double s = std::log2(double(r.size) / double(l.size));
+  return std::isfinite(s) ? static_cast<float>(s) : NAN;
+}
+
+FitSet fitSetOf(const PutativeMatches& input, size_t max_points, unsigned seed) {
+  std::vector<size_t> chosen;
+  for (size_t m = 0; m < input.matches.size(); ++m) {
+    if (input.hasFinitePositions(m)) chosen.push_back(m);
+  }
+  if (chosen.size() > max_points) {
+    std::mt19937 random(seed);
+    std::shuffle(chosen.begin(), chosen.end(), random);
+    chosen.resize(max_points);
+    std::sort(chosen.begin(), chosen.end());
+  }
+  FitSet set;
+  for (size_t m : chosen) {
+    const cv::KeyPoint &l = input.left(m), &r = input.right(m);
+    set.pairs.push(l.pt.x, l.pt.y, r.pt.x, r.pt.y);
+    set.rotation_deg.push_back(rotationOf(l, r));
+    set.log2_scale.push_back(log2ScaleOf(l, r));
+  }
+  return set;
+}
+
+FitSet subsetOf(const FitSet& set, const std::vector<int>& members) {
+  FitSet sub;
+  for (int i : members) {
+    sub.pairs.push(set.pairs.left_x[i], set.pairs.left_y[i], set.pairs.right_x[i],
+                   set.pairs.right_y[i]);
+    sub.rotation_deg.push_back(set.rotation_deg[i]);
+    sub.log2_scale.push_back(set.log2_scale[i]);
+  }
+  return sub;
+}
+
+/// The float's bits as an unsigned key of the same order.
+uint32_t orderedBits(float value) {
+  uint32_t bits;
+  std::memcpy(&bits, &value, sizeof bits);
+  return (bits & 0x80000000u) ? ~bits : bits | 0x80000000u;
+}
+
+/// (value, index) of the candidates sorted by value, ties in the candidates' order: a stable
+/// radix sort in three passes of 11 bits (candidates are at most a few thousand).
+std::vector<std::pair<float, int>> sortedByValue(const std::vector<float>& values,
+                                                 const std::vector<int>& candidates) {
+  const size_t n = candidates.size();
+  std::vector<uint64_t> keys(n), scratch(n);
+  for (size_t k = 0; k < n; ++k) {
+    keys[k] = uint64_t(orderedBits(values[size_t(candidates[k])])) << 32 | uint32_t(k);
+  }
+  for (int shift = 32; shift < 64; shift += 11) {
+    size_t count[2049] = {};
+    for (uint64_t key : keys) ++count[((key >> shift) & 2047u) + 1];
+    for (size_t d = 1; d < 2049; ++d) count[d] += count[d - 1];
+    for (uint64_t key : keys) scratch[count[(key >> shift) & 2047u]++] = key;
+    keys.swap(scratch);
+  }
+  std::vector<std::pair<float, int>> sorted(n);
+  for (size_t k = 0; k < n; ++k) {
+    const int c = candidates[size_t(keys[k] & 0xffffffffu)];
+    sorted[k] = {values[size_t(c)], c};
+  }
+  return sorted;
+}
+
+/// |a - b|, on a circle of the period when it is positive.
+double separation(double a, double b, double period) {
+  const double d = std::abs(a - b);
+  return period > 0.0 ? std::min(d, period - d) : d;
+}
+
+/// The densest window: among `candidates` (indices into values), the value that the most others
+/// lie within `half` of (ties: the lowest index), and the candidates within `half` of it. The
+/// windows are centred on the values themselves, so shifting every value shifts nothing else.
+std::vector<int> densestWindow(const std::vector<float>& values, const std::vector<int>& candidates,
+                               double half, double period, size_t* count) {
+  const std::vector<std::pair<float, int>> sorted = sortedByValue(values, candidates);
+  const size_t n = sorted.size();
+  std::vector<double> extended;  // circular: the values once below and once above the circle
+  if (period > 0.0) {
+    for (const auto& each : sorted) extended.push_back(each.first - period);
+  }
+  for (const auto& each : sorted) extended.push_back(each.first);
+  if (period > 0.0) {
+    for (const auto& each : sorted) extended.push_back(each.first + period);
+  }
+  size_t lo = 0, hi = 0, best = 0;
+  int centre = -1;
+  double centre_value = 0.0;
+  for (size_t k = 0; k < n; ++k) {
+    const double v = sorted[k].first;
+    while (lo < extended.size() && extended[lo] < v - half) ++lo;
+    while (hi < extended.size() && extended[hi] <= v + half) ++hi;
+    const size_t within = std::min(hi - lo, n);
+    if (within > best || (within == best && sorted[k].second < centre)) {
+      best = within, centre = sorted[k].second, centre_value = v;
+    }
+  }
+  *count = best;
+  std::vector<int> members;
+  for (int i : candidates) {
+    if (separation(values[i], centre_value, period) <= half) members.push_back(i);
+  }
+  return members;
+}
+
+/// The matches the vote chooses to sample from; empty when the rotations do not cluster enough
+/// (`require_cluster`: at least twice what evenly spread rotations would put in the window).
+std::vector<int> votedPool(const FitSet& set, const VoteRansacConfig& config,
+                           bool require_cluster) {
+  std::vector<int> voting;
+  for (size_t i = 0; i < set.pairs.size(); ++i) {
+    if (std::isfinite(set.rotation_deg[i]) && std::isfinite(set.log2_scale[i])) {
+      voting.push_back(static_cast<int>(i));
+    }
+  }
+  if (voting.empty()) return {};
+  size_t count = 0;
+  const double half = config.vote_ransac_max_angle_deg;
+  const std::vector<int> turned = densestWindow(set.rotation_deg, voting, half, 360.0, &count);
+  const double even = double(voting.size()) * std::min(1.0, 2.0 * half / 360.0);
+  if (require_cluster && double(count) < 2.0 * even) return {};
+  return densestWindow(set.log2_scale, turned, std::log2(config.vote_ransac_max_scale_ratio), 0.0,
+                       &count);
+}
+
+/// How many pairs the model explains when each left point meets the right point of another
+/// match (the right points shifted by half the set): what chance alone gives it.
+size_t chanceInliers(const TwoViewModel& model, const PointPairs& pairs, double threshold_px) {
+  PointPairs shuffled = pairs;
+  const size_t n = pairs.size(), shift = n / 2 + 1;
+  for (size_t i = 0; i < n; ++i) {
+    shuffled.right_x[i] = pairs.right_x[(i + shift) % n];
+    shuffled.right_y[i] = pairs.right_y[(i + shift) % n];
+  }
+  std::vector<float> r2;
+  squaredResiduals(model, shuffled, &r2);
+  const float t2 = static_cast<float>(threshold_px * threshold_px);
+  return static_cast<size_t>(std::count_if(r2.begin(), r2.end(), [&](float e) { return e <= t2; }));
+}
+
+size_t countIn(const std::vector<int>& inliers, const std::vector<int>& pool, size_t size) {
+  std::vector<uint8_t> in(size, 0);
+  for (int i : inliers) in[size_t(i)] = 1;
+  size_t count = 0;
+  for (int i : pool) count += in[size_t(i)];
+  return count;
+}
+
+/// The homography of the set, searched for in two stages when F was found: first only as long
+/// as H needs to match guided_homography_share of F's inliers, then, when what it found comes
+/// within half of that, as long as its own inlier share says (a plane's F explains mismatches
+/// along its epipolar lines too, so H may win from fewer inliers than F has).
+TwoViewFit fitHomography(const FitSet& set, const std::vector<int>& pool, const TwoViewFit& F,
+                         TwoViewFitSettings settings, const VoteRansacFilterConfig& config,
+                         std::mt19937* random) {
+  const double share = config.guided.guided_homography_share;
+  const int cap = settings.max_iterations;
+  settings.homography = true;
+  settings.max_residual_px = config.guided.guided_max_transfer_px;
+  if (!F.found) return fitTwoViewModel(set.pairs, pool, settings, random);
+  const size_t pool_size = pool.empty() ? set.pairs.size() : pool.size();
+  const double w = double(countIn(F.inliers, pool, set.pairs.size())) / double(pool_size);
+  settings.max_iterations = std::min(cap, ransacIterations(share * w, 4, settings.confidence, cap));
+  settings.min_inliers_to_refine = size_t(0.5 * share * w * double(pool_size));
+  const TwoViewFit first = fitTwoViewModel(set.pairs, pool, settings, random);
+  const bool close = first.found && first.inliers.size() >= 0.5 * share * F.inliers.size();
+  if (!close || first.iterations < settings.max_iterations || settings.max_iterations >= cap) {
+    return first;  // stopped by its own count, or already searched as long as allowed
+  }
+  settings.max_iterations = cap, settings.min_inliers_to_refine = 0;
+  const TwoViewFit second = fitTwoViewModel(set.pairs, pool, settings, random);
+  return second.found && second.cost < first.cost ? second : first;
+}
+
+/// The better of F and H for the set, sampled from the pool; not found when neither qualifies.
+/// A further motion (`further`) is sampled locally, searched for at most as long as a motion that
+/// explains kFurtherMotionShare of its pool needs, and must explain that share.
+TwoViewFit fitMotion(const FitSet& set, const std::vector<int>& pool, bool further,
+                     const VoteRansacFilterConfig& config, std::mt19937* random) {
+  const RobustFitConfig& fit = config.magsac;
+  const GuidedConfig& guided = config.guided;
+  const int cap = further ? ransacIterations(kFurtherMotionShare, kLocalSampleWeight,
+                                             fit.confidence, fit.max_iterations)
+                          : fit.max_iterations;
+  TwoViewFitSettings settings{false, fit.max_epipolar_px, fit.confidence, cap, further};
+  const TwoViewFit F = fitTwoViewModel(set.pairs, pool, settings, random);
+  const size_t pool_size = pool.empty() ? set.pairs.size() : pool.size();
+  const TwoViewFit H = fitHomography(set, pool, F, settings, config, random);
+  const bool use_h =
+      H.found && (!F.found || H.inliers.size() >= guided.guided_homography_share * F.inliers.size());
+  TwoViewFit chosen = use_h ? H : F;
+  const double threshold = use_h ? guided.guided_max_transfer_px : fit.max_epipolar_px;
+  size_t needed = std::max<size_t>(size_t(guided.guided_min_model_inliers),
+                                   4 * chanceInliers(chosen.model, set.pairs, threshold));
+  if (further) needed = std::max<size_t>(needed, size_t(std::ceil(kFurtherMotionShare * pool_size)));
+  const size_t explained_in_pool =
+      further ? countIn(chosen.inliers, pool, set.pairs.size()) : chosen.inliers.size();
+  if (!chosen.found || chosen.inliers.size() < needed || explained_in_pool < needed) {
+    chosen.found = false;
+  }
+  return chosen;
+}
+
+std::vector<int> unexplained(const FitSet& set, const std::vector<int>& inliers) {
+  std::vector<uint8_t> in(set.pairs.size(), 0);
+  for (int i : inliers) in[size_t(i)] = 1;
+  std::vector<int> rest;
+  for (size_t i = 0; i < in.size(); ++i) {
+    if (!in[i]) rest.push_back(static_cast<int>(i));
+  }
+  return rest;
+}
+
+/// The residual threshold of a motion, px.
+double thresholdOf(const TwoViewModel& motion, const VoteRansacFilterConfig& config) {
+  return motion.homography ? config.guided.guided_max_transfer_px : config.magsac.max_epipolar_px;
+}
+
+/// Whether most inliers of a further motion lie within twice the threshold of an earlier motion:
+/// then they are what the earlier one left at its threshold's edge, not a motion of their own.
+bool leftoverOf(const std::vector<TwoViewModel>& earlier, const FitSet& set,
+                const std::vector<int>& inliers, const VoteRansacFilterConfig& config) {
+  if (earlier.empty()) return false;
+  const FitSet found = subsetOf(set, inliers);
+  std::vector<uint8_t> near(found.pairs.size(), 0);
+  std::vector<float> r2;
+  for (const TwoViewModel& motion : earlier) {
+    squaredResiduals(motion, found.pairs, &r2);
+    const float t2 = static_cast<float>(4.0 * std::pow(thresholdOf(motion, config), 2));
+    for (size_t i = 0; i < r2.size(); ++i) near[i] |= r2[i] <= t2;
+  }
+  return 2 * size_t(std::count(near.begin(), near.end(), 1)) >= near.size();
+}
+
+/// Up to guided_max_models motions, each fitted to what the earlier ones leave unexplained.
+std::vector<TwoViewModel> fitMotions(FitSet set, const VoteRansacFilterConfig& config) {
+  std::mt19937 random(static_cast<unsigned>(config.magsac.seed));
+  std::vector<TwoViewModel> motions;
+  while (static_cast<int>(motions.size()) < config.guided.guided_max_models &&
+         set.pairs.size() >= static_cast<size_t>(config.guided.guided_min_model_inliers)) {
+    const bool further = !motions.empty();
+    std::vector<int> pool = votedPool(set, config.vote_ransac, further);
+    const size_t least = 2 * static_cast<size_t>(config.guided.guided_min_model_inliers);
+    if (further && pool.size() < least) break;  // no cluster that could hold a further motion
+    if (pool.size() < 16) pool.clear();         // too few votes to sample from: sample from all
+    const TwoViewFit motion = fitMotion(set, pool, further, config, &random);
+    if (!motion.found || leftoverOf(motions, set, motion.inliers, config)) break;
+    motions.push_back(motion.model);
+    set = subsetOf(set, unexplained(set, motion.inliers));
+  }
+  return motions;
+}
+
+/// Every match with finite positions judged against the motions (float residuals, vectorised).
+void judge(const PutativeMatches& input, const std::vector<TwoViewModel>& motions,
+           const VoteRansacFilterConfig& config, FilterResult* result) {
+  PointPairs all;
+  std::vector<size_t> index;
+  for (size_t m = 0; m < input.matches.size(); ++m) {
+    if (!input.hasFinitePositions(m)) continue;
+    const cv::Point2f &a = input.left(m).pt, &b = input.right(m).pt;
+    all.push(a.x, a.y, b.x, b.y);
+    index.push_back(m);
+  }
+  std::vector<float> best(all.size(), std::numeric_limits<float>::infinity()), r2;
+  std::vector<uint8_t> explained(all.size(), 0);
+  for (const TwoViewModel& motion : motions) {
+    const float t2 = static_cast<float>(std::pow(thresholdOf(motion, config), 2));
+    squaredResiduals(motion, all, &r2);
+    for (size_t i = 0; i < r2.size(); ++i) {
+      best[i] = std::min(best[i], r2[i]);
+      explained[i] |= r2[i] <= t2;
+    }
+  }
+  for (size_t i = 0; i < index.size(); ++i) {
+    result->score[index[i]] = std::sqrt(double(best[i]));
+    result->keep[index[i]] = explained[i];
+  }
+}
+
+}  // namespace
+
+void validate(const VoteRansacConfig& config) {
+  require(config.vote_ransac_max_angle_deg > 0.0 && config.vote_ransac_max_angle_deg <= 180.0,
+          "vote_ransac_max_angle_deg must be in (0, 180]");
+  require(config.vote_ransac_max_scale_ratio > 1.0 &&
+              std::isfinite(config.vote_ransac_max_scale_ratio),
+          "vote_ransac_max_scale_ratio must be finite and > 1");
+  require(config.vote_ransac_max_fit_points >= 16 &&
+              config.vote_ransac_max_fit_points <= 1000000,
+          "vote_ransac_max_fit_points must be in [16, 1000000]");
+}
+
+FilterResult filterVoteRansac(const PutativeMatches& input, const VoteRansacFilterConfig& config) {
+  validate(config.vote_ransac);
+  validate(config.guided);
+  validate(config.magsac, "magsac");
+  FilterResult result = FilterResult::keepingNone(input.matches.size());
+  const std::vector<TwoViewModel> motions =
+      fitMotions(fitSetOf(input, size_t(config.vote_ransac.vote_ransac_max_fit_points),
+                          static_cast<unsigned>(config.magsac.seed)),
+                 config);
+  if (motions.empty()) return result;
+  judge(input, motions, config, &result);
+  return result;
+}
+
+}  // namespace sift_hull
