@@ -72,10 +72,14 @@ set(SIFT_HULL_EVAL_SOURCES
   src/core/eval/mesh_render.cpp
 )
 # No contraction into fused multiply-adds: the GSC kernel's sectors must not depend on which vector
-# width the CPU dispatch picks, and the scalar and AVX2 distance look-ups must round alike.
+# width the CPU dispatch picks, the scalar and AVX2 distance look-ups must round alike, and the
+# two-view residual kernels (vote_ransac) must score a model alike on every CPU.
 set(SIFT_HULL_EXACT_FLOAT_SOURCES
   src/core/filters/gsc.cpp
   src/core/filters/guided.cpp
   src/core/filters/local_consistency.cpp
+  src/core/filters/two_view_fit.cpp
+  src/core/filters/two_view_models.cpp
+  src/core/filters/vote_ransac.cpp
   src/core/hull/distance_kernel.cpp
 )

@@ -172,11 +172,11 @@ TEST(Guided, SameDecisionsAfterRotatingTheRightImage) {
   // Its thresholds are in pixels (transfer error, epipolar distance), so only rotations, which
   // keep distances, must leave its decisions alone; rounding moves a few borderline ones.
   const LabelledMatches input = synthetic(0.3, 9);
-  const auto filter = makeFilter("best", FilterConfigs());
+  const auto filter = makeFilter("guided", FilterConfigs());
   const FilterResult before = filter->apply(input.putative);
   for (double deg : {90.0, 37.0, -120.0}) {
     const FilterResult after = filter->apply(transformRight(input.putative, deg, 1.0));
-    std::cout << "best rotated " << deg << ": " << differing(before, after) << " of "
+    std::cout << "guided rotated " << deg << ": " << differing(before, after) << " of "
               << input.truth.size() << " decisions differ\n";
     EXPECT_LE(differing(before, after), input.truth.size() / 100) << "rotated " << deg;  // 0
   }
@@ -211,7 +211,7 @@ TEST(LocalGsc, HistogramOverTheNeighbourUnionMatchesItsDefinition) {
   EXPECT_GT(swapped.score[1], 0.5);
 }
 
-// ---- guided and best ---------------------------------------------------------------------------
+// ---- guided ---------------------------------------------------------------------------
 
 /// Two groups of inliers, each following its own similarity, then outliers.
 LabelledMatches twoMotions() {
@@ -263,14 +263,12 @@ TEST(Guided, RejudgesEveryPutativeNotOnlyTheSurvivors) {
             scoreFilter(input.truth, lsc).correct_kept + 20);
 }
 
-TEST(Guided, BestIsGuidedAndSeedsRepeat) {
+TEST(Guided, SeedsRepeat) {
   const LabelledMatches input = synthetic(0.3, 31);
   FilterConfigs configs;
   configs.magsac.seed = 4;
-  const FilterResult a = makeFilter("best", configs)->apply(input.putative);
-  const FilterResult b = makeFilter("guided", configs)->apply(input.putative);
-  EXPECT_EQ(a.keep, b.keep);
-  EXPECT_EQ(makeFilter("best", configs)->apply(input.putative).keep, a.keep);
+  const FilterResult a = makeFilter("guided", configs)->apply(input.putative);
+  EXPECT_EQ(makeFilter("guided", configs)->apply(input.putative).keep, a.keep);
 }
 
 TEST(Guided, TinyAndDegenerateInputsKeepNothingWithoutThrowing) {

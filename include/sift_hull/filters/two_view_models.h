@@ -40,12 +40,16 @@ bool fourPointHomography(const Eigen::Matrix<double, 4, 2>& left,
 
 /// Least squares over n >= 8 (F) or n >= 4 (H) weighted correspondences (n x 2 arrays): the
 /// smallest eigenvector of the algebraic normal equations; F made rank 2. False when degenerate.
+/// `start`, a model near the answer, makes it a few steps of inverse iteration.
 bool leastSquaresFundamental(const Eigen::MatrixX2d& left, const Eigen::MatrixX2d& right,
-                             const Eigen::VectorXd& weights, Eigen::Matrix3d* F);
+                             const Eigen::VectorXd& weights, Eigen::Matrix3d* F,
+                             const Eigen::Matrix3d* start = nullptr);
 bool leastSquaresHomography(const Eigen::MatrixX2d& left, const Eigen::MatrixX2d& right,
-                            const Eigen::VectorXd& weights, Eigen::Matrix3d* H);
+                            const Eigen::VectorXd& weights, Eigen::Matrix3d* H,
+                            const Eigen::Matrix3d* start = nullptr);
 
-/// Hartley's normalisation of one image's points: centroid to the origin, mean distance sqrt(2).
+/// Hartley's normalisation of one image's points, made robust: the median point to the origin,
+/// the median distance from it sqrt(2).
 /// Returns T with x_normalised = T x.
 Eigen::Matrix3d hartleyNormalisation(const std::vector<float>& x, const std::vector<float>& y);
 
@@ -72,8 +76,8 @@ struct TwoViewFit {
   int iterations = 0;
 };
 
-/// LO-RANSAC over the pairs: minimal samples drawn from `sample_from` (indices into pairs; all
-/// when empty) with `random`, each hypothesis scored over all pairs by the truncated quadratic
+/// LO-RANSAC over the pairs: minimal samples drawn from `sample_from` (distinct indices into
+/// pairs, as many as a sample at least; all pairs when empty) with `random`, each hypothesis scored over all pairs by the truncated quadratic
 /// (MSAC), stopping when `confidence` says an all-inlier sample was drawn (the inlier share of
 /// `sample_from`) or at max_iterations; the best hypothesis then refined by iterated, Sampson-
 /// weighted least squares over its inliers while the score improves.

@@ -4,6 +4,7 @@
 #include "sift_hull/filters/filter_result.h"
 #include "sift_hull/filters/guided.h"
 #include "sift_hull/filters/robust_fit.h"
+#include "sift_hull/filters/two_view_models.h"
 
 namespace sift_hull {
 
@@ -46,5 +47,8 @@ struct VoteRansacFilterConfig {
 /// Throws std::invalid_argument naming the first bad field.
 void validate(const VoteRansacConfig& config);
 FilterResult filterVoteRansac(const PutativeMatches& input, const VoteRansacFilterConfig& config);
+/// Steps 1 to 4 alone: the motions found (none, one or up to guided_max_models), in pixels.
+std::vector<TwoViewModel> voteRansacMotions(const PutativeMatches& input,
+                                            const VoteRansacFilterConfig& config);
 
 }  // namespace sift_hull

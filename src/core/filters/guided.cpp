@@ -96,9 +96,10 @@ std::vector<Motion> fitMotions(std::vector<cv::Point2f> left, std::vector<cv::Po
 }  // namespace
 
 void validate(const GuidedConfig& config) {
-  require(config.guided_max_transfer_px > 0.0 && std::isfinite(config.guided_max_transfer_px),
-          "guided_max_transfer_px must be finite and > 0");
-  require(config.guided_homography_share >= 0.0, "guided_homography_share must be >= 0");
+  require(config.guided_max_transfer_px > 0.0 && config.guided_max_transfer_px <= 1000.0,
+          "guided_max_transfer_px must be in (0, 1000]");
+  require(config.guided_homography_share >= 0.0 && config.guided_homography_share <= 10.0,
+          "guided_homography_share must be in [0, 10]");
   require(config.guided_max_models >= 1 && config.guided_max_models <= 8,
           "guided_max_models must be in [1, 8]");
   require(config.guided_min_model_inliers >= 8, "guided_min_model_inliers must be >= 8");

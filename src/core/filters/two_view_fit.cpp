@@ -91,9 +91,14 @@ void drawSample(const std::vector<int>& from, size_t total, int m, std::mt19937*
   }
 }
 
-/// The first entry of `sample` (drawn already) and its m - 1 nearest others in the left image
-/// among `from` (all pairs when empty).
-void nearestSample(const PointPairs& pairs, const std::vector<int>& from, int m, int* sample) {
+/// Local samples draw the rest of a sample among this many times m nearest others of its first
+/// match, so that a sample spans more than the tightest cluster (whose model extrapolates badly).
+constexpr size_t kLocalSpread = 4;
+
+/// The first entry of `sample` (drawn already) and m - 1 others drawn among its kLocalSpread m
+/// nearest in the left image, among `from` (all pairs when empty).
+void nearbySample(const PointPairs& pairs, const std::vector<int>& from, int m,
+                  std::mt19937* random, int* sample) {
   const size_t pool = from.empty() ? pairs.size() : from.size();
   const float x = pairs.left_x[size_t(sample[0])], y = pairs.left_y[size_t(sample[0])];
   std::vector<std::pair<float, int>> near;
@@ -104,7 +109,10 @@ void nearestSample(const PointPairs& pairs, const std::vector<int>& from, int m,
     const float dx = pairs.left_x[size_t(i)] - x, dy = pairs.left_y[size_t(i)] - y;
     near.emplace_back(dx * dx + dy * dy, i);
   }
-  std::partial_sort(near.begin(), near.begin() + (m - 1), near.end());
+  const size_t reach = std::min(near.size(), kLocalSpread * size_t(m));
+  std::partial_sort(near.begin(), near.begin() + reach, near.end());
+  near.resize(reach);
+  std::shuffle(near.begin(), near.end(), *random);
   for (int k = 1; k < m; ++k) sample[k] = near[size_t(k - 1)].second;
 }
 
@@ -125,11 +133,12 @@ std::vector<Eigen::Matrix3d> solveMinimal(const Normalised& n, const int* sample
 
 /// The local optimisation refits to at most this many inliers (evenly spread over them), so that
 /// its cost does not grow with N.
-constexpr size_t kMaxRefitPoints = 1024;
+constexpr size_t kMaxRefitPoints = 256;
 
-/// Weighted least squares over the inliers; for F the Sampson weights of the previous model.
-bool refit(const Normalised& n, std::vector<int> inliers, const Eigen::Matrix3d& previous,
-           bool homography, Eigen::Matrix3d* M) {
+/// Weighted least squares over the inliers: Tukey's biweight of each one's squared residual r2
+/// under the previous model within `reach2`, for F times the Sampson weight.
+bool refit(const Normalised& n, std::vector<int> inliers, const std::vector<float>& r2,
+           float reach2, const Eigen::Matrix3d& previous, bool homography, Eigen::Matrix3d* M) {
   if (inliers.size() > kMaxRefitPoints) {
     std::vector<int> spread(kMaxRefitPoints);
     for (size_t k = 0; k < kMaxRefitPoints; ++k) {
@@ -141,15 +150,19 @@ bool refit(const Normalised& n, std::vector<int> inliers, const Eigen::Matrix3d&
   Eigen::MatrixX2d l(count, 2), r(count, 2);
   Eigen::VectorXd w = Eigen::VectorXd::Ones(count);
   for (Eigen::Index k = 0; k < count; ++k) {
-    l.row(k) = n.left.row(inliers[size_t(k)]), r.row(k) = n.right.row(inliers[size_t(k)]);
+    const int i = inliers[size_t(k)];
+    l.row(k) = n.left.row(i), r.row(k) = n.right.row(i);
+    const double tukey = 1.0 - double(r2[size_t(i)]) / reach2;
+    w(k) = std::max(1e-6, tukey * tukey);
     if (homography) continue;
     const Eigen::Vector3d a = previous * Eigen::Vector3d(l(k, 0), l(k, 1), 1.0);
     const Eigen::Vector3d b = previous.transpose() * Eigen::Vector3d(r(k, 0), r(k, 1), 1.0);
     const double g = a.head<2>().squaredNorm() + b.head<2>().squaredNorm();
-    w(k) = g > 1e-12 ? 1.0 / g : 1e12;
+    w(k) *= g > 1e-12 ? 1.0 / g : 1e12;
   }
   w /= w.maxCoeff();
-  return homography ? leastSquaresHomography(l, r, w, M) : leastSquaresFundamental(l, r, w, M);
+  return homography ? leastSquaresHomography(l, r, w, M, &previous)
+                    : leastSquaresFundamental(l, r, w, M, &previous);
 }
 
 std::vector<int> inliersOf(const std::vector<float>& r2, float t2) {
@@ -167,24 +180,66 @@ struct Best {
   Score score;
 };
 
-/// Local optimisation: refits to the inliers of a threshold that shrinks from twice the inlier
-/// threshold to it (so that a model fitted to part of a motion can reach the rest of it), keeping
-/// each refit whose score improves.
-void optimiseLocally(const PointPairs& pairs, const Normalised& n, const TwoViewFitSettings& s,
-                     const std::vector<uint8_t>& counted, Best* best) {
+/// The local optimisation refits to the matches within twice the inlier threshold (squared: 4),
+/// Tukey-weighted by their residuals, so that a model fitted to part of a motion reaches the rest
+/// of it and the threshold's edge does not bias it.
+constexpr float kReach = 4.0f;
+/// Reweighting stops when a refit improves the score by less than this share, or after
+/// kMaxRefits refits.
+constexpr double kConverged = 1e-3;
+constexpr int kMaxRefits = 8;
+
+/// Iteratively reweighted least squares from the best model while the score improves.
+void reweight(const PointPairs& pairs, const Normalised& n, const TwoViewFitSettings& s,
+              const std::vector<uint8_t>& counted, float reach2, Best* best) {
   const float t2 = static_cast<float>(s.max_residual_px * s.max_residual_px);
   const size_t minimum = s.homography ? 4 : 8;
-  std::vector<float> r2;
-  for (float widen : {4.0f, 2.25f, 1.0f, 1.0f}) {  // squared: 2, 1.5, 1 and 1 times the threshold
-    squaredResiduals(best->model, pairs, &r2);
-    const std::vector<int> inliers = inliersOf(r2, widen * t2);
+  std::vector<float> r2, candidate_r2;
+  squaredResiduals(best->model, pairs, &r2);
+  for (int round = 0; round < kMaxRefits; ++round) {
+    const std::vector<int> inliers = inliersOf(r2, reach2);
     Eigen::Matrix3d M;
-    if (inliers.size() < minimum || !refit(n, inliers, best->normalised, s.homography, &M)) return;
+    if (inliers.size() < minimum ||
+        !refit(n, inliers, r2, reach2, best->normalised, s.homography, &M)) {
+      return;
+    }
     const TwoViewModel candidate = inPixels(M, n, s.homography);
-    squaredResiduals(candidate, pairs, &r2);
-    const Score score = scoreOf(r2, t2, counted);
+    squaredResiduals(candidate, pairs, &candidate_r2);
+    const Score score = scoreOf(candidate_r2, t2, counted);
+    if (!(score.cost < best->score.cost)) return;
+    const bool converged = score.cost > (1.0 - kConverged) * best->score.cost;
+    *best = Best{M, candidate, score};
+    if (converged) return;
+    r2.swap(candidate_r2);
+  }
+}
+
+/// The inner RANSAC of LO-RANSAC: least squares over kInnerSamples random subsets of
+/// kInnerSampleFactor m of the best model's inliers (within reach), which lets a model that is
+/// its own least-squares fixed point (an epipole among the points explains some of them) give
+/// way to the motion; the best of them, then the reweighting.
+constexpr int kInnerSamples = 10;
+constexpr size_t kInnerSampleFactor = 4;
+
+void optimiseLocally(const PointPairs& pairs, const Normalised& n, const TwoViewFitSettings& s,
+                     const std::vector<uint8_t>& counted, std::mt19937* random, Best* best) {
+  const float t2 = static_cast<float>(s.max_residual_px * s.max_residual_px), reach2 = kReach * t2;
+  const size_t size = kInnerSampleFactor * (s.homography ? 4 : 7);
+  std::vector<float> r2, candidate_r2;
+  squaredResiduals(best->model, pairs, &r2);
+  std::vector<int> inliers = inliersOf(r2, reach2);
+  const Best start = *best;
+  for (int k = 0; k < kInnerSamples && inliers.size() > size; ++k) {
+    std::shuffle(inliers.begin(), inliers.end(), *random);
+    const std::vector<int> subset(inliers.begin(), inliers.begin() + size);
+    Eigen::Matrix3d M;
+    if (!refit(n, subset, r2, reach2, start.normalised, s.homography, &M)) continue;
+    const TwoViewModel candidate = inPixels(M, n, s.homography);
+    squaredResiduals(candidate, pairs, &candidate_r2);
+    const Score score = scoreOf(candidate_r2, t2, counted);
     if (score.cost < best->score.cost) *best = Best{M, candidate, score};
   }
+  reweight(pairs, n, s, counted, reach2, best);
 }
 
 }  // namespace
@@ -204,16 +259,17 @@ TwoViewFit fitTwoViewModel(const PointPairs& pairs, const std::vector<int>& samp
   int needed = settings.max_iterations;
   for (; fit.iterations < needed; ++fit.iterations) {
     drawSample(sample_from, pairs.size(), settings.local_samples ? 1 : m, random, sample);
-    if (settings.local_samples) nearestSample(pairs, sample_from, m, sample);
+    if (settings.local_samples) nearbySample(pairs, sample_from, m, random, sample);
     for (const Eigen::Matrix3d& M : solveMinimal(n, sample, settings.homography)) {
       const TwoViewModel candidate = inPixels(M, n, settings.homography);
       squaredResiduals(candidate, pairs, &r2);
       const Score score = scoreOf(r2, t2, counted);
       if (!(score.cost < best.score.cost)) continue;
       best = Best{M, candidate, score};
-      // LO-RANSAC: every new best is refined at once, and the refined support sets the count.
+      // LO-RANSAC: every new best is reweighted at once, and the refined support sets the
+      // count; the inner samples follow once, for the best of all.
       if (best.score.inliers_counted >= settings.min_inliers_to_refine) {
-        optimiseLocally(pairs, n, settings, counted, &best);
+        reweight(pairs, n, settings, counted, kReach * t2, &best);
       }
       needed = std::max(fit.iterations + 1,
                         ransacIterations(double(best.score.inliers_counted) / double(pool), m,
@@ -221,6 +277,9 @@ TwoViewFit fitTwoViewModel(const PointPairs& pairs, const std::vector<int>& samp
     }
   }
   if (!std::isfinite(best.score.cost)) return fit;
+  if (best.score.inliers_counted >= settings.min_inliers_to_refine) {
+    optimiseLocally(pairs, n, settings, counted, random, &best);
+  }
   squaredResiduals(best.model, pairs, &r2);
   fit.found = true;
   fit.model = best.model;

@@ -30,7 +30,7 @@ void homographyRows(double lx, double ly, double rx, double ry, Vector9d* a, Vec
 }
 
 /// Real roots of c3 x^3 + c2 x^2 + c1 x + c0, each polished by two Newton steps.
-std::vector<double> realCubicRoots(double c3, double c2, double c1, double c0) {
+std::vector<double> realCubicRootsOf(double c3, double c2, double c1, double c0) {
   std::vector<double> roots;
   const double largest = std::max({std::abs(c3), std::abs(c2), std::abs(c1), std::abs(c0)});
   if (!(largest > 0.0) || !std::isfinite(largest)) return roots;
@@ -85,6 +85,8 @@ bool anyThreeCollinear(const Eigen::Matrix<double, 4, 2>& p) {
   return false;
 }
 
+constexpr int kInverseIterations = 4;
+
 /// The sum of w a a^T over weighted rows a, accumulated in its upper triangle.
 class NormalEquations {
  public:
@@ -94,10 +96,23 @@ class NormalEquations {
       for (int c = r; c < 9; ++c) sum_[r][c] += wa * a(c);
     }
   }
-  Vector9d smallestEigenvector() const {
+  /// The eigenvector of the smallest eigenvalue: by inverse iteration from `start` (a model
+  /// near the answer, row-major) when given, which is a few 9x9 solves instead of a full
+  /// eigendecomposition, else (or when that fails) by the eigensolver.
+  Vector9d smallestEigenvector(const Eigen::Matrix3d* start = nullptr) const {
     Eigen::Matrix<double, 9, 9> normal;
     for (int r = 0; r < 9; ++r) {
       for (int c = r; c < 9; ++c) normal(r, c) = normal(c, r) = sum_[r][c];
+    }
+    if (start != nullptr) {
+      const Eigen::LDLT<Eigen::Matrix<double, 9, 9>> ldlt(normal);
+      Vector9d x;
+      for (int k = 0; k < 9; ++k) x(k) = (*start)(k / 3, k % 3);
+      for (int step = 0; step < kInverseIterations && ldlt.info() == Eigen::Success; ++step) {
+        x = ldlt.solve(x);
+        x /= x.norm();
+      }
+      if (ldlt.info() == Eigen::Success && x.allFinite()) return x;
     }
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 9, 9>> solver(normal);
     return solver.eigenvectors().col(0);
@@ -148,8 +163,8 @@ fundamentalResiduals(const float* m, const float* lx, const float* ly, const flo
     const float d = m[0] * rx[i] + m[3] * ry[i] + m[6];
     const float e = m[1] * rx[i] + m[4] * ry[i] + m[7];
     const float error = rx[i] * a + ry[i] * b + c;
-    const float norm = std::min(a * a + b * b, d * d + e * e);
-    out[i] = norm > 0.f ? error * error / norm : std::numeric_limits<float>::infinity();
+    const float r2 = error * error / std::min(a * a + b * b, d * d + e * e);
+    out[i] = r2 == r2 ? r2 : std::numeric_limits<float>::infinity();  // NaN: undefined
   }
 }
 
@@ -163,8 +178,9 @@ homographyResiduals(const float* h, const float* g, const float* lx, const float
     const float wb = g[6] * rx[i] + g[7] * ry[i] + g[8];
     const float ub = (g[0] * rx[i] + g[1] * ry[i] + g[2]) / wb - lx[i];
     const float vb = (g[3] * rx[i] + g[4] * ry[i] + g[5]) / wb - ly[i];
-    const float r2 = std::max(u * u + v * v, ub * ub + vb * vb);
-    out[i] = r2 == r2 ? r2 : std::numeric_limits<float>::infinity();  // NaN: undefined
+    const float forward = u * u + v * v, backward = ub * ub + vb * vb;
+    const float inf = std::numeric_limits<float>::infinity();
+    out[i] = std::max(forward == forward ? forward : inf, backward == backward ? backward : inf);
   }
 }
 
@@ -186,13 +202,25 @@ void squaredResiduals(const TwoViewModel& model, const PointPairs& pairs, std::v
   }
 }
 
+/// The same, well conditioned when c3 is small beside c0: then the roots of the reversed cubic
+/// c0 y^3 + c1 y^2 + c2 y + c3 in y = 1 / x (whose leading coefficient is the larger end).
+std::vector<double> realCubicRoots(double c3, double c2, double c1, double c0) {
+  if (std::abs(c3) >= std::abs(c0)) return realCubicRootsOf(c3, c2, c1, c0);
+  std::vector<double> roots;
+  for (double y : realCubicRootsOf(c0, c1, c2, c3)) {
+    if (y != 0.0 && std::isfinite(1.0 / y)) roots.push_back(1.0 / y);
+  }
+  return roots;
+}
+
 std::vector<Eigen::Matrix3d> sevenPointFundamental(const Eigen::Matrix<double, 7, 2>& left,
                                                    const Eigen::Matrix<double, 7, 2>& right) {
   Eigen::Matrix<double, 9, 7> At;
   for (int i = 0; i < 7; ++i) At.col(i) = epipolarRow(left(i, 0), left(i, 1), right(i, 0), right(i, 1));
   const Eigen::HouseholderQR<Eigen::Matrix<double, 9, 7>> qr(At);
   const Eigen::Matrix<double, 9, 7> R = qr.matrixQR().triangularView<Eigen::Upper>();
-  if (std::abs(R(6, 6)) <= 1e-10 * std::abs(R(0, 0))) return {};  // rank below 7
+  // Rank below 7 (collinear or repeated points: without pivoting, any diagonal entry may vanish).
+  if (R.diagonal().cwiseAbs().minCoeff() <= 1e-10 * R.diagonal().cwiseAbs().maxCoeff()) return {};
   const Eigen::Matrix<double, 9, 9> Q = qr.householderQ();
   const Eigen::Matrix3d F1 = fromRowMajor(Q.col(7)), F2 = fromRowMajor(Q.col(8));
   // det(a F1 + (1 - a) F2) = c3 a^3 + c2 a^2 + c1 a + c0, from its values at 0, 1, -1 and 2.
@@ -224,18 +252,20 @@ bool fourPointHomography(const Eigen::Matrix<double, 4, 2>& left,
 }
 
 bool leastSquaresFundamental(const Eigen::MatrixX2d& left, const Eigen::MatrixX2d& right,
-                             const Eigen::VectorXd& weights, Eigen::Matrix3d* F) {
+                             const Eigen::VectorXd& weights, Eigen::Matrix3d* F,
+                             const Eigen::Matrix3d* start) {
   if (left.rows() < 8) return false;
   NormalEquations normal;
   for (Eigen::Index i = 0; i < left.rows(); ++i) {
     normal.add(epipolarRow(left(i, 0), left(i, 1), right(i, 0), right(i, 1)), weights(i));
   }
-  *F = rankTwo(fromRowMajor(normal.smallestEigenvector()));
+  *F = rankTwo(fromRowMajor(normal.smallestEigenvector(start)));
   return finiteMatrix(*F);
 }
 
 bool leastSquaresHomography(const Eigen::MatrixX2d& left, const Eigen::MatrixX2d& right,
-                            const Eigen::VectorXd& weights, Eigen::Matrix3d* H) {
+                            const Eigen::VectorXd& weights, Eigen::Matrix3d* H,
+                            const Eigen::Matrix3d* start) {
   if (left.rows() < 4) return false;
   NormalEquations normal;
   for (Eigen::Index i = 0; i < left.rows(); ++i) {
@@ -243,21 +273,32 @@ bool leastSquaresHomography(const Eigen::MatrixX2d& left, const Eigen::MatrixX2d
     homographyRows(left(i, 0), left(i, 1), right(i, 0), right(i, 1), &a, &b);
     normal.add(a, weights(i)), normal.add(b, weights(i));
   }
-  *H = fromRowMajor(normal.smallestEigenvector());
+  *H = fromRowMajor(normal.smallestEigenvector(start));
   return finiteMatrix(*H) && std::abs(H->determinant()) > 1e-12 * std::pow(H->norm(), 3);
 }
 
 Eigen::Matrix3d hartleyNormalisation(const std::vector<float>& x, const std::vector<float>& y) {
-  double cx = 0.0, cy = 0.0;
-  for (size_t i = 0; i < x.size(); ++i) cx += x[i], cy += y[i];
-  const double n = std::max<double>(1.0, double(x.size()));
-  cx /= n, cy /= n;
-  double spread = 0.0;
+  // Medians rather than means, so that one point far away (a hostile 1e30) does not squeeze all
+  // the others onto the origin.
+  auto median = [](std::vector<double> values) {
+    if (values.empty()) return 0.0;
+    const auto middle = values.begin() + values.size() / 2;
+    std::nth_element(values.begin(), middle, values.end());
+    return *middle;
+  };
+  const double cx = median(std::vector<double>(x.begin(), x.end()));
+  const double cy = median(std::vector<double>(y.begin(), y.end()));
+  std::vector<double> distances(x.size());
   for (size_t i = 0; i < x.size(); ++i) {
     const double dx = x[i] - cx, dy = y[i] - cy;
-    spread += std::sqrt(dx * dx + dy * dy);
+    distances[i] = std::sqrt(dx * dx + dy * dy);
   }
-  spread /= n;
+  double spread = median(distances);
+  if (!(spread > 0.0)) {  // most points at one place: their mean distance, else no scaling
+    double sum = 0.0;
+    for (double d : distances) sum += d;
+    spread = distances.empty() ? 0.0 : sum / double(distances.size());
+  }
   const double s = spread > 0.0 && std::isfinite(spread) ? std::sqrt(2.0) / spread : 1.0;
   Eigen::Matrix3d T;
   T << s, 0.0, -s * cx, 0.0, s, -s * cy, 0.0, 0.0, 1.0;
@@ -265,6 +306,7 @@ Eigen::Matrix3d hartleyNormalisation(const std::vector<float>& x, const std::vec
 }
 
 int ransacIterations(double w, int m, double confidence, int cap) {
+  if (!(w > 0.0)) return cap;  // also NaN
   const double all_inliers = std::pow(std::clamp(w, 0.0, 1.0), m);
   if (all_inliers <= 0.0) return cap;
   if (all_inliers >= 1.0) return 1;

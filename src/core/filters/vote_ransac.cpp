@@ -210,7 +210,7 @@ TwoViewFit fitHomography(const FitSet& set, const std::vector<int>& pool, const 
   const size_t pool_size = pool.empty() ? set.pairs.size() : pool.size();
   const double w = double(countIn(F.inliers, pool, set.pairs.size())) / double(pool_size);
   settings.max_iterations = std::min(cap, ransacIterations(share * w, 4, settings.confidence, cap));
-  settings.min_inliers_to_refine = size_t(0.5 * share * w * double(pool_size));
+  settings.min_inliers_to_refine = size_t(0.25 * share * w * double(pool_size));
   const TwoViewFit first = fitTwoViewModel(set.pairs, pool, settings, random);
   const bool close = first.found && first.inliers.size() >= 0.5 * share * F.inliers.size();
   if (!close || first.iterations < settings.max_iterations || settings.max_iterations >= cap) {
@@ -340,15 +340,19 @@ void validate(const VoteRansacConfig& config) {
           "vote_ransac_max_fit_points must be in [16, 1000000]");
 }
 
-FilterResult filterVoteRansac(const PutativeMatches& input, const VoteRansacFilterConfig& config) {
+std::vector<TwoViewModel> voteRansacMotions(const PutativeMatches& input,
+                                            const VoteRansacFilterConfig& config) {
   validate(config.vote_ransac);
   validate(config.guided);
   validate(config.magsac, "magsac");
+  return fitMotions(fitSetOf(input, size_t(config.vote_ransac.vote_ransac_max_fit_points),
+                             static_cast<unsigned>(config.magsac.seed)),
+                    config);
+}
+
+FilterResult filterVoteRansac(const PutativeMatches& input, const VoteRansacFilterConfig& config) {
   FilterResult result = FilterResult::keepingNone(input.matches.size());
-  const std::vector<TwoViewModel> motions =
-      fitMotions(fitSetOf(input, size_t(config.vote_ransac.vote_ransac_max_fit_points),
-                          static_cast<unsigned>(config.magsac.seed)),
-                 config);
+  const std::vector<TwoViewModel> motions = voteRansacMotions(input, config);
   if (motions.empty()) return result;
   judge(input, motions, config, &result);
   return result;
