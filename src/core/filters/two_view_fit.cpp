@@ -218,7 +218,7 @@ void reweight(const PointPairs& pairs, const Normalised& n, const TwoViewFitSett
 /// kInnerSampleFactor m of the best model's inliers (within reach), which lets a model that is
 /// its own least-squares fixed point (an epipole among the points explains some of them) give
 /// way to the motion; the best of them, then the reweighting.
-constexpr int kInnerSamples = 10;
+constexpr int kInnerSamples = 5;
 constexpr size_t kInnerSampleFactor = 4;
 
 void optimiseLocally(const PointPairs& pairs, const Normalised& n, const TwoViewFitSettings& s,

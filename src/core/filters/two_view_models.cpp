@@ -87,22 +87,26 @@ bool anyThreeCollinear(const Eigen::Matrix<double, 4, 2>& p) {
 
 constexpr int kInverseIterations = 4;
 
-/// The sum of w a a^T over weighted rows a, accumulated in its upper triangle.
+/// sum += w a a^T for one row a of 9, whole rows of contiguous doubles so that they vectorise.
+__attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default"))) void addOuter(
+    double (*sum)[9], const double* a, double w) {
+  for (int r = 0; r < 9; ++r) {
+    const double wa = w * a[r];
+    for (int c = 0; c < 9; ++c) sum[r][c] += wa * a[c];
+  }
+}
+
+/// The sum of w a a^T over weighted rows a.
 class NormalEquations {
  public:
-  void add(const Vector9d& a, double w) {
-    for (int r = 0; r < 9; ++r) {
-      const double wa = w * a(r);
-      for (int c = r; c < 9; ++c) sum_[r][c] += wa * a(c);
-    }
-  }
+  void add(const Vector9d& a, double w) { addOuter(sum_, a.data(), w); }
   /// The eigenvector of the smallest eigenvalue: by inverse iteration from `start` (a model
   /// near the answer, row-major) when given, which is a few 9x9 solves instead of a full
   /// eigendecomposition, else (or when that fails) by the eigensolver.
   Vector9d smallestEigenvector(const Eigen::Matrix3d* start = nullptr) const {
     Eigen::Matrix<double, 9, 9> normal;
     for (int r = 0; r < 9; ++r) {
-      for (int c = r; c < 9; ++c) normal(r, c) = normal(c, r) = sum_[r][c];
+      for (int c = 0; c < 9; ++c) normal(r, c) = sum_[r][c];
     }
     if (start != nullptr) {
       const Eigen::LDLT<Eigen::Matrix<double, 9, 9>> ldlt(normal);
