@@ -247,7 +247,8 @@ std::string sampledMarkdown(const nlohmann::json& sweep) {
 
 std::string markdown(const nlohmann::json& result) {
   std::ostringstream md;
-  md << "Written by `sift_hull bench-filters --write docs/BENCHMARKS.md` on " << todayUtc() << ", "
+  md << "Written by `sift_hull bench-filters --write docs/BENCHMARKS.md` on " << todayUtc()
+     << ", CPU " << result["cpu"].get<std::string>() << " (/proc/cpuinfo), "
      << std::thread::hardware_concurrency() << " hardware threads. Times are medians of "
      << "repeated runs (at least 3, up to 101 or about 1.5 s per cell).\n\n";
   if (result["table1"].is_null()) {
@@ -290,6 +291,7 @@ int runBenchFilters(const std::vector<std::string>& args) {
   if (!parser.parse(args)) return 0;
   const std::string data_root = parser.has("data") ? parser.get("data") : "";
   nlohmann::json result;
+  result["cpu"] = cpuModel();
   std::string why_not;
   result["table1"] = tableOne(data_root, &why_not);
   if (result["table1"].is_null()) result["table1_skipped"] = why_not;
