@@ -162,7 +162,7 @@ std::string markdown(const nlohmann::json& rows, const nlohmann::json& skipped) 
   std::ostringstream md;
   md << "Written by `sift_hull evaluate-filters --write docs/EVALUATION.md` on " << todayUtc()
      << ". P = precision, R = recall of the correct putatives, F1; default thresholds; ransac, "
-        "magsac, guided and best: means over seeds 0 to 4.\n\n"
+        "magsac, guided, vote_ransac and best: means over seeds 0 to 4.\n\n"
      << "| pair | ratio | putative (correct / wrong / unknown) | filter | kept | P | R | F1 | "
         "mismatches removed |\n| --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
   for (const auto& row : rows) {

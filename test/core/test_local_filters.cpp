@@ -13,6 +13,7 @@
 #include "sift_hull/filters/filter.h"
 #include "sift_hull/filters/spatial_neighbours.h"
 #include "sift_hull/synthetic/synthetic_matches.h"
+#include "synthetic_putatives.h"
 
 namespace sift_hull {
 namespace {
@@ -66,35 +67,10 @@ std::vector<double> referenceLsc(const PutativeMatches& input, const LscConfig& 
   return support;
 }
 
-LabelledMatches synthetic(double outliers, unsigned seed, double rotation_deg = 20.0,
-                          double scale = 1.2) {
-  SyntheticMatchConfig config;
-  config.inliers = 600;
-  config.outlier_fraction = outliers;
-  config.seed = seed;
-  config.rotation_deg = rotation_deg;
-  config.scale = scale;
-  return syntheticMatches(config);
-}
-
-/// The right image's putatives turned by `deg` and scaled by `scale` about the origin: points,
-/// keypoint angles and sizes.
-PutativeMatches transformRight(PutativeMatches input, double deg, double scale) {
-  const double c = std::cos(deg * CV_PI / 180.0), s = std::sin(deg * CV_PI / 180.0);
-  for (cv::KeyPoint& k : input.right_keypoints) {
-    k.pt = cv::Point2f(static_cast<float>(scale * (c * k.pt.x - s * k.pt.y)),
-                       static_cast<float>(scale * (s * k.pt.x + c * k.pt.y)));
-    k.angle = static_cast<float>(std::fmod(k.angle + deg + 360.0, 360.0));
-    k.size = static_cast<float>(k.size * scale);
-  }
-  return input;
-}
-
-size_t differing(const FilterResult& a, const FilterResult& b) {
-  size_t count = 0;
-  for (size_t m = 0; m < a.keep.size(); ++m) count += a.keep[m] != b.keep[m];
-  return count;
-}
+using test::differing;
+using test::synthetic;
+using test::transformRight;
+using test::twoMotions;
 
 // ---- SpatialNeighbours -------------------------------------------------------------------------
 
@@ -212,23 +188,6 @@ TEST(LocalGsc, HistogramOverTheNeighbourUnionMatchesItsDefinition) {
 }
 
 // ---- guided ---------------------------------------------------------------------------
-
-/// Two groups of inliers, each following its own similarity, then outliers.
-LabelledMatches twoMotions() {
-  LabelledMatches a = synthetic(0.0, 13, 20.0, 1.2), b = synthetic(0.0, 17, -35.0, 0.8);
-  const int offset = static_cast<int>(a.putative.left_keypoints.size());
-  for (size_t m = 0; m < b.putative.matches.size(); ++m) {
-    a.putative.left_keypoints.push_back(b.putative.left(m));
-    a.putative.right_keypoints.push_back(b.putative.right(m));
-    a.putative.left_keypoints.back().pt.x += 700.f;  // beside the first object
-    a.putative.right_keypoints.back().pt.x += 700.f;
-    a.putative.matches.emplace_back(offset + int(m), offset + int(m), 0.f);
-    a.truth.push_back(b.truth[m]);
-  }
-  a.putative.left_image_size = a.putative.right_image_size = cv::Size(1400, 480);
-  injectMismatches(&a, 0.3, 19);
-  return a;
-}
 
 TEST(Guided, FindsBothMotionsWhereOneModelFails) {
   const LabelledMatches input = twoMotions();

@@ -17,6 +17,7 @@
 #include "sift_hull/filters/vote_ransac.h"
 #include "sift_hull/geometry/camera.h"
 #include "sift_hull/synthetic/synthetic_matches.h"
+#include "synthetic_putatives.h"
 
 namespace sift_hull {
 namespace {
@@ -74,31 +75,9 @@ LabelledMatches sceneMatches(size_t inliers, double outliers, unsigned seed, dou
   return out;
 }
 
-LabelledMatches similarityMatches(double outliers, unsigned seed) {
-  SyntheticMatchConfig config;
-  config.inliers = 600;
-  config.outlier_fraction = outliers;
-  config.seed = seed;
-  return syntheticMatches(config);
-}
-
-/// The right image's putatives turned by `deg` and scaled by `scale` about the origin.
-PutativeMatches transformRight(PutativeMatches input, double deg, double scale) {
-  const double c = std::cos(deg * CV_PI / 180.0), s = std::sin(deg * CV_PI / 180.0);
-  for (cv::KeyPoint& k : input.right_keypoints) {
-    k.pt = cv::Point2f(static_cast<float>(scale * (c * k.pt.x - s * k.pt.y)),
-                       static_cast<float>(scale * (s * k.pt.x + c * k.pt.y)));
-    k.angle = static_cast<float>(std::fmod(k.angle + deg + 360.0, 360.0));
-    k.size = static_cast<float>(k.size * scale);
-  }
-  return input;
-}
-
-size_t differing(const FilterResult& a, const FilterResult& b) {
-  size_t count = 0;
-  for (size_t m = 0; m < a.keep.size(); ++m) count += a.keep[m] != b.keep[m];
-  return count;
-}
+using test::differing;
+using test::transformRight;
+using test::twoMotions;
 
 Eigen::Matrix3d unit(const Eigen::Matrix3d& M) {
   const Eigen::Matrix3d U = M / M.norm();
@@ -217,7 +196,7 @@ TEST(VoteRansac, SeparatesASceneAtThirtyAndSixtyPercentOutliers) {
 
 TEST(VoteRansac, ASimilarityPairIsFittedByTheHomography) {
   for (double outliers : {0.3, 0.6}) {
-    const LabelledMatches input = similarityMatches(outliers, 23);
+    const LabelledMatches input = test::synthetic(outliers, 23);
     const FilterConfigs configs;
     const std::vector<TwoViewModel> motions = voteRansacMotions(
         input.putative, {configs.vote_ransac, configs.guided, configs.magsac});
@@ -286,27 +265,6 @@ TEST(VoteRansac, SameDecisionsAfterZoomingTheRightImageWhereNoiseAllows) {
   }
 }
 
-/// Two objects, each following its own similarity, beside each other, then mismatches.
-LabelledMatches twoMotions() {
-  LabelledMatches a = similarityMatches(0.0, 13), b = similarityMatches(0.0, 17);
-  SyntheticMatchConfig other;
-  other.inliers = 600, other.outlier_fraction = 0.0, other.seed = 17;
-  other.rotation_deg = -35.0, other.scale = 0.8;
-  b = syntheticMatches(other);
-  const int offset = static_cast<int>(a.putative.left_keypoints.size());
-  for (size_t m = 0; m < b.putative.matches.size(); ++m) {
-    a.putative.left_keypoints.push_back(b.putative.left(m));
-    a.putative.right_keypoints.push_back(b.putative.right(m));
-    a.putative.left_keypoints.back().pt.x += 700.f;
-    a.putative.right_keypoints.back().pt.x += 700.f;
-    a.putative.matches.emplace_back(offset + int(m), offset + int(m), 0.f);
-    a.truth.push_back(b.truth[m]);
-  }
-  a.putative.left_image_size = a.putative.right_image_size = cv::Size(1400, 480);
-  injectMismatches(&a, 0.3, 19);
-  return a;
-}
-
 TEST(VoteRansac, FindsBothMotionsWhereOneModelFails) {
   const LabelledMatches input = twoMotions();
   const FilterScores s =
@@ -317,7 +275,7 @@ TEST(VoteRansac, FindsBothMotionsWhereOneModelFails) {
 }
 
 TEST(VoteRansac, PureNoiseKeepsAlmostNothing) {
-  LabelledMatches input = similarityMatches(0.0, 53);
+  LabelledMatches input = test::synthetic(0.0, 53);
   input.putative.matches.resize(1), input.truth.resize(1);
   injectMismatches(&input, 0.998, 59);  // about 500 random pairs
   const FilterResult result = makeFilter("vote_ransac", FilterConfigs())->apply(input.putative);
@@ -336,7 +294,7 @@ TEST(VoteRansac, BestIsVoteRansacAndSeedsRepeat) {
 TEST(VoteRansac, TinyAndDegenerateInputsKeepNothingWithoutThrowing) {
   const auto filter = makeFilter("vote_ransac", FilterConfigs());
   for (size_t n : {0u, 1u, 7u, 19u}) {
-    LabelledMatches input = similarityMatches(0.0, 37);
+    LabelledMatches input = test::synthetic(0.0, 37);
     input.putative.matches.resize(std::min(n, input.putative.matches.size()));
     EXPECT_EQ(filter->apply(input.putative).keptCount(), 0u) << n << " matches";
   }
