@@ -231,8 +231,9 @@ void addMatchCommandOptions(ArgParser* parser) {
 int runMatch(const std::vector<std::string>& args) {
   ArgParser parser("match",
                    "Matches SIFT features of two images and filters the putative matches with\n"
-                   "each --filter (best, guided, lsc, local_gsc, gsc, ratio, epipolar, ransac,\n"
-                   "magsac, gms, a+b to keep what both keep, or all; default: best), scoring them\n"
+                   "each --filter (best, vote_ransac, guided, lsc, local_gsc, gsc, ratio,\n"
+                   "epipolar, ransac, magsac, gms, a+b to keep what both keep, or all; default:\n"
+                   "best), scoring them\n"
                    "against ground truth when one is given.");
   addMatchCommandOptions(&parser);
   if (!parser.parse(args)) return 0;

@@ -83,7 +83,8 @@ TEST(EvaluateFiltersCommand, ScoresTheSyntheticPairsWithoutData) {
     EXPECT_NEAR(summary["mean_f1"][name]["mean"].get<double>(), sum / 3.0, 1e-12) << name;
   }
   EXPECT_EQ(summary["mean_f1"].size(), filterNames().size());
-  // Measured: best 0.997, magsac 0.894 (+0.103); the closest pair is the scene pair (+0.001).
+  // Measured: best well ahead of magsac (two motions); the closest pair is the scene pair
+  // (within 0.001).
   const auto& targets = summary["targets"];
   EXPECT_GE(targets["mean_f1_best-magsac>=0.02"]["measured"].get<double>(), 0.05);
   EXPECT_TRUE(targets["mean_f1_best-magsac>=0.02"]["met"].get<bool>());

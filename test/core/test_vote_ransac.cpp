@@ -63,8 +63,9 @@ LabelledMatches sceneMatches(size_t inliers, double outliers, unsigned seed, dou
     const Eigen::Vector2d l = (c.K * X).hnormalized(), r = (c.K * Xr).hnormalized();
     if (r.x() < 0 || r.x() >= 640 || r.y() < 0 || r.y() >= 480) continue;
     const double a = angle(random), s = size(random);
-    p.left_keypoints.emplace_back(cv::Point2f(float(l.x() + noise(random)), float(l.y() + noise(random))),
-                                  float(s), float(a));
+    p.left_keypoints.emplace_back(
+        cv::Point2f(float(l.x() + noise(random)), float(l.y() + noise(random))), float(s),
+        float(a));
     p.right_keypoints.emplace_back(
         cv::Point2f(float(r.x() + noise(random)), float(r.y() + noise(random))),
         float(s * X.z() / Xr.z()), float(std::fmod(a + roll_deg + angle_noise(random) + 360, 360)));
@@ -155,12 +156,14 @@ TEST(TwoViewModels, ResidualsFollowTheirDefinitions) {
   std::mt19937 random(7);
   std::uniform_real_distribution<double> u(0, 640);
   PointPairs pairs;
-  for (int i = 0; i < 200; ++i) pairs.push(float(u(random)), float(u(random)), float(u(random)), float(u(random)));
+  for (int i = 0; i < 200; ++i)
+    pairs.push(float(u(random)), float(u(random)), float(u(random)), float(u(random)));
   std::vector<float> f2, h2;
   squaredResiduals(f, pairs, &f2);
   squaredResiduals(h, pairs, &h2);
   for (size_t i = 0; i < pairs.size(); ++i) {
-    const Eigen::Vector2d a(pairs.left_x[i], pairs.left_y[i]), b(pairs.right_x[i], pairs.right_y[i]);
+    const Eigen::Vector2d a(pairs.left_x[i], pairs.left_y[i]),
+        b(pairs.right_x[i], pairs.right_y[i]);
     const double epipolar = epipolarDistances(c.F(), a, b).max();
     EXPECT_NEAR(modelResidual(f, a.x(), a.y(), b.x(), b.y()), epipolar, 1e-9 * (1 + epipolar));
     const double forward = ((h.matrix * a.homogeneous()).hnormalized() - b).norm();
@@ -198,8 +201,8 @@ TEST(VoteRansac, ASimilarityPairIsFittedByTheHomography) {
   for (double outliers : {0.3, 0.6}) {
     const LabelledMatches input = test::synthetic(outliers, 23);
     const FilterConfigs configs;
-    const std::vector<TwoViewModel> motions = voteRansacMotions(
-        input.putative, {configs.vote_ransac, configs.guided, configs.magsac});
+    const std::vector<TwoViewModel> motions =
+        voteRansacMotions(input.putative, {configs.vote_ransac, configs.guided, configs.magsac});
     ASSERT_EQ(motions.size(), 1u) << outliers;
     EXPECT_TRUE(motions[0].homography);
     const FilterScores s =
@@ -259,8 +262,8 @@ TEST(VoteRansac, SameDecisionsAfterZoomingTheRightImageWhereNoiseAllows) {
   EXPECT_GE(scoreFilter(input.truth, before).recall(), 0.99);
   for (const auto& [deg, scale] : {std::pair{25.0, 1.6}, {-70.0, 0.5}, {0.0, 2.5}}) {
     const FilterResult after = filter->apply(transformRight(input.putative, deg, scale));
-    std::cout << "best rotated " << deg << " zoomed " << scale << ": "
-              << differing(before, after) << " of " << input.truth.size() << " differ\n";
+    std::cout << "best rotated " << deg << " zoomed " << scale << ": " << differing(before, after)
+              << " of " << input.truth.size() << " differ\n";
     EXPECT_LE(differing(before, after), input.truth.size() / 100) << deg << " " << scale;
   }
 }

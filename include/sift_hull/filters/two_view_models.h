@@ -59,8 +59,9 @@ struct TwoViewFitSettings {
   double max_residual_px = 1.0;  ///< inlier threshold: modelResidual <= this
   double confidence = 0.99;
   int max_iterations = 1000;
-  /// Local samples (NAPSAC): one match drawn at random and its nearest others in the left image,
-  /// so that a sample stays on one object where several move differently.
+  /// Local samples (NAPSAC): one match drawn at random and the rest of the sample drawn among
+  /// its 4 m nearest in the left image, so that a sample stays on one object where several move
+  /// differently.
   bool local_samples = false;
   /// The local optimisation runs only when the best hypothesis has at least this many inliers
   /// among `sample_from` (a model that cannot win the comparison it is fitted for is left as is).
@@ -77,10 +78,12 @@ struct TwoViewFit {
 };
 
 /// LO-RANSAC over the pairs: minimal samples drawn from `sample_from` (distinct indices into
-/// pairs, as many as a sample at least; all pairs when empty) with `random`, each hypothesis scored over all pairs by the truncated quadratic
-/// (MSAC), stopping when `confidence` says an all-inlier sample was drawn (the inlier share of
-/// `sample_from`) or at max_iterations; the best hypothesis then refined by iterated, Sampson-
-/// weighted least squares over its inliers while the score improves.
+/// pairs, as many as a sample at least; all pairs when empty) with `random`, each hypothesis
+/// scored over all pairs by the truncated quadratic (MSAC), stopping when `confidence` says an
+/// all-inlier sample was drawn (the inlier share of `sample_from`) or at max_iterations. Each new
+/// best is refined by least squares over the pairs within twice the threshold, Tukey-weighted by
+/// their residuals (times the Sampson weight for F), while the score improves; the final best
+/// also by least squares over 5 random subsets of 4 m of those pairs, then reweighted again.
 TwoViewFit fitTwoViewModel(const PointPairs& pairs, const std::vector<int>& sample_from,
                            const TwoViewFitSettings& settings, std::mt19937* random);
 

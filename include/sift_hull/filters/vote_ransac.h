@@ -15,17 +15,21 @@ namespace sift_hull {
 ///    are the fit set.
 /// 2. Vote: the rotation that the most matches of the fit set share within
 ///    vote_ransac_max_angle_deg, then among those the scale ratio the most share within a factor
-///    vote_ransac_max_scale_ratio. Minimal samples are drawn from these matches only, so few are
-///    mismatches and few iterations suffice; both modes are found from the data, so the choice is
-///    invariant to rotating and zooming either image.
+///    vote_ransac_max_scale_ratio. Minimal samples are drawn from these matches only (from all
+///    when fewer than 16 voted), so few are mismatches and few iterations suffice; both modes are
+///    found from the data, so the choice is invariant to rotating and zooming either image.
 /// 3. LO-RANSAC (two_view_models.h) for a fundamental matrix (7 points) and a homography (4
 ///    points), scored over the whole fit set; the homography is chosen when it explains at least
 ///    guided_homography_share of F's inliers (planes, pure rotations).
 /// 4. Again on what the motions found so far leave unexplained, up to guided_max_models motions,
 ///    each with at least guided_min_model_inliers inliers and 4 times as many as it explains when
-///    the left and right points are paired at random (a model that only fits noise does not).
-///    A further motion is looked for only while the rotations left over still cluster: their
-///    strongest window holds at least twice its share of evenly spread rotations.
+///    each left point is paired with the right point of another match (the right points shifted
+///    by half the set: a model that only fits noise does not). A further motion is looked for
+///    only while the rotations left over still cluster (their strongest window holds at least
+///    twice its share of evenly spread rotations, and at least 2 guided_min_model_inliers); it
+///    is sampled locally, searched for as long as a motion explaining two thirds of its vote
+///    needs (8 samples at confidence 0.99), must explain two thirds of its vote, and must not lie
+///    mostly within twice the threshold of an earlier motion (that one's leftovers).
 /// 5. Every putative is judged: kept when a motion explains it (symmetric epipolar distance <=
 ///    magsac_max_epipolar_px, transfer error <= guided_max_transfer_px both ways).
 /// Score: the smallest residual over the motions, px (NaN when none was found: none kept).

@@ -139,8 +139,9 @@ void validate(const FilterConfigs& configs) {
 }
 
 const std::vector<std::string>& filterNames() {
-  static const std::vector<std::string> names = {
-      "ratio", "epipolar", "gsc", "ransac", "magsac", "gms", "lsc", "local_gsc", "guided", "vote_ransac", "best"};
+  static const std::vector<std::string> names = {"ratio",  "epipolar",    "gsc", "ransac",
+                                                 "magsac", "gms",         "lsc", "local_gsc",
+                                                 "guided", "vote_ransac", "best"};
   return names;
 }
 

@@ -1,6 +1,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include "sift_hull/filters/two_view_models.h"
@@ -47,9 +48,8 @@ struct Score {
 
 /// Sums the truncated squares (8 partial sums, so that it vectorises) and counts the inliers
 /// among the pairs `counted` marks.
-__attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default"))) void
-truncatedScore(const float* r2, const uint8_t* counted, size_t n, float t2, double* cost,
-               size_t* inliers) {
+__attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default"))) void truncatedScore(
+    const float* r2, const uint8_t* counted, size_t n, float t2, double* cost, size_t* inliers) {
   float partial[8] = {};
   uint32_t count[8] = {};
   size_t i = 0;
@@ -117,8 +117,7 @@ void nearbySample(const PointPairs& pairs, const std::vector<int>& from, int m,
 }
 
 /// The minimal solver's models for the sample (normalised coordinates).
-std::vector<Eigen::Matrix3d> solveMinimal(const Normalised& n, const int* sample,
-                                          bool homography) {
+std::vector<Eigen::Matrix3d> solveMinimal(const Normalised& n, const int* sample, bool homography) {
   if (homography) {
     Eigen::Matrix<double, 4, 2> l, r;
     for (int k = 0; k < 4; ++k) l.row(k) = n.left.row(sample[k]), r.row(k) = n.right.row(sample[k]);
@@ -242,6 +241,47 @@ void optimiseLocally(const PointPairs& pairs, const Normalised& n, const TwoView
   reweight(pairs, n, s, counted, reach2, best);
 }
 
+/// What one fit searches over.
+struct Search {
+  const PointPairs& pairs;
+  Normalised n;
+  const TwoViewFitSettings& settings;
+  std::vector<uint8_t> counted;
+  const std::vector<int>& sample_from;
+};
+
+/// The hypothesis loop: minimal samples until the count that the best support asks for (or
+/// max_iterations); each new best reweighted at once. Returns the iterations run.
+int searchHypotheses(const Search& s, std::mt19937* random, Best* best) {
+  const TwoViewFitSettings& settings = s.settings;
+  const int m = settings.homography ? 4 : 7;
+  const size_t pool = s.sample_from.empty() ? s.pairs.size() : s.sample_from.size();
+  const float t2 = static_cast<float>(settings.max_residual_px * settings.max_residual_px);
+  std::vector<float> r2;
+  int sample[7];
+  int iterations = 0, needed = settings.max_iterations;
+  for (; iterations < needed; ++iterations) {
+    drawSample(s.sample_from, s.pairs.size(), settings.local_samples ? 1 : m, random, sample);
+    if (settings.local_samples) nearbySample(s.pairs, s.sample_from, m, random, sample);
+    for (const Eigen::Matrix3d& M : solveMinimal(s.n, sample, settings.homography)) {
+      const TwoViewModel candidate = inPixels(M, s.n, settings.homography);
+      squaredResiduals(candidate, s.pairs, &r2);
+      const Score score = scoreOf(r2, t2, s.counted);
+      if (!(score.cost < best->score.cost)) continue;
+      *best = Best{M, candidate, score};
+      // LO-RANSAC: every new best is reweighted at once, and the refined support sets the
+      // count; the inner samples follow once, for the best of all.
+      if (best->score.inliers_counted >= settings.min_inliers_to_refine) {
+        reweight(s.pairs, s.n, settings, s.counted, kReach * t2, best);
+      }
+      needed = std::max(iterations + 1,
+                        ransacIterations(double(best->score.inliers_counted) / double(pool), m,
+                                         settings.confidence, settings.max_iterations));
+    }
+  }
+  return iterations;
+}
+
 }  // namespace
 
 TwoViewFit fitTwoViewModel(const PointPairs& pairs, const std::vector<int>& sample_from,
@@ -250,36 +290,16 @@ TwoViewFit fitTwoViewModel(const PointPairs& pairs, const std::vector<int>& samp
   const int m = settings.homography ? 4 : 7;
   const size_t pool = sample_from.empty() ? pairs.size() : sample_from.size();
   if (pool < size_t(m) || pairs.size() < size_t(m) + 1) return fit;
-  const Normalised n = normalise(pairs);
-  const float t2 = static_cast<float>(settings.max_residual_px * settings.max_residual_px);
-  const std::vector<uint8_t> counted = countedMask(sample_from, pairs.size());
+  const Search search{pairs, normalise(pairs), settings, countedMask(sample_from, pairs.size()),
+                      sample_from};
   Best best;
-  std::vector<float> r2;
-  int sample[7];
-  int needed = settings.max_iterations;
-  for (; fit.iterations < needed; ++fit.iterations) {
-    drawSample(sample_from, pairs.size(), settings.local_samples ? 1 : m, random, sample);
-    if (settings.local_samples) nearbySample(pairs, sample_from, m, random, sample);
-    for (const Eigen::Matrix3d& M : solveMinimal(n, sample, settings.homography)) {
-      const TwoViewModel candidate = inPixels(M, n, settings.homography);
-      squaredResiduals(candidate, pairs, &r2);
-      const Score score = scoreOf(r2, t2, counted);
-      if (!(score.cost < best.score.cost)) continue;
-      best = Best{M, candidate, score};
-      // LO-RANSAC: every new best is reweighted at once, and the refined support sets the
-      // count; the inner samples follow once, for the best of all.
-      if (best.score.inliers_counted >= settings.min_inliers_to_refine) {
-        reweight(pairs, n, settings, counted, kReach * t2, &best);
-      }
-      needed = std::max(fit.iterations + 1,
-                        ransacIterations(double(best.score.inliers_counted) / double(pool), m,
-                                         settings.confidence, settings.max_iterations));
-    }
-  }
+  fit.iterations = searchHypotheses(search, random, &best);
   if (!std::isfinite(best.score.cost)) return fit;
   if (best.score.inliers_counted >= settings.min_inliers_to_refine) {
-    optimiseLocally(pairs, n, settings, counted, random, &best);
+    optimiseLocally(pairs, search.n, settings, search.counted, random, &best);
   }
+  const float t2 = static_cast<float>(settings.max_residual_px * settings.max_residual_px);
+  std::vector<float> r2;
   squaredResiduals(best.model, pairs, &r2);
   fit.found = true;
   fit.model = best.model;

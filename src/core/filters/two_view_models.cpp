@@ -50,7 +50,8 @@ std::vector<double> realCubicRootsOf(double c3, double c2, double c1, double c0)
     if (r * r < q * q * q) {
       const double theta = std::acos(std::clamp(r / std::sqrt(q * q * q), -1.0, 1.0));
       const double s = -2.0 * std::sqrt(q);
-      for (int k = 0; k < 3; ++k) roots.push_back(s * std::cos((theta + 2.0 * M_PI * k) / 3.0) - b / 3.0);
+      for (int k = 0; k < 3; ++k)
+        roots.push_back(s * std::cos((theta + 2.0 * M_PI * k) / 3.0) - b / 3.0);
     } else {
       const double a = -std::copysign(std::cbrt(std::abs(r) + std::sqrt(r * r - q * q * q)), r);
       roots.push_back(a + (a == 0.0 ? 0.0 : q / a) - b / 3.0);
@@ -110,13 +111,17 @@ class NormalEquations {
     }
     if (start != nullptr) {
       const Eigen::LDLT<Eigen::Matrix<double, 9, 9>> ldlt(normal);
+      const Eigen::VectorXd pivots = ldlt.vectorD().cwiseAbs();
+      // A zero pivot (exactly consistent points) is solved as zero: the eigensolver then.
+      const bool usable = pivots.minCoeff() > 1e-15 * pivots.maxCoeff();
       Vector9d x;
       for (int k = 0; k < 9; ++k) x(k) = (*start)(k / 3, k % 3);
-      for (int step = 0; step < kInverseIterations && ldlt.info() == Eigen::Success; ++step) {
+      for (int step = 0; usable && step < kInverseIterations && ldlt.info() == Eigen::Success;
+           ++step) {
         x = ldlt.solve(x);
         x /= x.norm();
       }
-      if (ldlt.info() == Eigen::Success && x.allFinite()) return x;
+      if (usable && ldlt.info() == Eigen::Success && x.allFinite()) return x;
     }
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 9, 9>> solver(normal);
     return solver.eigenvectors().col(0);
@@ -134,28 +139,6 @@ Eigen::Matrix3d rankTwo(const Eigen::Matrix3d& F) {
 }
 
 bool finiteMatrix(const Eigen::Matrix3d& M) { return M.allFinite() && M.norm() > 0.0; }
-
-}  // namespace
-
-void PointPairs::push(float lx, float ly, float rx, float ry) {
-  left_x.push_back(lx), left_y.push_back(ly), right_x.push_back(rx), right_y.push_back(ry);
-}
-
-double modelResidual(const TwoViewModel& model, double lx, double ly, double rx, double ry) {
-  const Eigen::Matrix3d& M = model.matrix;
-  const Eigen::Vector3d l(lx, ly, 1.0), r(rx, ry, 1.0);
-  if (!model.homography) {
-    const Eigen::Vector3d line_r = M * l, line_l = M.transpose() * r;
-    const double e = std::abs(r.dot(line_r));
-    const double n = std::min(line_r.head<2>().squaredNorm(), line_l.head<2>().squaredNorm());
-    return n > 0.0 ? e / std::sqrt(n) : std::numeric_limits<double>::infinity();
-  }
-  const Eigen::Vector3d forward = M * l, backward = M.inverse() * r;
-  const double f = (forward.hnormalized() - r.head<2>()).norm();
-  const double b = (backward.hnormalized() - l.head<2>()).norm();
-  return std::isfinite(f) && std::isfinite(b) ? std::max(f, b)
-                                              : std::numeric_limits<double>::infinity();
-}
 
 __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default"))) void
 fundamentalResiduals(const float* m, const float* lx, const float* ly, const float* rx,
@@ -188,11 +171,44 @@ homographyResiduals(const float* h, const float* g, const float* lx, const float
   }
 }
 
+/// The same, well conditioned when c3 is small beside c0: then the roots of the reversed cubic
+/// c0 y^3 + c1 y^2 + c2 y + c3 in y = 1 / x (whose leading coefficient is the larger end).
+std::vector<double> realCubicRoots(double c3, double c2, double c1, double c0) {
+  if (std::abs(c3) >= std::abs(c0)) return realCubicRootsOf(c3, c2, c1, c0);
+  std::vector<double> roots;
+  for (double y : realCubicRootsOf(c0, c1, c2, c3)) {
+    if (y != 0.0 && std::isfinite(1.0 / y)) roots.push_back(1.0 / y);
+  }
+  return roots;
+}
+
+}  // namespace
+
+void PointPairs::push(float lx, float ly, float rx, float ry) {
+  left_x.push_back(lx), left_y.push_back(ly), right_x.push_back(rx), right_y.push_back(ry);
+}
+
+double modelResidual(const TwoViewModel& model, double lx, double ly, double rx, double ry) {
+  const Eigen::Matrix3d& M = model.matrix;
+  const Eigen::Vector3d l(lx, ly, 1.0), r(rx, ry, 1.0);
+  if (!model.homography) {
+    const Eigen::Vector3d line_r = M * l, line_l = M.transpose() * r;
+    const double e = std::abs(r.dot(line_r));
+    const double n = std::min(line_r.head<2>().squaredNorm(), line_l.head<2>().squaredNorm());
+    return n > 0.0 ? e / std::sqrt(n) : std::numeric_limits<double>::infinity();
+  }
+  const Eigen::Vector3d forward = M * l, backward = M.inverse() * r;
+  const double f = (forward.hnormalized() - r.head<2>()).norm();
+  const double b = (backward.hnormalized() - l.head<2>()).norm();
+  return std::isfinite(f) && std::isfinite(b) ? std::max(f, b)
+                                              : std::numeric_limits<double>::infinity();
+}
+
 void squaredResiduals(const TwoViewModel& model, const PointPairs& pairs, std::vector<float>* out) {
   out->resize(pairs.size());
   float m[9], g[9];
-  const Eigen::Matrix3d inverse = model.homography ? Eigen::Matrix3d(model.matrix.inverse())
-                                                   : Eigen::Matrix3d::Zero();
+  const Eigen::Matrix3d inverse =
+      model.homography ? Eigen::Matrix3d(model.matrix.inverse()) : Eigen::Matrix3d::Zero();
   for (int k = 0; k < 9; ++k) {
     m[k] = static_cast<float>(model.matrix(k / 3, k % 3));
     g[k] = static_cast<float>(inverse(k / 3, k % 3));
@@ -206,21 +222,11 @@ void squaredResiduals(const TwoViewModel& model, const PointPairs& pairs, std::v
   }
 }
 
-/// The same, well conditioned when c3 is small beside c0: then the roots of the reversed cubic
-/// c0 y^3 + c1 y^2 + c2 y + c3 in y = 1 / x (whose leading coefficient is the larger end).
-std::vector<double> realCubicRoots(double c3, double c2, double c1, double c0) {
-  if (std::abs(c3) >= std::abs(c0)) return realCubicRootsOf(c3, c2, c1, c0);
-  std::vector<double> roots;
-  for (double y : realCubicRootsOf(c0, c1, c2, c3)) {
-    if (y != 0.0 && std::isfinite(1.0 / y)) roots.push_back(1.0 / y);
-  }
-  return roots;
-}
-
 std::vector<Eigen::Matrix3d> sevenPointFundamental(const Eigen::Matrix<double, 7, 2>& left,
                                                    const Eigen::Matrix<double, 7, 2>& right) {
   Eigen::Matrix<double, 9, 7> At;
-  for (int i = 0; i < 7; ++i) At.col(i) = epipolarRow(left(i, 0), left(i, 1), right(i, 0), right(i, 1));
+  for (int i = 0; i < 7; ++i)
+    At.col(i) = epipolarRow(left(i, 0), left(i, 1), right(i, 0), right(i, 1));
   const Eigen::HouseholderQR<Eigen::Matrix<double, 9, 7>> qr(At);
   const Eigen::Matrix<double, 9, 7> R = qr.matrixQR().triangularView<Eigen::Upper>();
   // Rank below 7 (collinear or repeated points: without pivoting, any diagonal entry may vanish).

@@ -1,9 +1,9 @@
 #include "sift_hull/filters/vote_ransac.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <cmath>
 #include <limits>
 #include <numeric>
 #include <random>
@@ -235,13 +235,14 @@ TwoViewFit fitMotion(const FitSet& set, const std::vector<int>& pool, bool furth
   const TwoViewFit F = fitTwoViewModel(set.pairs, pool, settings, random);
   const size_t pool_size = pool.empty() ? set.pairs.size() : pool.size();
   const TwoViewFit H = fitHomography(set, pool, F, settings, config, random);
-  const bool use_h =
-      H.found && (!F.found || H.inliers.size() >= guided.guided_homography_share * F.inliers.size());
+  const bool use_h = H.found && (!F.found || H.inliers.size() >=
+                                                 guided.guided_homography_share * F.inliers.size());
   TwoViewFit chosen = use_h ? H : F;
   const double threshold = use_h ? guided.guided_max_transfer_px : fit.max_epipolar_px;
   size_t needed = std::max<size_t>(size_t(guided.guided_min_model_inliers),
                                    4 * chanceInliers(chosen.model, set.pairs, threshold));
-  if (further) needed = std::max<size_t>(needed, size_t(std::ceil(kFurtherMotionShare * pool_size)));
+  if (further)
+    needed = std::max<size_t>(needed, size_t(std::ceil(kFurtherMotionShare * pool_size)));
   const size_t explained_in_pool =
       further ? countIn(chosen.inliers, pool, set.pairs.size()) : chosen.inliers.size();
   if (!chosen.found || chosen.inliers.size() < needed || explained_in_pool < needed) {
@@ -332,11 +333,10 @@ void judge(const PutativeMatches& input, const std::vector<TwoViewModel>& motion
 void validate(const VoteRansacConfig& config) {
   require(config.vote_ransac_max_angle_deg > 0.0 && config.vote_ransac_max_angle_deg <= 180.0,
           "vote_ransac_max_angle_deg must be in (0, 180]");
-  require(config.vote_ransac_max_scale_ratio > 1.0 &&
-              std::isfinite(config.vote_ransac_max_scale_ratio),
-          "vote_ransac_max_scale_ratio must be finite and > 1");
-  require(config.vote_ransac_max_fit_points >= 16 &&
-              config.vote_ransac_max_fit_points <= 1000000,
+  require(
+      config.vote_ransac_max_scale_ratio > 1.0 && std::isfinite(config.vote_ransac_max_scale_ratio),
+      "vote_ransac_max_scale_ratio must be finite and > 1");
+  require(config.vote_ransac_max_fit_points >= 16 && config.vote_ransac_max_fit_points <= 1000000,
           "vote_ransac_max_fit_points must be in [16, 1000000]");
 }
 
