@@ -185,15 +185,105 @@ TEST(TwoViewModels, RansacIterationsFollowTheFormula) {
 
 // ---- the filter --------------------------------------------------------------------------------
 
+PointPairs pairsOf(const PutativeMatches& p) {
+  PointPairs pairs;
+  for (size_t m = 0; m < p.matches.size(); ++m) {
+    pairs.push(p.left(m).pt.x, p.left(m).pt.y, p.right(m).pt.x, p.right(m).pt.y);
+  }
+  return pairs;
+}
+
+/// The truncated quadratic of a model over the pairs (threshold 1 px) and its true inliers.
+std::pair<double, size_t> costAndTrueInliers(const TwoViewModel& model, const PointPairs& pairs,
+                                             const std::vector<MatchTruth>& truth) {
+  std::vector<float> r2;
+  squaredResiduals(model, pairs, &r2);
+  double cost = 0.0;
+  size_t found = 0;
+  for (size_t i = 0; i < r2.size(); ++i) {
+    cost += std::min(r2[i], 1.0f);
+    found += r2[i] <= 1.0f && truth[i] == MatchTruth::kCorrect;
+  }
+  return {cost, found};
+}
+
+TEST(TwoViewModels, PolishingAnOffsetModelRecoversTheTrueMatches) {
+  // The exact F of cameras turned 0.3 deg further: it loses many true matches at 1 px; refined
+  // against all the putatives (60 % mismatches) it must lower the cost and keep about as many as
+  // the exact F does.
+  const LabelledMatches input = sceneMatches(600, 0.6, 5, 0.3);
+  const PointPairs pairs = pairsOf(input.putative);
+  TwoCameras offset = twoCameras();
+  offset.R = Eigen::AngleAxisd(0.3 * M_PI / 180.0, Eigen::Vector3d::UnitX()) * offset.R;
+  TwoViewModel exact, start;
+  exact.matrix = twoCameras().F(), start.matrix = offset.F();
+  const auto [exact_cost, exact_found] = costAndTrueInliers(exact, pairs, input.truth);
+  const auto [start_cost, start_found] = costAndTrueInliers(start, pairs, input.truth);
+  const TwoViewModel polished = polishTwoViewModel(pairs, start, 1.0);
+  const auto [cost, found] = costAndTrueInliers(polished, pairs, input.truth);
+  std::cout << "true matches within 1 px: exact " << exact_found << ", offset " << start_found
+            << ", polished " << found << "; cost " << exact_cost << ", " << start_cost << ", "
+            << cost << "\n";
+  ASSERT_LT(start_found, exact_found * 0.9);  // the offset is large enough to matter
+  EXPECT_LT(cost, start_cost);
+  EXPECT_GE(double(found), 0.98 * double(exact_found));
+  EXPECT_FALSE(polished.homography);
+}
+
+TEST(TwoViewModels, PolishingLeavesWhatItCannotImprove) {
+  const LabelledMatches input = sceneMatches(600, 0.3, 7, 0.3);
+  const PointPairs pairs = pairsOf(input.putative);
+  TwoViewModel broken;
+  broken.matrix(0, 0) = NAN;
+  EXPECT_TRUE(polishTwoViewModel(pairs, broken, 1.0).matrix.hasNaN());
+  PointPairs few;
+  for (size_t i = 0; i < 7; ++i) {
+    few.push(pairs.left_x[i], pairs.left_y[i], pairs.right_x[i], pairs.right_y[i]);
+  }
+  TwoViewModel exact;
+  exact.matrix = twoCameras().F();
+  EXPECT_EQ(polishTwoViewModel(few, exact, 1.0).matrix, exact.matrix);
+  // Never worse than where it started.
+  const double before = costAndTrueInliers(exact, pairs, input.truth).first;
+  EXPECT_LE(costAndTrueInliers(polishTwoViewModel(pairs, exact, 1.0), pairs, input.truth).first,
+            before);
+}
+
+/// The share of the true matches that the exact F keeps at the filter's threshold: with 0.3 px of
+/// noise on each coordinate some true matches lie beyond 1 px, so no filter can reach recall 1.
+double oracleRecall(const LabelledMatches& input, double threshold_px) {
+  TwoViewModel truth;
+  truth.matrix = twoCameras().F();
+  size_t correct = 0, within = 0;
+  for (size_t m = 0; m < input.truth.size(); ++m) {
+    if (input.truth[m] != MatchTruth::kCorrect) continue;
+    const cv::Point2f &a = input.putative.left(m).pt, &b = input.putative.right(m).pt;
+    ++correct;
+    within += modelResidual(truth, a.x, a.y, b.x, b.y) <= threshold_px;
+  }
+  return double(within) / double(correct);
+}
+
 TEST(VoteRansac, SeparatesASceneAtThirtyAndSixtyPercentOutliers) {
+  // Ten scenes each: the recall is measured against what the exact F keeps (the oracle), since
+  // the found F differs from it by the noise of the fit (on 100 scenes at 60 % outliers the
+  // largest shortfall was 0.042, the mean 0.004).
+  const FilterConfigs configs;
+  const auto filter = makeFilter("vote_ransac", configs);
   for (double outliers : {0.3, 0.6}) {
-    const LabelledMatches input = sceneMatches(600, outliers, 41, 0.3);
-    const FilterScores s =
-        scoreFilter(input.truth, makeFilter("vote_ransac", FilterConfigs())->apply(input.putative));
-    std::cout << "scene, " << outliers << " outliers: P " << s.precision() << " R " << s.recall()
-              << "\n";
-    EXPECT_GE(s.recall(), 0.97) << outliers;
-    EXPECT_GE(s.precision(), 0.97) << outliers;
+    double shortfall_sum = 0.0;
+    const unsigned first = 41, count = 10;
+    for (unsigned seed = first; seed < first + count; ++seed) {
+      const LabelledMatches input = sceneMatches(600, outliers, seed, 0.3);
+      const FilterScores s = scoreFilter(input.truth, filter->apply(input.putative));
+      const double oracle = oracleRecall(input, configs.magsac.max_epipolar_px);
+      std::cout << "scene " << seed << ", " << outliers << " outliers: P " << s.precision() << " R "
+                << s.recall() << " (exact F: " << oracle << ")\n";
+      EXPECT_GE(s.recall(), oracle - 0.07) << outliers << " seed " << seed;
+      EXPECT_GE(s.precision(), 0.97) << outliers << " seed " << seed;
+      shortfall_sum += oracle - s.recall();
+    }
+    EXPECT_LE(shortfall_sum / count, 0.015) << outliers;
   }
 }
 

@@ -87,6 +87,13 @@ struct TwoViewFit {
 TwoViewFit fitTwoViewModel(const PointPairs& pairs, const std::vector<int>& sample_from,
                            const TwoViewFitSettings& settings, std::mt19937* random);
 
+/// A finished model refined against `pairs` (all the putatives, where the fit saw a sample of
+/// them): Tukey-reweighted least squares over the pairs within twice max_residual_px (at most
+/// 4096, evenly spread), while the truncated quadratic over all pairs improves. The model itself
+/// when nothing improves it.
+TwoViewModel polishTwoViewModel(const PointPairs& pairs, const TwoViewModel& model,
+                                double max_residual_px);
+
 /// The RANSAC iteration count for an inlier share w and sample size m at `confidence`, capped.
 int ransacIterations(double w, int m, double confidence, int cap);
 

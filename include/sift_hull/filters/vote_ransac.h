@@ -30,10 +30,14 @@ namespace sift_hull {
 ///    is sampled locally, searched for as long as a motion explaining two thirds of its vote
 ///    needs (8 samples at confidence 0.99), must explain two thirds of its vote, and must not lie
 ///    mostly within twice the threshold of an earlier motion (that one's leftovers).
-/// 5. Every putative is judged: kept when a motion explains it (symmetric epipolar distance <=
+/// 5. When the fit set was a sample, each motion is refined against all the putatives: the
+///    ones within three times its threshold (at most 512, evenly spread) go to
+///    polishTwoViewModel, so that a motion fitted to a few hundred matches does not lose the
+///    others at its edges, at a cost of one residual per putative beyond that.
+/// 6. Every putative is judged: kept when a motion explains it (symmetric epipolar distance <=
 ///    magsac_max_epipolar_px, transfer error <= guided_max_transfer_px both ways).
 /// Score: the smallest residual over the motions, px (NaN when none was found: none kept).
-/// Its time hardly grows with N beyond the fit set: step 5 is one residual per match.
+/// Its time hardly grows with N beyond the fit set: steps 5 and 6 are a few residuals per match.
 struct VoteRansacConfig {
   double vote_ransac_max_angle_deg = 30.0;   ///< half width of the rotation vote's window, deg
   double vote_ransac_max_scale_ratio = 2.0;  ///< half width of the scale vote's window (factor)
@@ -51,7 +55,7 @@ struct VoteRansacFilterConfig {
 /// Throws std::invalid_argument naming the first bad field.
 void validate(const VoteRansacConfig& config);
 FilterResult filterVoteRansac(const PutativeMatches& input, const VoteRansacFilterConfig& config);
-/// Steps 1 to 4 alone: the motions found (none, one or up to guided_max_models), in pixels.
+/// Steps 1 to 5 alone: the motions found (none, one or up to guided_max_models), in pixels.
 std::vector<TwoViewModel> voteRansacMotions(const PutativeMatches& input,
                                             const VoteRansacFilterConfig& config);
 

@@ -131,18 +131,19 @@ std::vector<Eigen::Matrix3d> solveMinimal(const Normalised& n, const int* sample
 }
 
 /// The local optimisation refits to at most this many inliers (evenly spread over them), so that
-/// its cost does not grow with N.
+/// its cost does not grow with N; the polish of a finished model to at most kMaxPolishPoints.
 constexpr size_t kMaxRefitPoints = 256;
+constexpr size_t kMaxPolishPoints = 4096;
 
-/// Weighted least squares over the inliers: Tukey's biweight of each one's squared residual r2
-/// under the previous model within `reach2`, for F times the Sampson weight.
+/// Weighted least squares over the inliers (at most max_points of them, evenly spread): Tukey's
+/// biweight of each one's squared residual r2 under the previous model within `reach2`, for F
+/// times the Sampson weight.
 bool refit(const Normalised& n, std::vector<int> inliers, const std::vector<float>& r2,
-           float reach2, const Eigen::Matrix3d& previous, bool homography, Eigen::Matrix3d* M) {
-  if (inliers.size() > kMaxRefitPoints) {
-    std::vector<int> spread(kMaxRefitPoints);
-    for (size_t k = 0; k < kMaxRefitPoints; ++k) {
-      spread[k] = inliers[k * inliers.size() / kMaxRefitPoints];
-    }
+           float reach2, const Eigen::Matrix3d& previous, bool homography, Eigen::Matrix3d* M,
+           size_t max_points = kMaxRefitPoints) {
+  if (inliers.size() > max_points) {
+    std::vector<int> spread(max_points);
+    for (size_t k = 0; k < max_points; ++k) spread[k] = inliers[k * inliers.size() / max_points];
     inliers.swap(spread);
   }
   const Eigen::Index count = Eigen::Index(inliers.size());
@@ -190,7 +191,8 @@ constexpr int kMaxRefits = 8;
 
 /// Iteratively reweighted least squares from the best model while the score improves.
 void reweight(const PointPairs& pairs, const Normalised& n, const TwoViewFitSettings& s,
-              const std::vector<uint8_t>& counted, float reach2, Best* best) {
+              const std::vector<uint8_t>& counted, float reach2, Best* best,
+              size_t max_points = kMaxRefitPoints) {
   const float t2 = static_cast<float>(s.max_residual_px * s.max_residual_px);
   const size_t minimum = s.homography ? 4 : 8;
   std::vector<float> r2, candidate_r2;
@@ -199,7 +201,7 @@ void reweight(const PointPairs& pairs, const Normalised& n, const TwoViewFitSett
     const std::vector<int> inliers = inliersOf(r2, reach2);
     Eigen::Matrix3d M;
     if (inliers.size() < minimum ||
-        !refit(n, inliers, r2, reach2, best->normalised, s.homography, &M)) {
+        !refit(n, inliers, r2, reach2, best->normalised, s.homography, &M, max_points)) {
       return;
     }
     const TwoViewModel candidate = inPixels(M, n, s.homography);
@@ -282,7 +284,31 @@ int searchHypotheses(const Search& s, std::mt19937* random, Best* best) {
   return iterations;
 }
 
+/// A model in pixels, in the normalised coordinates of `n` (the inverse of inPixels).
+Eigen::Matrix3d inNormalised(const TwoViewModel& model, const Normalised& n) {
+  return model.homography
+             ? Eigen::Matrix3d(n.T_right * model.matrix * n.T_left.inverse())
+             : Eigen::Matrix3d(n.T_right.inverse().transpose() * model.matrix * n.T_left.inverse());
+}
+
 }  // namespace
+
+TwoViewModel polishTwoViewModel(const PointPairs& pairs, const TwoViewModel& model,
+                                double max_residual_px) {
+  if (pairs.size() < (model.homography ? 4u : 8u)) return model;
+  TwoViewFitSettings settings;
+  settings.homography = model.homography;
+  settings.max_residual_px = max_residual_px;
+  const Normalised n = normalise(pairs);
+  const std::vector<uint8_t> counted(pairs.size(), 1);
+  const float t2 = static_cast<float>(max_residual_px * max_residual_px);
+  std::vector<float> r2;
+  squaredResiduals(model, pairs, &r2);
+  Best best{inNormalised(model, n), model, scoreOf(r2, t2, counted)};
+  if (!best.normalised.allFinite() || !std::isfinite(best.score.cost)) return model;
+  reweight(pairs, n, settings, counted, kReach * t2, &best, kMaxPolishPoints);
+  return best.model;
+}
 
 TwoViewFit fitTwoViewModel(const PointPairs& pairs, const std::vector<int>& sample_from,
                            const TwoViewFitSettings& settings, std::mt19937* random) {

@@ -301,17 +301,22 @@ std::vector<TwoViewModel> fitMotions(FitSet set, const VoteRansacFilterConfig& c
   return motions;
 }
 
-/// Every match with finite positions judged against the motions (float residuals, vectorised).
-void judge(const PutativeMatches& input, const std::vector<TwoViewModel>& motions,
-           const VoteRansacFilterConfig& config, FilterResult* result) {
+/// The matches with finite positions, as pairs, with their indices into input.matches.
+PointPairs finitePairs(const PutativeMatches& input, std::vector<size_t>* index) {
   PointPairs all;
-  std::vector<size_t> index;
   for (size_t m = 0; m < input.matches.size(); ++m) {
     if (!input.hasFinitePositions(m)) continue;
     const cv::Point2f &a = input.left(m).pt, &b = input.right(m).pt;
     all.push(a.x, a.y, b.x, b.y);
-    index.push_back(m);
+    index->push_back(m);
   }
+  return all;
+}
+
+/// Every match judged against the motions (float residuals, vectorised).
+void judge(const PointPairs& all, const std::vector<size_t>& index,
+           const std::vector<TwoViewModel>& motions, const VoteRansacFilterConfig& config,
+           FilterResult* result) {
   std::vector<float> best(all.size(), std::numeric_limits<float>::infinity()), r2;
   std::vector<uint8_t> explained(all.size(), 0);
   for (const TwoViewModel& motion : motions) {
@@ -340,21 +345,64 @@ void validate(const VoteRansacConfig& config) {
           "vote_ransac_max_fit_points must be in [16, 1000000]");
 }
 
-std::vector<TwoViewModel> voteRansacMotions(const PutativeMatches& input,
-                                            const VoteRansacFilterConfig& config) {
+namespace {
+
+/// The refinement of a motion against all the matches sees those within this many times its
+/// threshold (the rest cannot join it in a few reweighting steps), at most kMaxPolishPoints of
+/// them, evenly spread, so that its cost is one residual per match beyond that (512 near
+/// matches hold more of the motion than the fit set's sample of 500 putatives does).
+constexpr double kPolishReach = 3.0;
+constexpr size_t kMaxPolishPoints = 512;
+
+TwoViewModel polished(const PointPairs& all, const TwoViewModel& motion, double threshold_px) {
+  std::vector<float> r2;
+  squaredResiduals(motion, all, &r2);
+  const float reach2 = static_cast<float>(std::pow(kPolishReach * threshold_px, 2));
+  std::vector<int> near;
+  for (size_t i = 0; i < r2.size(); ++i) {
+    if (r2[i] <= reach2) near.push_back(static_cast<int>(i));
+  }
+  PointPairs chosen;
+  const size_t count = std::min(near.size(), kMaxPolishPoints);
+  for (size_t k = 0; k < count; ++k) {
+    const size_t i = size_t(near[k * near.size() / count]);
+    chosen.push(all.left_x[i], all.left_y[i], all.right_x[i], all.right_y[i]);
+  }
+  return polishTwoViewModel(chosen, motion, threshold_px);
+}
+
+/// The motions of the matches `all` (the finite ones of `input`): fitted to at most
+/// vote_ransac_max_fit_points of them, then, when that was a sample, each refined against all.
+std::vector<TwoViewModel> motionsOf(const PutativeMatches& input, const PointPairs& all,
+                                    const VoteRansacFilterConfig& config) {
   validate(config.vote_ransac);
   validate(config.guided);
   validate(config.magsac, "magsac");
-  return fitMotions(fitSetOf(input, size_t(config.vote_ransac.vote_ransac_max_fit_points),
-                             static_cast<unsigned>(config.magsac.seed)),
-                    config);
+  const size_t max_points = size_t(config.vote_ransac.vote_ransac_max_fit_points);
+  std::vector<TwoViewModel> motions =
+      fitMotions(fitSetOf(input, max_points, static_cast<unsigned>(config.magsac.seed)), config);
+  if (all.size() > max_points) {
+    for (TwoViewModel& motion : motions) {
+      motion = polished(all, motion, thresholdOf(motion, config));
+    }
+  }
+  return motions;
+}
+
+}  // namespace
+
+std::vector<TwoViewModel> voteRansacMotions(const PutativeMatches& input,
+                                            const VoteRansacFilterConfig& config) {
+  std::vector<size_t> index;
+  return motionsOf(input, finitePairs(input, &index), config);
 }
 
 FilterResult filterVoteRansac(const PutativeMatches& input, const VoteRansacFilterConfig& config) {
   FilterResult result = FilterResult::keepingNone(input.matches.size());
-  const std::vector<TwoViewModel> motions = voteRansacMotions(input, config);
-  if (motions.empty()) return result;
-  judge(input, motions, config, &result);
+  std::vector<size_t> index;
+  const PointPairs all = finitePairs(input, &index);
+  const std::vector<TwoViewModel> motions = motionsOf(input, all, config);
+  if (!motions.empty()) judge(all, index, motions, config, &result);
   return result;
 }
 
