@@ -5,6 +5,7 @@
 // degenerate inputs. Its time is measured by `sift_hull bench-filters`, not here.
 #include <gtest/gtest.h>
 
+#include <Eigen/Dense>
 #include <Eigen/Geometry>
 #include <cmath>
 #include <iostream>
@@ -147,6 +148,53 @@ TEST(TwoViewModels, LeastSquaresRecoverNoiseFreeModels) {
   for (int m = 0; m < 60; ++m) r.row(m) = (H0 * l.row(m).transpose().homogeneous()).hnormalized();
   ASSERT_TRUE(leastSquaresHomography(l, r, Eigen::VectorXd::Ones(60), &H));
   EXPECT_LT((unit(H) - unit(H0)).norm(), 1e-7);
+  // Sizes that differ are refused.
+  EXPECT_FALSE(leastSquaresFundamental(l, r.topRows(59), Eigen::VectorXd::Ones(60), &F));
+  EXPECT_FALSE(leastSquaresHomography(l, r, Eigen::VectorXd::Ones(59), &H));
+}
+
+TEST(TwoViewModels, WeightedLeastSquaresEqualAPlainEigenvectorOfTheWeightedProduct) {
+  // Noisy points and random weights, at sizes around the kernel's blocks of 8 and at 512 (whose
+  // columns would lie 4 KiB apart unpadded): the smallest eigenvector of A^T W A computed plainly.
+  for (int n : {8, 13, 61, 512}) {
+    const LabelledMatches scene = sceneMatches(size_t(n), 0.0, 9, 0.5);
+    std::mt19937 random(3);
+    std::uniform_real_distribution<double> weight(0.1, 1.0);
+    Eigen::MatrixX2d l(n, 2), r(n, 2);
+    Eigen::VectorXd w(n);
+    Eigen::MatrixXd A(n, 9), B(2 * n, 9);
+    Eigen::VectorXd wb(2 * n);
+    for (int m = 0; m < n; ++m) {
+      const double lx = scene.putative.left(m).pt.x / 320.0 - 1,
+                   ly = scene.putative.left(m).pt.y / 240.0 - 1,
+                   rx = scene.putative.right(m).pt.x / 320.0 - 1,
+                   ry = scene.putative.right(m).pt.y / 240.0 - 1;
+      l.row(m) << lx, ly;
+      r.row(m) << rx, ry;
+      w(m) = weight(random);
+      A.row(m) << rx * lx, rx * ly, rx, ry * lx, ry * ly, ry, lx, ly, 1.0;
+      B.row(2 * m) << -lx, -ly, -1, 0, 0, 0, rx * lx, rx * ly, rx;
+      B.row(2 * m + 1) << 0, 0, 0, -lx, -ly, -1, ry * lx, ry * ly, ry;
+      wb(2 * m) = wb(2 * m + 1) = w(m);
+    }
+    auto smallest = [](const Eigen::MatrixXd& M, const Eigen::VectorXd& weights) {
+      const Eigen::MatrixXd normal = M.transpose() * weights.asDiagonal() * M;
+      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver(normal);
+      Eigen::Matrix3d X;
+      for (int k = 0; k < 9; ++k) X(k / 3, k % 3) = solver.eigenvectors()(k, 0);
+      return X;
+    };
+    Eigen::Matrix3d F, H;
+    ASSERT_TRUE(leastSquaresFundamental(l, r, w, &F)) << n;
+    Eigen::JacobiSVD<Eigen::Matrix3d> svd(smallest(A, w),
+                                          Eigen::ComputeFullU | Eigen::ComputeFullV);
+    Eigen::Vector3d s = svd.singularValues();
+    s(2) = 0.0;
+    const Eigen::Matrix3d F_plain = svd.matrixU() * s.asDiagonal() * svd.matrixV().transpose();
+    EXPECT_LT((unit(F) - unit(F_plain)).norm(), 1e-8) << n;
+    ASSERT_TRUE(leastSquaresHomography(l, r, w, &H)) << n;
+    EXPECT_LT((unit(H) - unit(smallest(B, wb))).norm(), 1e-8) << n;
+  }
 }
 
 TEST(TwoViewModels, ResidualsFollowTheirDefinitions) {

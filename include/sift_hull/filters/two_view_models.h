@@ -39,7 +39,8 @@ bool fourPointHomography(const Eigen::Matrix<double, 4, 2>& left,
                          const Eigen::Matrix<double, 4, 2>& right, Eigen::Matrix3d* H);
 
 /// Least squares over n >= 8 (F) or n >= 4 (H) weighted correspondences (n x 2 arrays): the
-/// smallest eigenvector of the algebraic normal equations; F made rank 2. False when degenerate.
+/// smallest eigenvector of the algebraic normal equations; F made rank 2. False when degenerate
+/// or when the three sizes differ.
 /// `start`, a model near the answer, makes it a few steps of inverse iteration.
 bool leastSquaresFundamental(const Eigen::MatrixX2d& left, const Eigen::MatrixX2d& right,
                              const Eigen::VectorXd& weights, Eigen::Matrix3d* F,
@@ -49,7 +50,8 @@ bool leastSquaresHomography(const Eigen::MatrixX2d& left, const Eigen::MatrixX2d
                             const Eigen::Matrix3d* start = nullptr);
 
 /// Hartley's normalisation of one image's points, made robust: the median point to the origin,
-/// the median distance from it sqrt(2).
+/// the median distance from it sqrt(2) (medians of at most 255 points evenly spread over the
+/// list).
 /// Returns T with x_normalised = T x.
 Eigen::Matrix3d hartleyNormalisation(const std::vector<float>& x, const std::vector<float>& y);
 

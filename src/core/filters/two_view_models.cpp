@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 namespace sift_hull {
 namespace {
@@ -88,26 +89,77 @@ bool anyThreeCollinear(const Eigen::Matrix<double, 4, 2>& p) {
 
 constexpr int kInverseIterations = 4;
 
-/// sum += w a a^T for one row a of 9, whole rows of contiguous doubles so that they vectorise.
-__attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default"))) void addOuter(
-    double (*sum)[9], const double* a, double w) {
+/// sum = sum_i w_i a_i a_i^T over n rows of 9 stored by column (a[k * stride + i] is entry k of
+/// row i): 45 weighted dot products, each in 8 partial sums so that it vectorises.
+__attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default"))) void weightedGram(
+    const double* a, const double* w, size_t n, size_t stride, double (*sum)[9]) {
   for (int r = 0; r < 9; ++r) {
-    const double wa = w * a[r];
-    for (int c = 0; c < 9; ++c) sum[r][c] += wa * a[c];
+    const double* ar = a + size_t(r) * stride;
+    for (int c = r; c < 9; ++c) {
+      const double* ac = a + size_t(c) * stride;
+      double partial[8] = {};
+      size_t i = 0;
+      for (; i + 8 <= n; i += 8) {
+        for (int k = 0; k < 8; ++k) partial[k] += w[i + k] * ar[i + k] * ac[i + k];
+      }
+      double total = 0.0;
+      for (; i < n; ++i) total += w[i] * ar[i] * ac[i];
+      for (int k = 0; k < 8; ++k) total += partial[k];
+      sum[r][c] = sum[c][r] = total;
+    }
   }
 }
 
-/// The sum of w a a^T over weighted rows a.
+/// The sum of w a a^T over at most `rows` weighted rows a, kept by column until it is solved.
 class NormalEquations {
  public:
-  void add(const Vector9d& a, double w) { addOuter(sum_, a.data(), w); }
+  /// Columns of `rows` entries, padded so that they are not a multiple of 4 KiB apart (stores
+  /// to nine columns at such a distance alias in the cache and take several times as long).
+  explicit NormalEquations(size_t rows)
+      : rows_(rows), stride_((rows + 7) / 8 * 8 + 8), a_(9 * stride_), w_(rows) {}
+  /// All rows of x_r^T F x_l = 0 at once, column by column (so that it vectorises): n
+  /// correspondences (n x 2 arrays, column-major) and their weights.
+  void setEpipolarRows(const Eigen::MatrixX2d& left, const Eigen::MatrixX2d& right,
+                       const Eigen::VectorXd& weights) {
+    used_ = std::min(rows_, size_t(left.rows()));
+    const double *lx = left.col(0).data(), *ly = left.col(1).data();
+    const double *rx = right.col(0).data(), *ry = right.col(1).data();
+    double* c[9];
+    for (int k = 0; k < 9; ++k) c[k] = a_.data() + size_t(k) * stride_;
+    for (size_t i = 0; i < used_; ++i) {
+      c[0][i] = rx[i] * lx[i], c[1][i] = rx[i] * ly[i], c[2][i] = rx[i];
+      c[3][i] = ry[i] * lx[i], c[4][i] = ry[i] * ly[i], c[5][i] = ry[i];
+      c[6][i] = lx[i], c[7][i] = ly[i], c[8][i] = 1.0;
+      w_[i] = weights(Eigen::Index(i));
+    }
+  }
+  /// The same for the two DLT rows of r ~ H l per correspondence (rows i and n + i).
+  void setHomographyRows(const Eigen::MatrixX2d& left, const Eigen::MatrixX2d& right,
+                         const Eigen::VectorXd& weights) {
+    const size_t n = std::min(rows_ / 2, size_t(left.rows()));
+    used_ = 2 * n;
+    const double *lx = left.col(0).data(), *ly = left.col(1).data();
+    const double *rx = right.col(0).data(), *ry = right.col(1).data();
+    double* c[9];
+    for (int k = 0; k < 9; ++k) c[k] = a_.data() + size_t(k) * stride_;
+    for (size_t i = 0; i < n; ++i) {
+      const size_t j = n + i;
+      c[0][i] = -lx[i], c[1][i] = -ly[i], c[2][i] = -1.0, c[3][i] = c[4][i] = c[5][i] = 0.0;
+      c[6][i] = rx[i] * lx[i], c[7][i] = rx[i] * ly[i], c[8][i] = rx[i];
+      c[0][j] = c[1][j] = c[2][j] = 0.0, c[3][j] = -lx[i], c[4][j] = -ly[i], c[5][j] = -1.0;
+      c[6][j] = ry[i] * lx[i], c[7][j] = ry[i] * ly[i], c[8][j] = ry[i];
+      w_[i] = w_[j] = weights(Eigen::Index(i));
+    }
+  }
   /// The eigenvector of the smallest eigenvalue: by inverse iteration from `start` (a model
   /// near the answer, row-major) when given, which is a few 9x9 solves instead of a full
   /// eigendecomposition, else (or when that fails) by the eigensolver.
   Vector9d smallestEigenvector(const Eigen::Matrix3d* start = nullptr) const {
+    double sum[9][9];
+    weightedGram(a_.data(), w_.data(), used_, stride_, sum);
     Eigen::Matrix<double, 9, 9> normal;
     for (int r = 0; r < 9; ++r) {
-      for (int c = 0; c < 9; ++c) normal(r, c) = sum_[r][c];
+      for (int c = 0; c < 9; ++c) normal(r, c) = sum[r][c];
     }
     if (start != nullptr) {
       const Eigen::LDLT<Eigen::Matrix<double, 9, 9>> ldlt(normal);
@@ -128,7 +180,8 @@ class NormalEquations {
   }
 
  private:
-  double sum_[9][9] = {};
+  size_t rows_, stride_, used_ = 0;
+  std::vector<double> a_, w_;
 };
 
 Eigen::Matrix3d rankTwo(const Eigen::Matrix3d& F) {
@@ -264,11 +317,9 @@ bool fourPointHomography(const Eigen::Matrix<double, 4, 2>& left,
 bool leastSquaresFundamental(const Eigen::MatrixX2d& left, const Eigen::MatrixX2d& right,
                              const Eigen::VectorXd& weights, Eigen::Matrix3d* F,
                              const Eigen::Matrix3d* start) {
-  if (left.rows() < 8) return false;
-  NormalEquations normal;
-  for (Eigen::Index i = 0; i < left.rows(); ++i) {
-    normal.add(epipolarRow(left(i, 0), left(i, 1), right(i, 0), right(i, 1)), weights(i));
-  }
+  if (left.rows() < 8 || right.rows() != left.rows() || weights.size() != left.rows()) return false;
+  NormalEquations normal(size_t(left.rows()));
+  normal.setEpipolarRows(left, right, weights);
   *F = rankTwo(fromRowMajor(normal.smallestEigenvector(start)));
   return finiteMatrix(*F);
 }
@@ -276,32 +327,35 @@ bool leastSquaresFundamental(const Eigen::MatrixX2d& left, const Eigen::MatrixX2
 bool leastSquaresHomography(const Eigen::MatrixX2d& left, const Eigen::MatrixX2d& right,
                             const Eigen::VectorXd& weights, Eigen::Matrix3d* H,
                             const Eigen::Matrix3d* start) {
-  if (left.rows() < 4) return false;
-  NormalEquations normal;
-  for (Eigen::Index i = 0; i < left.rows(); ++i) {
-    Vector9d a, b;
-    homographyRows(left(i, 0), left(i, 1), right(i, 0), right(i, 1), &a, &b);
-    normal.add(a, weights(i)), normal.add(b, weights(i));
-  }
+  if (left.rows() < 4 || right.rows() != left.rows() || weights.size() != left.rows()) return false;
+  NormalEquations normal(2 * size_t(left.rows()));
+  normal.setHomographyRows(left, right, weights);
   *H = fromRowMajor(normal.smallestEigenvector(start));
   return finiteMatrix(*H) && std::abs(H->determinant()) > 1e-12 * std::pow(H->norm(), 3);
 }
 
 Eigen::Matrix3d hartleyNormalisation(const std::vector<float>& x, const std::vector<float>& y) {
   // Medians rather than means, so that one point far away (a hostile 1e30) does not squeeze all
-  // the others onto the origin.
+  // the others onto the origin; of at most kMedianSample points evenly spread over the list,
+  // which is as good a normalisation and keeps its cost fixed.
+  constexpr size_t kMedianSample = 255;
+  const size_t n = std::min(x.size(), y.size()), count = std::min(n, kMedianSample);
+  std::vector<double> xs(count), ys(count);
+  for (size_t k = 0; k < count; ++k) {
+    const size_t i = k * n / count;
+    xs[k] = x[i], ys[k] = y[i];
+  }
   auto median = [](std::vector<double> values) {
     if (values.empty()) return 0.0;
     const auto middle = values.begin() + values.size() / 2;
     std::nth_element(values.begin(), middle, values.end());
     return *middle;
   };
-  const double cx = median(std::vector<double>(x.begin(), x.end()));
-  const double cy = median(std::vector<double>(y.begin(), y.end()));
-  std::vector<double> distances(x.size());
-  for (size_t i = 0; i < x.size(); ++i) {
-    const double dx = x[i] - cx, dy = y[i] - cy;
-    distances[i] = std::sqrt(dx * dx + dy * dy);
+  const double cx = median(xs), cy = median(ys);
+  std::vector<double> distances(count);
+  for (size_t k = 0; k < count; ++k) {
+    const double dx = xs[k] - cx, dy = ys[k] - cy;
+    distances[k] = std::sqrt(dx * dx + dy * dy);
   }
   double spread = median(distances);
   if (!(spread > 0.0)) {  // most points at one place: their mean distance, else no scaling
