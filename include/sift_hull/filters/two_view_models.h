@@ -12,6 +12,7 @@ struct PointPairs {
   std::vector<float> left_x, left_y, right_x, right_y;
   size_t size() const { return left_x.size(); }
   void push(float lx, float ly, float rx, float ry);
+  void reserve(size_t n);
 };
 
 /// One motion between two images, in pixels: a fundamental matrix (x_r^T F x_l = 0) or a

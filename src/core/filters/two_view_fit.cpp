@@ -138,6 +138,28 @@ constexpr size_t kMaxPolishPoints = 4096;
 /// Weighted least squares over the inliers (at most max_points of them, evenly spread): Tukey's
 /// biweight of each one's squared residual r2 under the previous model within `reach2`, for F
 /// times the Sampson weight.
+/// The weights of a refit, in place: w holds each pair's squared residual r2 and becomes Tukey's
+/// biweight (1 - r2 / reach2)^2 (at least 1e-6), for F (`P`, the previous model, row-major)
+/// times the Sampson weight 1 / (|(P l)_xy|^2 + |(P^T r)_xy|^2). Plain loops, so that they
+/// vectorise.
+__attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default"))) void refitWeights(
+    const double* lx, const double* ly, const double* rx, const double* ry, size_t n, double reach2,
+    const double* P, bool sampson, double* w) {
+  for (size_t k = 0; k < n; ++k) {
+    const double tukey = 1.0 - w[k] / reach2;
+    w[k] = std::max(1e-6, tukey * tukey);
+  }
+  if (!sampson) return;
+  for (size_t k = 0; k < n; ++k) {
+    const double a0 = P[0] * lx[k] + P[1] * ly[k] + P[2];
+    const double a1 = P[3] * lx[k] + P[4] * ly[k] + P[5];
+    const double b0 = P[0] * rx[k] + P[3] * ry[k] + P[6];
+    const double b1 = P[1] * rx[k] + P[4] * ry[k] + P[7];
+    const double g = a0 * a0 + a1 * a1 + b0 * b0 + b1 * b1;
+    w[k] *= g > 1e-12 ? 1.0 / g : 1e12;
+  }
+}
+
 bool refit(const Normalised& n, std::vector<int> inliers, const std::vector<float>& r2,
            float reach2, const Eigen::Matrix3d& previous, bool homography, Eigen::Matrix3d* M,
            size_t max_points = kMaxRefitPoints) {
@@ -148,18 +170,17 @@ bool refit(const Normalised& n, std::vector<int> inliers, const std::vector<floa
   }
   const Eigen::Index count = Eigen::Index(inliers.size());
   Eigen::MatrixX2d l(count, 2), r(count, 2);
-  Eigen::VectorXd w = Eigen::VectorXd::Ones(count);
+  Eigen::VectorXd w(count);
+  const double *nlx = n.left.col(0).data(), *nly = n.left.col(1).data();
+  const double *nrx = n.right.col(0).data(), *nry = n.right.col(1).data();
+  double *lx = l.col(0).data(), *ly = l.col(1).data(), *rx = r.col(0).data(), *ry = r.col(1).data();
   for (Eigen::Index k = 0; k < count; ++k) {
-    const int i = inliers[size_t(k)];
-    l.row(k) = n.left.row(i), r.row(k) = n.right.row(i);
-    const double tukey = 1.0 - double(r2[size_t(i)]) / reach2;
-    w(k) = std::max(1e-6, tukey * tukey);
-    if (homography) continue;
-    const Eigen::Vector3d a = previous * Eigen::Vector3d(l(k, 0), l(k, 1), 1.0);
-    const Eigen::Vector3d b = previous.transpose() * Eigen::Vector3d(r(k, 0), r(k, 1), 1.0);
-    const double g = a.head<2>().squaredNorm() + b.head<2>().squaredNorm();
-    w(k) *= g > 1e-12 ? 1.0 / g : 1e12;
+    const size_t i = size_t(inliers[size_t(k)]);
+    lx[k] = nlx[i], ly[k] = nly[i], rx[k] = nrx[i], ry[k] = nry[i];
+    w(k) = double(r2[i]);
   }
+  const Eigen::Matrix<double, 3, 3, Eigen::RowMajor> P = previous;
+  refitWeights(lx, ly, rx, ry, size_t(count), double(reach2), P.data(), !homography, w.data());
   w /= w.maxCoeff();
   return homography ? leastSquaresHomography(l, r, w, M, &previous)
                     : leastSquaresFundamental(l, r, w, M, &previous);

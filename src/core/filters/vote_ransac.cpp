@@ -60,6 +60,7 @@ FitSet fitSetOf(const PutativeMatches& input, size_t max_points, unsigned seed) 
     std::sort(chosen.begin(), chosen.end());
   }
   FitSet set;
+  set.pairs.reserve(chosen.size());
   for (size_t m : chosen) {
     const cv::KeyPoint &l = input.left(m), &r = input.right(m);
     set.pairs.push(l.pt.x, l.pt.y, r.pt.x, r.pt.y);
@@ -88,7 +89,8 @@ uint32_t orderedBits(float value) {
 }
 
 /// (value, index) of the candidates sorted by value, ties in the candidates' order: a stable
-/// radix sort in three passes of 11 bits (candidates are at most a few thousand).
+/// radix sort in four passes of 8 bits (candidates are at most a few thousand, so that larger
+/// digits would spend more on their counts than on the keys).
 std::vector<std::pair<float, int>> sortedByValue(const std::vector<float>& values,
                                                  const std::vector<int>& candidates) {
   const size_t n = candidates.size();
@@ -96,11 +98,11 @@ std::vector<std::pair<float, int>> sortedByValue(const std::vector<float>& value
   for (size_t k = 0; k < n; ++k) {
     keys[k] = uint64_t(orderedBits(values[size_t(candidates[k])])) << 32 | uint32_t(k);
   }
-  for (int shift = 32; shift < 64; shift += 11) {
-    size_t count[2049] = {};
-    for (uint64_t key : keys) ++count[((key >> shift) & 2047u) + 1];
-    for (size_t d = 1; d < 2049; ++d) count[d] += count[d - 1];
-    for (uint64_t key : keys) scratch[count[(key >> shift) & 2047u]++] = key;
+  for (int shift = 32; shift < 64; shift += 8) {
+    size_t count[257] = {};
+    for (uint64_t key : keys) ++count[((key >> shift) & 255u) + 1];
+    for (size_t d = 1; d < 257; ++d) count[d] += count[d - 1];
+    for (uint64_t key : keys) scratch[count[(key >> shift) & 255u]++] = key;
     keys.swap(scratch);
   }
   std::vector<std::pair<float, int>> sorted(n);
@@ -304,6 +306,7 @@ std::vector<TwoViewModel> fitMotions(FitSet set, const VoteRansacFilterConfig& c
 /// The matches with finite positions, as pairs, with their indices into input.matches.
 PointPairs finitePairs(const PutativeMatches& input, std::vector<size_t>* index) {
   PointPairs all;
+  all.reserve(input.matches.size());
   for (size_t m = 0; m < input.matches.size(); ++m) {
     if (!input.hasFinitePositions(m)) continue;
     const cv::Point2f &a = input.left(m).pt, &b = input.right(m).pt;
@@ -362,8 +365,9 @@ TwoViewModel polished(const PointPairs& all, const TwoViewModel& motion, double 
   for (size_t i = 0; i < r2.size(); ++i) {
     if (r2[i] <= reach2) near.push_back(static_cast<int>(i));
   }
-  PointPairs chosen;
   const size_t count = std::min(near.size(), kMaxPolishPoints);
+  PointPairs chosen;
+  chosen.reserve(count);
   for (size_t k = 0; k < count; ++k) {
     const size_t i = size_t(near[k * near.size() / count]);
     chosen.push(all.left_x[i], all.left_y[i], all.right_x[i], all.right_y[i]);
