@@ -90,10 +90,10 @@ struct TwoViewFit {
 TwoViewFit fitTwoViewModel(const PointPairs& pairs, const std::vector<int>& sample_from,
                            const TwoViewFitSettings& settings, std::mt19937* random);
 
-/// A finished model refined against `pairs` (all the putatives, where the fit saw a sample of
-/// them): Tukey-reweighted least squares over the pairs within twice max_residual_px (at most
-/// 4096, evenly spread), while the truncated quadratic over all pairs improves. The model itself
-/// when nothing improves it.
+/// A finished model refined against `pairs` (e.g. the putatives near it, where the fit saw a
+/// sample of them): Tukey-reweighted least squares over those within twice max_residual_px (at
+/// most 4096, evenly spread), while the truncated quadratic over `pairs` improves. The model
+/// itself when nothing improves it (also for NaN models and fewer than 8 pairs for F, 4 for H).
 TwoViewModel polishTwoViewModel(const PointPairs& pairs, const TwoViewModel& model,
                                 double max_residual_px);
 

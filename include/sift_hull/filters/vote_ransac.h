@@ -31,9 +31,11 @@ namespace sift_hull {
 ///    needs (8 samples at confidence 0.99), must explain two thirds of its vote, and must not lie
 ///    mostly within twice the threshold of an earlier motion (that one's leftovers).
 /// 5. When the fit set was a sample, each motion is refined against all the putatives: the
-///    ones within three times its threshold (at most 512, evenly spread) go to
-///    polishTwoViewModel, so that a motion fitted to a few hundred matches does not lose the
-///    others at its edges, at a cost of one residual per putative beyond that.
+///    ones within three times its threshold that no earlier motion explains (at most 512,
+///    evenly spread) go to polishTwoViewModel, so that a motion fitted to a few hundred matches
+///    does not lose the others at its edges, at a cost of a few residuals per putative. With
+///    more than 512 near, its score is that of the sample, so a few matches at the threshold's
+///    edge may change sides, as in the fit itself.
 /// 6. Every putative is judged: kept when a motion explains it (symmetric epipolar distance <=
 ///    magsac_max_epipolar_px, transfer error <= guided_max_transfer_px both ways).
 /// Score: the smallest residual over the motions, px (NaN when none was found: none kept).

@@ -135,9 +135,6 @@ std::vector<Eigen::Matrix3d> solveMinimal(const Normalised& n, const int* sample
 constexpr size_t kMaxRefitPoints = 256;
 constexpr size_t kMaxPolishPoints = 4096;
 
-/// Weighted least squares over the inliers (at most max_points of them, evenly spread): Tukey's
-/// biweight of each one's squared residual r2 under the previous model within `reach2`, for F
-/// times the Sampson weight.
 /// The weights of a refit, in place: w holds each pair's squared residual r2 and becomes Tukey's
 /// biweight (1 - r2 / reach2)^2 (at least 1e-6), for F (`P`, the previous model, row-major)
 /// times the Sampson weight 1 / (|(P l)_xy|^2 + |(P^T r)_xy|^2). Plain loops, so that they
@@ -160,6 +157,9 @@ __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default"))) vo
   }
 }
 
+/// Weighted least squares over the inliers (at most max_points of them, evenly spread): Tukey's
+/// biweight of each one's squared residual r2 under the previous model within `reach2`, for F
+/// times the Sampson weight.
 bool refit(const Normalised& n, std::vector<int> inliers, const std::vector<float>& r2,
            float reach2, const Eigen::Matrix3d& previous, bool homography, Eigen::Matrix3d* M,
            size_t max_points = kMaxRefitPoints) {
@@ -305,11 +305,15 @@ int searchHypotheses(const Search& s, std::mt19937* random, Best* best) {
   return iterations;
 }
 
-/// A model in pixels, in the normalised coordinates of `n` (the inverse of inPixels).
+/// A model in pixels, in the normalised coordinates of `n` (the inverse of inPixels, unit norm).
 Eigen::Matrix3d inNormalised(const TwoViewModel& model, const Normalised& n) {
-  return model.homography
-             ? Eigen::Matrix3d(n.T_right * model.matrix * n.T_left.inverse())
-             : Eigen::Matrix3d(n.T_right.inverse().transpose() * model.matrix * n.T_left.inverse());
+  Eigen::Matrix3d M =
+      model.homography
+          ? Eigen::Matrix3d(n.T_right * model.matrix * n.T_left.inverse())
+          : Eigen::Matrix3d(n.T_right.inverse().transpose() * model.matrix * n.T_left.inverse());
+  const double norm = M.norm();
+  if (norm > 0.0 && std::isfinite(norm)) M /= norm;
+  return M;
 }
 
 }  // namespace

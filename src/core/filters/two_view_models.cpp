@@ -113,10 +113,11 @@ __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default"))) vo
 /// The sum of w a a^T over at most `rows` weighted rows a, kept by column until it is solved.
 class NormalEquations {
  public:
-  /// Columns of `rows` entries, padded so that they are not a multiple of 4 KiB apart (stores
-  /// to nine columns at such a distance alias in the cache and take several times as long).
+  /// Columns of `rows` entries, 8 doubles more than a multiple of 64 apart, so that no two of
+  /// the nine are a multiple of 4 KiB apart (stores to columns at such distances alias in the
+  /// cache and take several times as long).
   explicit NormalEquations(size_t rows)
-      : rows_(rows), stride_((rows + 7) / 8 * 8 + 8), a_(9 * stride_), w_(rows) {}
+      : rows_(rows), stride_((rows + 63) / 64 * 64 + 8), a_(9 * stride_), w_(rows) {}
   /// All rows of x_r^T F x_l = 0 at once, column by column (so that it vectorises): n
   /// correspondences (n x 2 arrays, column-major) and their weights.
   void setEpipolarRows(const Eigen::MatrixX2d& left, const Eigen::MatrixX2d& right,

@@ -357,13 +357,17 @@ namespace {
 constexpr double kPolishReach = 3.0;
 constexpr size_t kMaxPolishPoints = 512;
 
-TwoViewModel polished(const PointPairs& all, const TwoViewModel& motion, double threshold_px) {
+/// The motion refined against the matches within kPolishReach times its threshold that `taken`
+/// does not mark (those an earlier motion explains, so that a further motion is not drawn onto
+/// an earlier one's matches).
+TwoViewModel polished(const PointPairs& all, const std::vector<uint8_t>& taken,
+                      const TwoViewModel& motion, double threshold_px) {
   std::vector<float> r2;
   squaredResiduals(motion, all, &r2);
   const float reach2 = static_cast<float>(std::pow(kPolishReach * threshold_px, 2));
   std::vector<int> near;
   for (size_t i = 0; i < r2.size(); ++i) {
-    if (r2[i] <= reach2) near.push_back(static_cast<int>(i));
+    if (r2[i] <= reach2 && !taken[i]) near.push_back(static_cast<int>(i));
   }
   const size_t count = std::min(near.size(), kMaxPolishPoints);
   PointPairs chosen;
@@ -376,7 +380,8 @@ TwoViewModel polished(const PointPairs& all, const TwoViewModel& motion, double 
 }
 
 /// The motions of the matches `all` (the finite ones of `input`): fitted to at most
-/// vote_ransac_max_fit_points of them, then, when that was a sample, each refined against all.
+/// vote_ransac_max_fit_points of them, then, when that was a sample, each refined against the
+/// matches near it that the motions before it do not explain.
 std::vector<TwoViewModel> motionsOf(const PutativeMatches& input, const PointPairs& all,
                                     const VoteRansacFilterConfig& config) {
   validate(config.vote_ransac);
@@ -386,8 +391,15 @@ std::vector<TwoViewModel> motionsOf(const PutativeMatches& input, const PointPai
   std::vector<TwoViewModel> motions =
       fitMotions(fitSetOf(input, max_points, static_cast<unsigned>(config.magsac.seed)), config);
   if (all.size() > max_points) {
-    for (TwoViewModel& motion : motions) {
-      motion = polished(all, motion, thresholdOf(motion, config));
+    std::vector<uint8_t> taken(all.size(), 0);
+    std::vector<float> r2;
+    for (size_t k = 0; k < motions.size(); ++k) {
+      const double threshold = thresholdOf(motions[k], config);
+      motions[k] = polished(all, taken, motions[k], threshold);
+      if (k + 1 == motions.size()) break;
+      squaredResiduals(motions[k], all, &r2);
+      const float t2 = static_cast<float>(threshold * threshold);
+      for (size_t i = 0; i < r2.size(); ++i) taken[i] |= r2[i] <= t2;
     }
   }
   return motions;
