@@ -20,6 +20,7 @@ set(SIFT_HULL_CORE_GTESTS
   test_feature_cache core
   test_filters eval
   test_local_filters eval
+  test_two_view_models eval
   test_vote_ransac eval
   test_evaluation eval
   test_evaluation_commands eval
