@@ -15,17 +15,21 @@ struct Normalised {
   Eigen::Matrix3d T_left, T_right;
 };
 
+/// x' = s x + t for a list, in a plain loop (so that it vectorises).
+void affineCopy(const std::vector<float>& x, double s, double t, double* out) {
+  for (size_t i = 0; i < x.size(); ++i) out[i] = s * double(x[i]) + t;
+}
+
 Normalised normalise(const PointPairs& pairs) {
   Normalised n;
   n.T_left = hartleyNormalisation(pairs.left_x, pairs.left_y);
   n.T_right = hartleyNormalisation(pairs.right_x, pairs.right_y);
   n.left.resize(Eigen::Index(pairs.size()), 2), n.right.resize(Eigen::Index(pairs.size()), 2);
-  for (size_t i = 0; i < pairs.size(); ++i) {
-    const Eigen::Index r = Eigen::Index(i);
-    n.left.row(r) = (n.T_left * Eigen::Vector3d(pairs.left_x[i], pairs.left_y[i], 1.0)).head<2>();
-    n.right.row(r) =
-        (n.T_right * Eigen::Vector3d(pairs.right_x[i], pairs.right_y[i], 1.0)).head<2>();
-  }
+  // T = [s 0 tx; 0 s ty; 0 0 1] (hartleyNormalisation's form)
+  affineCopy(pairs.left_x, n.T_left(0, 0), n.T_left(0, 2), n.left.col(0).data());
+  affineCopy(pairs.left_y, n.T_left(1, 1), n.T_left(1, 2), n.left.col(1).data());
+  affineCopy(pairs.right_x, n.T_right(0, 0), n.T_right(0, 2), n.right.col(0).data());
+  affineCopy(pairs.right_y, n.T_right(1, 1), n.T_right(1, 2), n.right.col(1).data());
   return n;
 }
 
@@ -188,6 +192,7 @@ bool refit(const Normalised& n, std::vector<int> inliers, const std::vector<floa
 
 std::vector<int> inliersOf(const std::vector<float>& r2, float t2) {
   std::vector<int> inliers;
+  inliers.reserve(r2.size());
   for (size_t i = 0; i < r2.size(); ++i) {
     if (r2[i] <= t2) inliers.push_back(static_cast<int>(i));
   }
@@ -209,16 +214,19 @@ constexpr float kReach = 4.0f;
 /// kMaxRefits refits.
 constexpr double kConverged = 1e-3;
 constexpr int kMaxRefits = 8;
+/// A new best during the search gets this many refits: enough to set the count from its
+/// refined support; the reweighting to convergence follows once, for the best of all.
+constexpr int kRefitsPerNewBest = 1;
 
 /// Iteratively reweighted least squares from the best model while the score improves.
 void reweight(const PointPairs& pairs, const Normalised& n, const TwoViewFitSettings& s,
               const std::vector<uint8_t>& counted, float reach2, Best* best,
-              size_t max_points = kMaxRefitPoints) {
+              size_t max_points = kMaxRefitPoints, int max_refits = kMaxRefits) {
   const float t2 = static_cast<float>(s.max_residual_px * s.max_residual_px);
   const size_t minimum = s.homography ? 4 : 8;
   std::vector<float> r2, candidate_r2;
   squaredResiduals(best->model, pairs, &r2);
-  for (int round = 0; round < kMaxRefits; ++round) {
+  for (int round = 0; round < max_refits; ++round) {
     const std::vector<int> inliers = inliersOf(r2, reach2);
     Eigen::Matrix3d M;
     if (inliers.size() < minimum ||
@@ -239,7 +247,8 @@ void reweight(const PointPairs& pairs, const Normalised& n, const TwoViewFitSett
 /// The inner RANSAC of LO-RANSAC: least squares over kInnerSamples random subsets of
 /// kInnerSampleFactor m of the best model's inliers (within reach), which lets a model that is
 /// its own least-squares fixed point (an epipole among the points explains some of them) give
-/// way to the motion; the best of them, then the reweighting.
+/// way to the motion; the best of them, then the reweighting. For F only: a homography has no
+/// epipole, and its search mostly decides whether a plane explains what F does.
 constexpr int kInnerSamples = 5;
 constexpr size_t kInnerSampleFactor = 4;
 
@@ -251,7 +260,8 @@ void optimiseLocally(const PointPairs& pairs, const Normalised& n, const TwoView
   squaredResiduals(best->model, pairs, &r2);
   std::vector<int> inliers = inliersOf(r2, reach2);
   const Best start = *best;
-  for (int k = 0; k < kInnerSamples && inliers.size() > size; ++k) {
+  const int samples = s.homography ? 0 : kInnerSamples;
+  for (int k = 0; k < samples && inliers.size() > size; ++k) {
     std::shuffle(inliers.begin(), inliers.end(), *random);
     const std::vector<int> subset(inliers.begin(), inliers.begin() + size);
     Eigen::Matrix3d M;
@@ -295,7 +305,8 @@ int searchHypotheses(const Search& s, std::mt19937* random, Best* best) {
       // LO-RANSAC: every new best is reweighted at once, and the refined support sets the
       // count; the inner samples follow once, for the best of all.
       if (best->score.inliers_counted >= settings.min_inliers_to_refine) {
-        reweight(s.pairs, s.n, settings, s.counted, kReach * t2, best);
+        reweight(s.pairs, s.n, settings, s.counted, kReach * t2, best, kMaxRefitPoints,
+                 kRefitsPerNewBest);
       }
       needed = std::max(iterations + 1,
                         ransacIterations(double(best->score.inliers_counted) / double(pool), m,

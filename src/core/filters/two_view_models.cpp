@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <vector>
 
 namespace sift_hull {
@@ -117,7 +118,10 @@ class NormalEquations {
   /// the nine are a multiple of 4 KiB apart (stores to columns at such distances alias in the
   /// cache and take several times as long).
   explicit NormalEquations(size_t rows)
-      : rows_(rows), stride_((rows + 63) / 64 * 64 + 8), a_(9 * stride_), w_(rows) {}
+      : rows_(rows),
+        stride_((rows + 63) / 64 * 64 + 8),
+        a_(new double[9 * stride_]),  // left uninitialised: only the rows set are read
+        w_(new double[rows]) {}
   /// All rows of x_r^T F x_l = 0 at once, column by column (so that it vectorises): n
   /// correspondences (n x 2 arrays, column-major) and their weights.
   void setEpipolarRows(const Eigen::MatrixX2d& left, const Eigen::MatrixX2d& right,
@@ -126,7 +130,7 @@ class NormalEquations {
     const double *lx = left.col(0).data(), *ly = left.col(1).data();
     const double *rx = right.col(0).data(), *ry = right.col(1).data();
     double* c[9];
-    for (int k = 0; k < 9; ++k) c[k] = a_.data() + size_t(k) * stride_;
+    for (int k = 0; k < 9; ++k) c[k] = a_.get() + size_t(k) * stride_;
     for (size_t i = 0; i < used_; ++i) {
       c[0][i] = rx[i] * lx[i], c[1][i] = rx[i] * ly[i], c[2][i] = rx[i];
       c[3][i] = ry[i] * lx[i], c[4][i] = ry[i] * ly[i], c[5][i] = ry[i];
@@ -142,7 +146,7 @@ class NormalEquations {
     const double *lx = left.col(0).data(), *ly = left.col(1).data();
     const double *rx = right.col(0).data(), *ry = right.col(1).data();
     double* c[9];
-    for (int k = 0; k < 9; ++k) c[k] = a_.data() + size_t(k) * stride_;
+    for (int k = 0; k < 9; ++k) c[k] = a_.get() + size_t(k) * stride_;
     for (size_t i = 0; i < n; ++i) {
       const size_t j = n + i;
       c[0][i] = -lx[i], c[1][i] = -ly[i], c[2][i] = -1.0, c[3][i] = c[4][i] = c[5][i] = 0.0;
@@ -157,7 +161,7 @@ class NormalEquations {
   /// eigendecomposition, else (or when that fails) by the eigensolver.
   Vector9d smallestEigenvector(const Eigen::Matrix3d* start = nullptr) const {
     double sum[9][9];
-    weightedGram(a_.data(), w_.data(), used_, stride_, sum);
+    weightedGram(a_.get(), w_.get(), used_, stride_, sum);
     Eigen::Matrix<double, 9, 9> normal;
     for (int r = 0; r < 9; ++r) {
       for (int c = 0; c < 9; ++c) normal(r, c) = sum[r][c];
@@ -182,7 +186,7 @@ class NormalEquations {
 
  private:
   size_t rows_, stride_, used_ = 0;
-  std::vector<double> a_, w_;
+  std::unique_ptr<double[]> a_, w_;
 };
 
 Eigen::Matrix3d rankTwo(const Eigen::Matrix3d& F) {
@@ -342,8 +346,9 @@ bool leastSquaresHomography(const Eigen::MatrixX2d& left, const Eigen::MatrixX2d
 Eigen::Matrix3d hartleyNormalisation(const std::vector<float>& x, const std::vector<float>& y) {
   // Medians rather than means, so that one point far away (a hostile 1e30) does not squeeze all
   // the others onto the origin; of at most kMedianSample points evenly spread over the list,
-  // which is as good a normalisation and keeps its cost fixed.
-  constexpr size_t kMedianSample = 255;
+  // which is as good a normalisation (it only conditions the least squares) and keeps its cost
+  // fixed and small: a fit normalises its pairs several times.
+  constexpr size_t kMedianSample = 63;
   const size_t n = std::min(x.size(), y.size()), count = std::min(n, kMedianSample);
   std::vector<double> xs(count), ys(count);
   for (size_t k = 0; k < count; ++k) {

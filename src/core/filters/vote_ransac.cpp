@@ -48,16 +48,24 @@ float log2ScaleOf(const cv::KeyPoint& l, const cv::KeyPoint& r) {
   return std::isfinite(s) ? static_cast<float>(s) : NAN;
 }
 
-FitSet fitSetOf(const PutativeMatches& input, size_t max_points, unsigned seed) {
-  std::vector<size_t> chosen;
-  for (size_t m = 0; m < input.matches.size(); ++m) {
-    if (input.hasFinitePositions(m)) chosen.push_back(m);
-  }
-  if (chosen.size() > max_points) {
+/// `finite`: the matches with finite positions, in order.
+FitSet fitSetOf(const PutativeMatches& input, const std::vector<size_t>& finite, size_t max_points,
+                unsigned seed) {
+  std::vector<size_t> chosen = finite;
+  if (chosen.size() > max_points) {  // a uniform sample, kept in the matches' order
     std::mt19937 random(seed);
-    std::shuffle(chosen.begin(), chosen.end(), random);
-    chosen.resize(max_points);
-    std::sort(chosen.begin(), chosen.end());
+    std::vector<size_t> order(finite.size());
+    std::iota(order.begin(), order.end(), size_t(0));
+    std::vector<uint8_t> taken(finite.size(), 0);
+    for (size_t k = 0; k < max_points; ++k) {  // the first max_points steps of a shuffle
+      std::uniform_int_distribution<size_t> pick(k, order.size() - 1);
+      std::swap(order[k], order[pick(random)]);
+      taken[order[k]] = 1;
+    }
+    chosen.clear();
+    for (size_t p = 0; p < finite.size(); ++p) {
+      if (taken[p]) chosen.push_back(finite[p]);
+    }
   }
   FitSet set;
   set.pairs.reserve(chosen.size());
@@ -127,6 +135,7 @@ std::vector<int> densestWindow(const std::vector<float>& values, const std::vect
   const std::vector<std::pair<float, int>> sorted = sortedByValue(values, candidates);
   const size_t n = sorted.size();
   std::vector<double> extended;  // circular: the values once below and once above the circle
+  extended.reserve(period > 0.0 ? 3 * n : n);
   if (period > 0.0) {
     for (const auto& each : sorted) extended.push_back(each.first - period);
   }
@@ -307,6 +316,7 @@ std::vector<TwoViewModel> fitMotions(FitSet set, const VoteRansacFilterConfig& c
 PointPairs finitePairs(const PutativeMatches& input, std::vector<size_t>* index) {
   PointPairs all;
   all.reserve(input.matches.size());
+  index->reserve(input.matches.size());
   for (size_t m = 0; m < input.matches.size(); ++m) {
     if (!input.hasFinitePositions(m)) continue;
     const cv::Point2f &a = input.left(m).pt, &b = input.right(m).pt;
@@ -383,13 +393,14 @@ TwoViewModel polished(const PointPairs& all, const std::vector<uint8_t>& taken,
 /// vote_ransac_max_fit_points of them, then, when that was a sample, each refined against the
 /// matches near it that the motions before it do not explain.
 std::vector<TwoViewModel> motionsOf(const PutativeMatches& input, const PointPairs& all,
+                                    const std::vector<size_t>& index,
                                     const VoteRansacFilterConfig& config) {
   validate(config.vote_ransac);
   validate(config.guided);
   validate(config.magsac, "magsac");
   const size_t max_points = size_t(config.vote_ransac.vote_ransac_max_fit_points);
-  std::vector<TwoViewModel> motions =
-      fitMotions(fitSetOf(input, max_points, static_cast<unsigned>(config.magsac.seed)), config);
+  std::vector<TwoViewModel> motions = fitMotions(
+      fitSetOf(input, index, max_points, static_cast<unsigned>(config.magsac.seed)), config);
   if (all.size() > max_points) {
     std::vector<uint8_t> taken(all.size(), 0);
     std::vector<float> r2;
@@ -410,14 +421,15 @@ std::vector<TwoViewModel> motionsOf(const PutativeMatches& input, const PointPai
 std::vector<TwoViewModel> voteRansacMotions(const PutativeMatches& input,
                                             const VoteRansacFilterConfig& config) {
   std::vector<size_t> index;
-  return motionsOf(input, finitePairs(input, &index), config);
+  const PointPairs all = finitePairs(input, &index);
+  return motionsOf(input, all, index, config);
 }
 
 FilterResult filterVoteRansac(const PutativeMatches& input, const VoteRansacFilterConfig& config) {
   FilterResult result = FilterResult::keepingNone(input.matches.size());
   std::vector<size_t> index;
   const PointPairs all = finitePairs(input, &index);
-  const std::vector<TwoViewModel> motions = motionsOf(input, all, config);
+  const std::vector<TwoViewModel> motions = motionsOf(input, all, index, config);
   if (!motions.empty()) judge(all, index, motions, config, &result);
   return result;
 }
