@@ -11,6 +11,7 @@ namespace sift_hull {
 namespace {
 
 using Vector9d = Eigen::Matrix<double, 9, 1>;
+using Matrix9d = Eigen::Matrix<double, 9, 9>;
 
 Eigen::Matrix3d fromRowMajor(const Vector9d& f) {
   Eigen::Matrix3d M;
@@ -111,7 +112,7 @@ __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default"))) vo
   }
 }
 
-/// The sum of w a a^T over at most `rows` weighted rows a, kept by column until it is solved.
+/// The sum of w a a^T over at most `rows` weighted rows a, kept by column until it is summed.
 class NormalEquations {
  public:
   /// Columns of `rows` entries, 8 doubles more than a multiple of 64 apart, so that no two of
@@ -122,8 +123,9 @@ class NormalEquations {
         stride_((rows + 63) / 64 * 64 + 8),
         a_(new double[9 * stride_]),  // left uninitialised: only the rows set are read
         w_(new double[rows]) {}
-  /// All rows of x_r^T F x_l = 0 at once, column by column (so that it vectorises): n
-  /// correspondences (n x 2 arrays, column-major) and their weights.
+  /// All rows of x_r^T F x_l = 0 at once (also the columns homographyNormal combines), column
+  /// by column (so that it vectorises): n correspondences (n x 2 arrays, column-major) and
+  /// their weights.
   void setEpipolarRows(const Eigen::MatrixX2d& left, const Eigen::MatrixX2d& right,
                        const Eigen::VectorXd& weights) {
     used_ = std::min(rows_, size_t(left.rows()));
@@ -138,56 +140,59 @@ class NormalEquations {
       w_[i] = weights(Eigen::Index(i));
     }
   }
-  /// The same for the two DLT rows of r ~ H l per correspondence (rows i and n + i).
-  void setHomographyRows(const Eigen::MatrixX2d& left, const Eigen::MatrixX2d& right,
-                         const Eigen::VectorXd& weights) {
-    const size_t n = std::min(rows_ / 2, size_t(left.rows()));
-    used_ = 2 * n;
-    const double *lx = left.col(0).data(), *ly = left.col(1).data();
-    const double *rx = right.col(0).data(), *ry = right.col(1).data();
-    double* c[9];
-    for (int k = 0; k < 9; ++k) c[k] = a_.get() + size_t(k) * stride_;
-    for (size_t i = 0; i < n; ++i) {
-      const size_t j = n + i;
-      c[0][i] = -lx[i], c[1][i] = -ly[i], c[2][i] = -1.0, c[3][i] = c[4][i] = c[5][i] = 0.0;
-      c[6][i] = rx[i] * lx[i], c[7][i] = rx[i] * ly[i], c[8][i] = rx[i];
-      c[0][j] = c[1][j] = c[2][j] = 0.0, c[3][j] = -lx[i], c[4][j] = -ly[i], c[5][j] = -1.0;
-      c[6][j] = ry[i] * lx[i], c[7][j] = ry[i] * ly[i], c[8][j] = ry[i];
-      w_[i] = w_[j] = weights(Eigen::Index(i));
-    }
-  }
-  /// The eigenvector of the smallest eigenvalue: by inverse iteration from `start` (a model
-  /// near the answer, row-major) when given, which is a few 9x9 solves instead of a full
-  /// eigendecomposition, else (or when that fails) by the eigensolver.
-  Vector9d smallestEigenvector(const Eigen::Matrix3d* start = nullptr) const {
+  /// sum_i w_i a_i a_i^T over the rows set.
+  Matrix9d gram() const {
     double sum[9][9];
     weightedGram(a_.get(), w_.get(), used_, stride_, sum);
-    Eigen::Matrix<double, 9, 9> normal;
+    Matrix9d normal;
     for (int r = 0; r < 9; ++r) {
       for (int c = 0; c < 9; ++c) normal(r, c) = sum[r][c];
     }
-    if (start != nullptr) {
-      const Eigen::LDLT<Eigen::Matrix<double, 9, 9>> ldlt(normal);
-      const Eigen::VectorXd pivots = ldlt.vectorD().cwiseAbs();
-      // A zero pivot (exactly consistent points) is solved as zero: the eigensolver then.
-      const bool usable = pivots.minCoeff() > 1e-15 * pivots.maxCoeff();
-      Vector9d x;
-      for (int k = 0; k < 9; ++k) x(k) = (*start)(k / 3, k % 3);
-      for (int step = 0; usable && step < kInverseIterations && ldlt.info() == Eigen::Success;
-           ++step) {
-        x = ldlt.solve(x);
-        x /= x.norm();
-      }
-      if (usable && ldlt.info() == Eigen::Success && x.allFinite()) return x;
-    }
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 9, 9>> solver(normal);
-    return solver.eigenvectors().col(0);
+    return normal;
   }
 
  private:
   size_t rows_, stride_, used_ = 0;
   std::unique_ptr<double[]> a_, w_;
 };
+
+/// The eigenvector of the smallest eigenvalue of a normal matrix: by inverse iteration from
+/// `start` (a model near the answer, row-major) when given, which is a few 9x9 solves instead of
+/// a full eigendecomposition, else (or when that fails) by the eigensolver.
+Vector9d smallestEigenvector(const Matrix9d& normal, const Eigen::Matrix3d* start) {
+  if (start != nullptr) {
+    const Eigen::LDLT<Matrix9d> ldlt(normal);
+    const Eigen::VectorXd pivots = ldlt.vectorD().cwiseAbs();
+    // A zero pivot (exactly consistent points) is solved as zero: the eigensolver then.
+    const bool usable = pivots.minCoeff() > 1e-15 * pivots.maxCoeff();
+    Vector9d x;
+    for (int k = 0; k < 9; ++k) x(k) = (*start)(k / 3, k % 3);
+    for (int step = 0; usable && step < kInverseIterations && ldlt.info() == Eigen::Success;
+         ++step) {
+      x = ldlt.solve(x);
+      x /= x.norm();
+    }
+    if (usable && ldlt.info() == Eigen::Success && x.allFinite()) return x;
+  }
+  Eigen::SelfAdjointEigenSolver<Matrix9d> solver(normal);
+  return solver.eigenvectors().col(0);
+}
+
+/// The normal matrix of the two DLT rows of r ~ H l per correspondence, a = [-l, 0, u l] and
+/// b = [0, -l, v l] (l = (x, y, 1), r = (u, v)), from the Gram matrix G of the epipolar rows'
+/// columns [u l, v l, l] (one row per correspondence instead of two): sum w (a a^T + b b^T) has
+/// the blocks G_ll, G_ll on the diagonal, -G_l(ul), -G_l(vl) beside and G_(ul)(ul) + G_(vl)(vl)
+/// last.
+Matrix9d homographyNormal(const Matrix9d& G) {
+  Matrix9d N = Matrix9d::Zero();
+  const auto ll = G.block<3, 3>(6, 6);
+  N.block<3, 3>(0, 0) = ll, N.block<3, 3>(3, 3) = ll;
+  N.block<3, 3>(0, 6) = -G.block<3, 3>(6, 0), N.block<3, 3>(3, 6) = -G.block<3, 3>(6, 3);
+  N.block<3, 3>(6, 0) = N.block<3, 3>(0, 6).transpose();
+  N.block<3, 3>(6, 3) = N.block<3, 3>(3, 6).transpose();
+  N.block<3, 3>(6, 6) = G.block<3, 3>(0, 0) + G.block<3, 3>(3, 3);
+  return N;
+}
 
 Eigen::Matrix3d rankTwo(const Eigen::Matrix3d& F) {
   Eigen::JacobiSVD<Eigen::Matrix3d> svd(F, Eigen::ComputeFullU | Eigen::ComputeFullV);
@@ -329,7 +334,7 @@ bool leastSquaresFundamental(const Eigen::MatrixX2d& left, const Eigen::MatrixX2
   if (left.rows() < 8 || right.rows() != left.rows() || weights.size() != left.rows()) return false;
   NormalEquations normal(size_t(left.rows()));
   normal.setEpipolarRows(left, right, weights);
-  *F = rankTwo(fromRowMajor(normal.smallestEigenvector(start)));
+  *F = rankTwo(fromRowMajor(smallestEigenvector(normal.gram(), start)));
   return finiteMatrix(*F);
 }
 
@@ -337,9 +342,9 @@ bool leastSquaresHomography(const Eigen::MatrixX2d& left, const Eigen::MatrixX2d
                             const Eigen::VectorXd& weights, Eigen::Matrix3d* H,
                             const Eigen::Matrix3d* start) {
   if (left.rows() < 4 || right.rows() != left.rows() || weights.size() != left.rows()) return false;
-  NormalEquations normal(2 * size_t(left.rows()));
-  normal.setHomographyRows(left, right, weights);
-  *H = fromRowMajor(normal.smallestEigenvector(start));
+  NormalEquations normal(size_t(left.rows()));
+  normal.setEpipolarRows(left, right, weights);
+  *H = fromRowMajor(smallestEigenvector(homographyNormal(normal.gram()), start));
   return finiteMatrix(*H) && std::abs(H->determinant()) > 1e-12 * std::pow(H->norm(), 3);
 }
 
