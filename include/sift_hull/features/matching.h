@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cmath>
 #include <limits>
 #include <opencv2/core.hpp>
 #include <optional>
@@ -45,7 +46,10 @@ struct PutativeMatches {
   const cv::KeyPoint& left(size_t match) const { return left_keypoints[matches[match].queryIdx]; }
   const cv::KeyPoint& right(size_t match) const { return right_keypoints[matches[match].trainIdx]; }
   /// False when either point of the match has a NaN or infinite coordinate.
-  bool hasFinitePositions(size_t match) const;
+  bool hasFinitePositions(size_t match) const {
+    const cv::Point2f &a = left(match).pt, &b = right(match).pt;
+    return std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(b.x) && std::isfinite(b.y);
+  }
 };
 
 /// Nearest neighbours of each left descriptor among the right ones, filtered as `config` says.

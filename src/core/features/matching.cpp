@@ -194,12 +194,6 @@ PutativeMatches matchImages(const cv::Mat& left_image, const cv::Mat& right_imag
   return result;
 }
 
-bool PutativeMatches::hasFinitePositions(size_t match) const {
-  const cv::Point2f& a = left(match).pt;
-  const cv::Point2f& b = right(match).pt;
-  return std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(b.x) && std::isfinite(b.y);
-}
-
 Eigen::Matrix3d rectifiedFundamentalMatrix() {
   Eigen::Matrix3d F;
   F << 0, 0, 0, 0, 0, -1, 0, 1, 0;
