@@ -29,6 +29,9 @@ double modelResidual(const TwoViewModel& model, double lx, double ly, double rx,
 
 /// Squared residuals of every pair (float, as modelResidual squared), into `out`.
 void squaredResiduals(const TwoViewModel& model, const PointPairs& pairs, std::vector<float>* out);
+/// The same for the pairs [begin, end) only, written to out[begin, end).
+void squaredResiduals(const TwoViewModel& model, const PointPairs& pairs, size_t begin, size_t end,
+                      float* out);
 
 /// Fundamental matrices through 7 correspondences (rows of the 7x2 arrays; best normalised, as
 /// Hartley's), from the cubic det(a F1 + (1 - a) F2) = 0: up to three, none for a degenerate

@@ -77,6 +77,28 @@ Score scoreOf(const std::vector<float>& r2, float t2, const std::vector<uint8_t>
   return score;
 }
 
+/// A hypothesis' score, computed in blocks of kScoreBlock pairs that stop once its cost reaches
+/// `bound` (the truncated squares only add up, so it could no longer score below it): a cost
+/// of infinity then. `r2` holds every pair's squared residual when the cost is below `bound`.
+constexpr size_t kScoreBlock = 128;
+
+Score boundedScore(const TwoViewModel& model, const PointPairs& pairs, float t2,
+                   const std::vector<uint8_t>& counted, double bound, std::vector<float>* r2) {
+  r2->resize(pairs.size());
+  Score score;
+  score.cost = 0.0;
+  for (size_t begin = 0; begin < pairs.size(); begin += kScoreBlock) {
+    const size_t end = std::min(pairs.size(), begin + kScoreBlock);
+    squaredResiduals(model, pairs, begin, end, r2->data());
+    double cost = 0.0;
+    size_t inliers = 0;
+    truncatedScore(r2->data() + begin, counted.data() + begin, end - begin, t2, &cost, &inliers);
+    score.cost += cost, score.inliers_counted += inliers;
+    if (!(score.cost < bound)) return Score{};  // also NaN
+  }
+  return score;
+}
+
 std::vector<uint8_t> countedMask(const std::vector<int>& sample_from, size_t size) {
   std::vector<uint8_t> mask(size, sample_from.empty() ? 1 : 0);
   for (int i : sample_from) mask[size_t(i)] = 1;
@@ -234,8 +256,8 @@ void reweight(const PointPairs& pairs, const Normalised& n, const TwoViewFitSett
       return;
     }
     const TwoViewModel candidate = inPixels(M, n, s.homography);
-    squaredResiduals(candidate, pairs, &candidate_r2);
-    const Score score = scoreOf(candidate_r2, t2, counted);
+    const Score score =
+        boundedScore(candidate, pairs, t2, counted, best->score.cost, &candidate_r2);
     if (!(score.cost < best->score.cost)) return;
     const bool converged = score.cost > (1.0 - kConverged) * best->score.cost;
     *best = Best{M, candidate, score};
@@ -267,8 +289,8 @@ void optimiseLocally(const PointPairs& pairs, const Normalised& n, const TwoView
     Eigen::Matrix3d M;
     if (!refit(n, subset, r2, reach2, start.normalised, s.homography, &M)) continue;
     const TwoViewModel candidate = inPixels(M, n, s.homography);
-    squaredResiduals(candidate, pairs, &candidate_r2);
-    const Score score = scoreOf(candidate_r2, t2, counted);
+    const Score score =
+        boundedScore(candidate, pairs, t2, counted, best->score.cost, &candidate_r2);
     if (score.cost < best->score.cost) *best = Best{M, candidate, score};
   }
   reweight(pairs, n, s, counted, reach2, best);
@@ -298,8 +320,7 @@ int searchHypotheses(const Search& s, std::mt19937* random, Best* best) {
     if (settings.local_samples) nearbySample(s.pairs, s.sample_from, m, random, sample);
     for (const Eigen::Matrix3d& M : solveMinimal(s.n, sample, settings.homography)) {
       const TwoViewModel candidate = inPixels(M, s.n, settings.homography);
-      squaredResiduals(candidate, s.pairs, &r2);
-      const Score score = scoreOf(r2, t2, s.counted);
+      const Score score = boundedScore(candidate, s.pairs, t2, s.counted, best->score.cost, &r2);
       if (!(score.cost < best->score.cost)) continue;
       *best = Best{M, candidate, score};
       // LO-RANSAC: every new best is reweighted at once, and the refined support sets the

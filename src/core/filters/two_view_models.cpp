@@ -32,6 +32,38 @@ void homographyRows(double lx, double ly, double rx, double ry, Vector9d* a, Vec
   *b << 0.0, 0.0, 0.0, -lx, -ly, -1.0, ry * lx, ry * ly, ry;
 }
 
+/// A basis (unit vectors, not orthogonal) of the null space of a Rows x 9 matrix of rank Rows (7 or 8 rows):
+/// Gauss-Jordan elimination with full pivoting to [I | B] (columns permuted), then one unit
+/// vector per free column. False when a pivot falls below 1e-10 of the first (rank below Rows:
+/// collinear or repeated points) or is not finite.
+template <int Rows>
+bool nullSpace(Eigen::Matrix<double, Rows, 9> A, Eigen::Matrix<double, 9, 9 - Rows>* basis) {
+  int column[9];
+  for (int k = 0; k < 9; ++k) column[k] = k;
+  double first = 0.0;
+  for (int k = 0; k < Rows; ++k) {
+    Eigen::Index r = 0, c = 0;
+    const double pivot = A.bottomRightCorner(Rows - k, 9 - k).cwiseAbs().maxCoeff(&r, &c);
+    if (k == 0) first = pivot;
+    if (!(pivot > 1e-10 * first) || !std::isfinite(pivot)) return false;
+    r += k, c += k;
+    A.row(k).swap(A.row(r));
+    A.col(k).swap(A.col(c));
+    std::swap(column[k], column[c]);
+    A.row(k) /= A(k, k);
+    for (int i = 0; i < Rows; ++i) {
+      if (i != k) A.row(i) -= A(i, k) * A.row(k);
+    }
+  }
+  for (int j = 0; j < 9 - Rows; ++j) {
+    Vector9d x = Vector9d::Zero();
+    for (int i = 0; i < Rows; ++i) x(column[i]) = -A(i, Rows + j);
+    x(column[Rows + j]) = 1.0;
+    basis->col(j) = x / x.norm();
+  }
+  return true;
+}
+
 /// Real roots of c3 x^3 + c2 x^2 + c1 x + c0, each polished by two Newton steps.
 std::vector<double> realCubicRootsOf(double c3, double c2, double c1, double c0) {
   std::vector<double> roots;
@@ -273,6 +305,13 @@ double modelResidual(const TwoViewModel& model, double lx, double ly, double rx,
 
 void squaredResiduals(const TwoViewModel& model, const PointPairs& pairs, std::vector<float>* out) {
   out->resize(pairs.size());
+  squaredResiduals(model, pairs, 0, pairs.size(), out->data());
+}
+
+void squaredResiduals(const TwoViewModel& model, const PointPairs& pairs, size_t begin, size_t end,
+                      float* out) {
+  end = std::min(end, pairs.size());
+  if (begin >= end) return;
   float m[9], g[9];
   const Eigen::Matrix3d inverse =
       model.homography ? Eigen::Matrix3d(model.matrix.inverse()) : Eigen::Matrix3d::Zero();
@@ -280,26 +319,24 @@ void squaredResiduals(const TwoViewModel& model, const PointPairs& pairs, std::v
     m[k] = static_cast<float>(model.matrix(k / 3, k % 3));
     g[k] = static_cast<float>(inverse(k / 3, k % 3));
   }
+  const size_t n = end - begin;
+  const float *lx = pairs.left_x.data() + begin, *ly = pairs.left_y.data() + begin;
+  const float *rx = pairs.right_x.data() + begin, *ry = pairs.right_y.data() + begin;
   if (model.homography) {
-    homographyResiduals(m, g, pairs.left_x.data(), pairs.left_y.data(), pairs.right_x.data(),
-                        pairs.right_y.data(), pairs.size(), out->data());
+    homographyResiduals(m, g, lx, ly, rx, ry, n, out + begin);
   } else {
-    fundamentalResiduals(m, pairs.left_x.data(), pairs.left_y.data(), pairs.right_x.data(),
-                         pairs.right_y.data(), pairs.size(), out->data());
+    fundamentalResiduals(m, lx, ly, rx, ry, n, out + begin);
   }
 }
 
 std::vector<Eigen::Matrix3d> sevenPointFundamental(const Eigen::Matrix<double, 7, 2>& left,
                                                    const Eigen::Matrix<double, 7, 2>& right) {
-  Eigen::Matrix<double, 9, 7> At;
+  Eigen::Matrix<double, 7, 9> A;
   for (int i = 0; i < 7; ++i)
-    At.col(i) = epipolarRow(left(i, 0), left(i, 1), right(i, 0), right(i, 1));
-  const Eigen::HouseholderQR<Eigen::Matrix<double, 9, 7>> qr(At);
-  const Eigen::Matrix<double, 9, 7> R = qr.matrixQR().triangularView<Eigen::Upper>();
-  // Rank below 7 (collinear or repeated points: without pivoting, any diagonal entry may vanish).
-  if (R.diagonal().cwiseAbs().minCoeff() <= 1e-10 * R.diagonal().cwiseAbs().maxCoeff()) return {};
-  const Eigen::Matrix<double, 9, 9> Q = qr.householderQ();
-  const Eigen::Matrix3d F1 = fromRowMajor(Q.col(7)), F2 = fromRowMajor(Q.col(8));
+    A.row(i) = epipolarRow(left(i, 0), left(i, 1), right(i, 0), right(i, 1)).transpose();
+  Eigen::Matrix<double, 9, 2> null;
+  if (!nullSpace<7>(A, &null)) return {};  // collinear or repeated points
+  const Eigen::Matrix3d F1 = fromRowMajor(null.col(0)), F2 = fromRowMajor(null.col(1));
   // det(a F1 + (1 - a) F2) = c3 a^3 + c2 a^2 + c1 a + c0, from its values at 0, 1, -1 and 2.
   const double d0 = F2.determinant(), d1 = F1.determinant();
   const double dm = (2.0 * F2 - F1).determinant(), d2 = (2.0 * F1 - F2).determinant();
@@ -316,15 +353,15 @@ std::vector<Eigen::Matrix3d> sevenPointFundamental(const Eigen::Matrix<double, 7
 bool fourPointHomography(const Eigen::Matrix<double, 4, 2>& left,
                          const Eigen::Matrix<double, 4, 2>& right, Eigen::Matrix3d* H) {
   if (anyThreeCollinear(left) || anyThreeCollinear(right)) return false;
-  Eigen::Matrix<double, 9, 8> At;
+  Eigen::Matrix<double, 8, 9> A;
   for (int i = 0; i < 4; ++i) {
     Vector9d a, b;
     homographyRows(left(i, 0), left(i, 1), right(i, 0), right(i, 1), &a, &b);
-    At.col(2 * i) = a, At.col(2 * i + 1) = b;
+    A.row(2 * i) = a.transpose(), A.row(2 * i + 1) = b.transpose();
   }
-  const Eigen::HouseholderQR<Eigen::Matrix<double, 9, 8>> qr(At);
-  const Eigen::Matrix<double, 9, 9> Q = qr.householderQ();
-  *H = fromRowMajor(Q.col(8));
+  Eigen::Matrix<double, 9, 1> null;
+  if (!nullSpace<8>(A, &null)) return false;
+  *H = fromRowMajor(null.col(0));
   return finiteMatrix(*H) && std::abs(H->determinant()) > 1e-12 * std::pow(H->norm(), 3);
 }
 
