@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <utility>
 
 #include "sift_hull/filters/two_view_models.h"
 
@@ -240,14 +241,14 @@ constexpr int kMaxRefits = 8;
 /// refined support; the reweighting to convergence follows once, for the best of all.
 constexpr int kRefitsPerNewBest = 1;
 
-/// Iteratively reweighted least squares from the best model while the score improves.
+/// Iteratively reweighted least squares from the best model while the score improves; `r2`:
+/// the best model's squared residuals.
 void reweight(const PointPairs& pairs, const Normalised& n, const TwoViewFitSettings& s,
-              const std::vector<uint8_t>& counted, float reach2, Best* best,
-              size_t max_points = kMaxRefitPoints, int max_refits = kMaxRefits) {
+              const std::vector<uint8_t>& counted, float reach2, std::vector<float> r2,
+              Best* best, size_t max_points = kMaxRefitPoints, int max_refits = kMaxRefits) {
   const float t2 = static_cast<float>(s.max_residual_px * s.max_residual_px);
   const size_t minimum = s.homography ? 4 : 8;
-  std::vector<float> r2, candidate_r2;
-  squaredResiduals(best->model, pairs, &r2);
+  std::vector<float> candidate_r2;
   for (int round = 0; round < max_refits; ++round) {
     const std::vector<int> inliers = inliersOf(r2, reach2);
     Eigen::Matrix3d M;
@@ -278,10 +279,11 @@ void optimiseLocally(const PointPairs& pairs, const Normalised& n, const TwoView
                      const std::vector<uint8_t>& counted, std::mt19937* random, Best* best) {
   const float t2 = static_cast<float>(s.max_residual_px * s.max_residual_px), reach2 = kReach * t2;
   const size_t size = kInnerSampleFactor * (s.homography ? 4 : 7);
-  std::vector<float> r2, candidate_r2;
+  std::vector<float> r2, candidate_r2, best_r2;
   squaredResiduals(best->model, pairs, &r2);
   std::vector<int> inliers = inliersOf(r2, reach2);
   const Best start = *best;
+  best_r2 = r2;
   const int samples = s.homography ? 0 : kInnerSamples;
   for (int k = 0; k < samples && inliers.size() > size; ++k) {
     std::shuffle(inliers.begin(), inliers.end(), *random);
@@ -291,9 +293,12 @@ void optimiseLocally(const PointPairs& pairs, const Normalised& n, const TwoView
     const TwoViewModel candidate = inPixels(M, n, s.homography);
     const Score score =
         boundedScore(candidate, pairs, t2, counted, best->score.cost, &candidate_r2);
-    if (score.cost < best->score.cost) *best = Best{M, candidate, score};
+    if (score.cost < best->score.cost) {
+      *best = Best{M, candidate, score};
+      best_r2.swap(candidate_r2);
+    }
   }
-  reweight(pairs, n, s, counted, reach2, best);
+  reweight(pairs, n, s, counted, reach2, std::move(best_r2), best);
 }
 
 /// What one fit searches over.
@@ -326,7 +331,7 @@ int searchHypotheses(const Search& s, std::mt19937* random, Best* best) {
       // LO-RANSAC: every new best is reweighted at once, and the refined support sets the
       // count; the inner samples follow once, for the best of all.
       if (best->score.inliers_counted >= settings.min_inliers_to_refine) {
-        reweight(s.pairs, s.n, settings, s.counted, kReach * t2, best, kMaxRefitPoints,
+        reweight(s.pairs, s.n, settings, s.counted, kReach * t2, r2, best, kMaxRefitPoints,
                  kRefitsPerNewBest);
       }
       needed = std::max(iterations + 1,
@@ -363,7 +368,7 @@ TwoViewModel polishTwoViewModel(const PointPairs& pairs, const TwoViewModel& mod
   squaredResiduals(model, pairs, &r2);
   Best best{inNormalised(model, n), model, scoreOf(r2, t2, counted)};
   if (!best.normalised.allFinite() || !std::isfinite(best.score.cost)) return model;
-  reweight(pairs, n, settings, counted, kReach * t2, &best, kMaxPolishPoints);
+  reweight(pairs, n, settings, counted, kReach * t2, std::move(r2), &best, kMaxPolishPoints);
   return best.model;
 }
 

@@ -38,8 +38,13 @@ float rotationOf(const cv::KeyPoint& l, const cv::KeyPoint& r) {
   if (!std::isfinite(l.angle) || !std::isfinite(r.angle) || l.angle < 0.f || r.angle < 0.f) {
     return NAN;  // OpenCV's -1: no orientation
   }
-  const double d = std::fmod(double(r.angle) - double(l.angle), 360.0);
-  return static_cast<float>(d < 0.0 ? d + 360.0 : d);
+  double d = double(r.angle) - double(l.angle);  // in (-360, 360) for angles in [0, 360)
+  if (d < 0.0) d += 360.0;
+  if (!(d < 360.0)) {  // angles beyond a turn (or d + 360 rounded up to it): the remainder
+    d = std::fmod(double(r.angle) - double(l.angle), 360.0);
+    if (d < 0.0) d += 360.0;
+  }
+  return static_cast<float>(d);
 }
 
 float log2ScaleOf(const cv::KeyPoint& l, const cv::KeyPoint& r) {
@@ -68,12 +73,16 @@ FitSet fitSetOf(const PutativeMatches& input, const std::vector<size_t>& finite,
     }
   }
   FitSet set;
-  set.pairs.reserve(chosen.size());
-  for (size_t m : chosen) {
-    const cv::KeyPoint &l = input.left(m), &r = input.right(m);
-    set.pairs.push(l.pt.x, l.pt.y, r.pt.x, r.pt.y);
-    set.rotation_deg.push_back(rotationOf(l, r));
-    set.log2_scale.push_back(log2ScaleOf(l, r));
+  const size_t n = chosen.size();
+  set.pairs.left_x.resize(n), set.pairs.left_y.resize(n);
+  set.pairs.right_x.resize(n), set.pairs.right_y.resize(n);
+  set.rotation_deg.resize(n), set.log2_scale.resize(n);
+  for (size_t k = 0; k < n; ++k) {
+    const cv::KeyPoint &l = input.left(chosen[k]), &r = input.right(chosen[k]);
+    set.pairs.left_x[k] = l.pt.x, set.pairs.left_y[k] = l.pt.y;
+    set.pairs.right_x[k] = r.pt.x, set.pairs.right_y[k] = r.pt.y;
+    set.rotation_deg[k] = rotationOf(l, r);
+    set.log2_scale[k] = log2ScaleOf(l, r);
   }
   return set;
 }
