@@ -214,11 +214,13 @@ bool refit(const Normalised& n, std::vector<int> inliers, const std::vector<floa
 }
 
 std::vector<int> inliersOf(const std::vector<float>& r2, float t2) {
-  std::vector<int> inliers;
-  inliers.reserve(r2.size());
-  for (size_t i = 0; i < r2.size(); ++i) {
-    if (r2[i] <= t2) inliers.push_back(static_cast<int>(i));
+  std::vector<int> inliers(r2.size());
+  size_t count = 0;
+  for (size_t i = 0; i < r2.size(); ++i) {  // without a branch: write, then advance if within
+    inliers[count] = static_cast<int>(i);
+    count += r2[i] <= t2;
   }
+  inliers.resize(count);
   return inliers;
 }
 

@@ -67,6 +67,7 @@ bool nullSpace(Eigen::Matrix<double, Rows, 9> A, Eigen::Matrix<double, 9, 9 - Ro
 /// Real roots of c3 x^3 + c2 x^2 + c1 x + c0, each polished by two Newton steps.
 std::vector<double> realCubicRootsOf(double c3, double c2, double c1, double c0) {
   std::vector<double> roots;
+  roots.reserve(3);
   const double largest = std::max({std::abs(c3), std::abs(c2), std::abs(c1), std::abs(c0)});
   if (!(largest > 0.0) || !std::isfinite(largest)) return roots;
   if (std::abs(c3) < 1e-12 * largest) {  // quadratic
@@ -343,6 +344,7 @@ std::vector<Eigen::Matrix3d> sevenPointFundamental(const Eigen::Matrix<double, 7
   const double c0 = d0, c2 = 0.5 * (d1 + dm) - d0, odd = 0.5 * (d1 - dm);  // odd = c3 + c1
   const double c3 = (d2 - c0 - 4.0 * c2 - 2.0 * odd) / 6.0, c1 = odd - c3;
   std::vector<Eigen::Matrix3d> solutions;
+  solutions.reserve(3);
   for (double a : realCubicRoots(c3, c2, c1, c0)) {
     const Eigen::Matrix3d F = a * F1 + (1.0 - a) * F2;
     if (finiteMatrix(F)) solutions.push_back(F / F.norm());

@@ -196,11 +196,12 @@ std::vector<int> votedPool(const FitSet& set, const VoteRansacConfig& config,
 /// match (the right points shifted by half the set): what chance alone gives it.
 size_t chanceInliers(const TwoViewModel& model, const PointPairs& pairs, double threshold_px) {
   PointPairs shuffled = pairs;
-  const size_t n = pairs.size(), shift = n / 2 + 1;
-  for (size_t i = 0; i < n; ++i) {
-    shuffled.right_x[i] = pairs.right_x[(i + shift) % n];
-    shuffled.right_y[i] = pairs.right_y[(i + shift) % n];
-  }
+  const size_t n = pairs.size(), shift = n == 0 ? 0 : (n / 2 + 1) % n;
+  // right point i of the shuffled pairs is right point (i + shift) mod n
+  std::rotate_copy(pairs.right_x.begin(), pairs.right_x.begin() + long(shift), pairs.right_x.end(),
+                   shuffled.right_x.begin());
+  std::rotate_copy(pairs.right_y.begin(), pairs.right_y.begin() + long(shift), pairs.right_y.end(),
+                   shuffled.right_y.begin());
   std::vector<float> r2;
   squaredResiduals(model, shuffled, &r2);
   const float t2 = static_cast<float>(threshold_px * threshold_px);
