@@ -58,6 +58,28 @@ TEST(TwoViewModels, SevenPointsGiveTheExactFundamentalMatrix) {
   EXPECT_LT(nearest, 1e-5);  // the true F is one of the (up to three) solutions (float input)
 }
 
+TEST(TwoViewModels, SevenPointsOfRankBelowSevenGiveNone) {
+  // A repeated point or seven points on one line leave a null space of more than two
+  // dimensions: no fundamental matrix is determined, so none is returned.
+  const LabelledMatches scene = sceneMatches(7, 0.0, 3, 0.0);
+  Eigen::Matrix<double, 7, 2> l, r;
+  for (int i = 0; i < 7; ++i) {
+    l.row(i) << scene.putative.left(i).pt.x / 320.0 - 1, scene.putative.left(i).pt.y / 240.0 - 1;
+    r.row(i) << scene.putative.right(i).pt.x / 320.0 - 1,
+        scene.putative.right(i).pt.y / 240.0 - 1;
+  }
+  ASSERT_FALSE(sevenPointFundamental(l, r).empty());
+  Eigen::Matrix<double, 7, 2> repeated_l = l, repeated_r = r;
+  repeated_l.row(6) = l.row(2), repeated_r.row(6) = r.row(2);
+  EXPECT_TRUE(sevenPointFundamental(repeated_l, repeated_r).empty());
+  Eigen::Matrix<double, 7, 2> line_l, line_r;
+  for (int i = 0; i < 7; ++i) line_l.row(i) << 0.1 * i, 0.2, line_r.row(i) << 0.1 * i + 0.05, 0.2;
+  EXPECT_TRUE(sevenPointFundamental(line_l, line_r).empty());
+  Eigen::Matrix<double, 7, 2> nan_l = l;
+  nan_l(3, 0) = NAN;
+  EXPECT_TRUE(sevenPointFundamental(nan_l, r).empty());
+}
+
 TEST(TwoViewModels, FourPointsGiveTheHomographyAndCollinearOnesNone) {
   Eigen::Matrix3d H;
   H << 1.1, 0.2, 5, -0.1, 0.9, 7, 1e-4, 2e-4, 1;
