@@ -239,7 +239,12 @@ std::string sampledMarkdown(const nlohmann::json& sweep) {
         "| --- | --- | --- | --- |\n";
   for (const auto& row : sweep) {
     if (!row.contains("gsc_max_support")) continue;
-    for (const auto& [support, cell] : row["gsc_max_support"].items()) {
+    std::vector<std::pair<int, std::string>> supports;  // by number, not by the keys' text
+    for (const auto& each : row["gsc_max_support"].items())
+      supports.emplace_back(std::stoi(each.key()), each.key());
+    std::sort(supports.begin(), supports.end());
+    for (const auto& [number_of, support] : supports) {
+      const nlohmann::json& cell = row["gsc_max_support"][support];
       md << "| " << row["n"] << " | " << support << " | " << number(cell["all_threads_ms"])
          << " ms | " << number(100.0 * cell["same_decisions_share"].get<double>(), 4) << " % |\n";
     }

@@ -41,7 +41,8 @@ inline TwoCameras twoCameras() {
 
 /// `inliers` projections of random points of the box (keypoint angles turned by the roll, sizes
 /// scaled by the depth ratio, with noise), then random mismatches to make `outliers` of all.
-inline LabelledMatches sceneMatches(size_t inliers, double outliers, unsigned seed, double noise_px) {
+inline LabelledMatches sceneMatches(size_t inliers, double outliers, unsigned seed,
+                                    double noise_px) {
   const TwoCameras c = twoCameras();
   std::mt19937 random(seed);
   std::uniform_real_distribution<double> x(-1.5, 1.5), y(-1.0, 1.0), z(4.0, 6.0), angle(0, 360),

@@ -71,12 +71,6 @@ __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default"))) vo
   *cost = sum, *inliers = total;
 }
 
-/// `counted`: 1 for the pairs whose inliers are counted.
-Score scoreOf(const std::vector<float>& r2, float t2, const std::vector<uint8_t>& counted) {
-  Score score;
-  truncatedScore(r2.data(), counted.data(), r2.size(), t2, &score.cost, &score.inliers_counted);
-  return score;
-}
 
 /// A hypothesis' score, computed in blocks of kScoreBlock pairs that stop once its cost reaches
 /// `bound` (the truncated squares only add up, so it could no longer score below it): a cost
@@ -285,7 +279,7 @@ void optimiseLocally(const PointPairs& pairs, const Normalised& n, const TwoView
   squaredResiduals(best->model, pairs, &r2);
   std::vector<int> inliers = inliersOf(r2, reach2);
   const Best start = *best;
-  best_r2 = r2;
+  best_r2 = r2;  // r2 stays: the inner refits weight by the start model's residuals
   const int samples = s.homography ? 0 : kInnerSamples;
   for (int k = 0; k < samples && inliers.size() > size; ++k) {
     std::shuffle(inliers.begin(), inliers.end(), *random);
@@ -367,8 +361,9 @@ TwoViewModel polishTwoViewModel(const PointPairs& pairs, const TwoViewModel& mod
   const std::vector<uint8_t> counted(pairs.size(), 1);
   const float t2 = static_cast<float>(max_residual_px * max_residual_px);
   std::vector<float> r2;
-  squaredResiduals(model, pairs, &r2);
-  Best best{inNormalised(model, n), model, scoreOf(r2, t2, counted)};
+  // Scored as the candidates are (in blocks), so that equal models compare equal.
+  Best best{inNormalised(model, n), model,
+            boundedScore(model, pairs, t2, counted, std::numeric_limits<double>::infinity(), &r2)};
   if (!best.normalised.allFinite() || !std::isfinite(best.score.cost)) return model;
   reweight(pairs, n, settings, counted, kReach * t2, std::move(r2), &best, kMaxPolishPoints);
   return best.model;

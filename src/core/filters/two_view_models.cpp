@@ -32,9 +32,10 @@ void homographyRows(double lx, double ly, double rx, double ry, Vector9d* a, Vec
   *b << 0.0, 0.0, 0.0, -lx, -ly, -1.0, ry * lx, ry * ly, ry;
 }
 
-/// A basis (unit vectors, not orthogonal) of the null space of a Rows x 9 matrix of rank Rows (7 or 8 rows):
-/// Gauss-Jordan elimination with full pivoting to [I | B] (columns permuted), then one unit
-/// vector per free column. False when a pivot falls below 1e-10 of the first (rank below Rows:
+/// An orthonormal basis of the null space of a Rows x 9 matrix of rank Rows (7 or 8 rows):
+/// Gauss-Jordan elimination with full pivoting to [I | B] (columns permuted), one vector per
+/// free column, then Gram-Schmidt (so that a nearly degenerate sample does not give two nearly
+/// parallel vectors). False when a pivot falls below 1e-10 of the first (rank below Rows:
 /// collinear or repeated points) or is not finite.
 template <int Rows>
 bool nullSpace(Eigen::Matrix<double, Rows, 9> A, Eigen::Matrix<double, 9, 9 - Rows>* basis) {
@@ -59,6 +60,7 @@ bool nullSpace(Eigen::Matrix<double, Rows, 9> A, Eigen::Matrix<double, 9, 9 - Ro
     Vector9d x = Vector9d::Zero();
     for (int i = 0; i < Rows; ++i) x(column[i]) = -A(i, Rows + j);
     x(column[Rows + j]) = 1.0;
+    for (int k = 0; k < j; ++k) x -= basis->col(k).dot(x) * basis->col(k);
     basis->col(j) = x / x.norm();
   }
   return true;
