@@ -89,9 +89,9 @@ struct TwoViewFit {
 /// all-inlier sample was drawn (the inlier share of `sample_from`) or at max_iterations. Each new
 /// best is refined once by least squares over the pairs within twice the threshold, Tukey-weighted
 /// by their residuals (times the Sampson weight for F), and its refined support sets the count;
-/// the final best of an F search also by least squares over 5 random subsets of 4 m of those
-/// pairs (a fundamental matrix whose epipole lies among the points can be its own least-squares
-/// fixed point), then the final best of either is reweighted while the score improves.
+/// the final best also by least squares over 5 random subsets of 4 m of those pairs (a
+/// fundamental matrix whose epipole lies among the points, or a homography across two close
+/// motions, can be its own least-squares fixed point), then reweighted while the score improves.
 TwoViewFit fitTwoViewModel(const PointPairs& pairs, const std::vector<int>& sample_from,
                            const TwoViewFitSettings& settings, std::mt19937* random);
 

@@ -266,8 +266,8 @@ void reweight(const PointPairs& pairs, const Normalised& n, const TwoViewFitSett
 /// The inner RANSAC of LO-RANSAC: least squares over kInnerSamples random subsets of
 /// kInnerSampleFactor m of the best model's inliers (within reach), which lets a model that is
 /// its own least-squares fixed point (an epipole among the points explains some of them) give
-/// way to the motion; the best of them, then the reweighting. For F only: a homography has no
-/// epipole, and its search mostly decides whether a plane explains what F does.
+/// way to the motion, and a homography fitted across two close motions (the Tukey weights
+/// reach both) give way to one of them; the best of them, then the reweighting.
 constexpr int kInnerSamples = 5;
 constexpr size_t kInnerSampleFactor = 4;
 
@@ -280,8 +280,7 @@ void optimiseLocally(const PointPairs& pairs, const Normalised& n, const TwoView
   std::vector<int> inliers = inliersOf(r2, reach2);
   const Best start = *best;
   best_r2 = r2;  // r2 stays: the inner refits weight by the start model's residuals
-  const int samples = s.homography ? 0 : kInnerSamples;
-  for (int k = 0; k < samples && inliers.size() > size; ++k) {
+  for (int k = 0; k < kInnerSamples && inliers.size() > size; ++k) {
     std::shuffle(inliers.begin(), inliers.end(), *random);
     const std::vector<int> subset(inliers.begin(), inliers.begin() + size);
     Eigen::Matrix3d M;
