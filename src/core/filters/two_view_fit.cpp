@@ -71,7 +71,6 @@ __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default"))) vo
   *cost = sum, *inliers = total;
 }
 
-
 /// A hypothesis' score, computed in blocks of kScoreBlock pairs that stop once its cost reaches
 /// `bound` (the truncated squares only add up, so it could no longer score below it): a cost
 /// of infinity then. `r2` holds every pair's squared residual when the cost is below `bound`.
@@ -326,8 +325,8 @@ int searchHypotheses(const Search& s, std::mt19937* random, Best* best) {
       // LO-RANSAC: every new best is reweighted at once, and the refined support sets the
       // count; the inner samples follow once, for the best of all.
       if (best->score.inliers_counted >= settings.min_inliers_to_refine) {
-        reweight(s.pairs, s.n, settings, s.counted, kReach * t2, r2, best, kMaxRefitPoints,
-                 kRefitsPerNewBest);
+        reweight(s.pairs, s.n, settings, s.counted, kReach * t2, std::move(r2), best,
+                 kMaxRefitPoints, kRefitsPerNewBest);  // r2 is rewritten by the next score
       }
       needed = std::max(iterations + 1,
                         ransacIterations(double(best->score.inliers_counted) / double(pool), m,

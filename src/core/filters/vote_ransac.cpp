@@ -56,8 +56,10 @@ float log2ScaleOf(const cv::KeyPoint& l, const cv::KeyPoint& r) {
 /// `finite`: the matches with finite positions, in order.
 FitSet fitSetOf(const PutativeMatches& input, const std::vector<size_t>& finite, size_t max_points,
                 unsigned seed) {
-  std::vector<size_t> chosen = finite;
-  if (chosen.size() > max_points) {  // a uniform sample, kept in the matches' order
+  std::vector<size_t> chosen;
+  if (finite.size() <= max_points) {
+    chosen = finite;
+  } else {  // a uniform sample, kept in the matches' order
     std::mt19937 random(seed);
     std::vector<size_t> order(finite.size());
     std::iota(order.begin(), order.end(), size_t(0));
@@ -67,7 +69,7 @@ FitSet fitSetOf(const PutativeMatches& input, const std::vector<size_t>& finite,
       std::swap(order[k], order[pick(random)]);
       taken[order[k]] = 1;
     }
-    chosen.clear();
+    chosen.reserve(max_points);
     for (size_t p = 0; p < finite.size(); ++p) {
       if (taken[p]) chosen.push_back(finite[p]);
     }
