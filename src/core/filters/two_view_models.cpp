@@ -3,8 +3,8 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
-#include <memory>
 #include <vector>
 
 namespace sift_hull {
@@ -126,70 +126,75 @@ bool anyThreeCollinear(const Eigen::Matrix<double, 4, 2>& p) {
 
 constexpr int kInverseIterations = 4;
 
-/// sum = sum_i w_i a_i a_i^T over n rows of 9 stored by column (a[k * stride + i] is entry k of
-/// row i): 45 weighted dot products, each in 8 partial sums so that it vectorises.
-__attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default"))) void weightedGram(
-    const double* a, const double* w, size_t n, size_t stride, double (*sum)[9]) {
-  for (int r = 0; r < 9; ++r) {
-    const double* ar = a + size_t(r) * stride;
-    for (int c = r; c < 9; ++c) {
-      const double* ac = a + size_t(c) * stride;
-      double partial[8] = {};
-      size_t i = 0;
-      for (; i + 8 <= n; i += 8) {
-        for (int k = 0; k < 8; ++k) partial[k] += w[i + k] * ar[i + k] * ac[i + k];
+/// Eight doubles: one vector register with AVX-512, split by the compiler where narrower.
+typedef double Lanes __attribute__((vector_size(64)));
+
+/// The six products of (x, y, 1) with itself: x x, x y, x, y y, y, 1 (index of entry pair (i, k)
+/// of (x, y, 1), i <= k, by kMonomial).
+constexpr int kMonomial[3][3] = {{0, 1, 2}, {1, 3, 4}, {2, 4, 5}};
+
+/// sums[p][q] = sum_i w_i R_p(i) L_q(i) for the six monomials R of the right points and L of the
+/// left ones (both listed as kMonomial does), over n points: each lane of eight sums its own rows
+/// (8 k + lane), then the lanes and the remaining rows are added in a fixed order, so that the
+/// result does not depend on the vector width the CPU has.
+__attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default"))) void monomialSums(
+    const double* lx, const double* ly, const double* rx, const double* ry, const double* w,
+    size_t n, double (*sums)[6]) {
+  const size_t whole = n / 8 * 8;
+  for (int half = 0; half < 2; ++half) {  // three right monomials at a time: 18 accumulators
+    Lanes acc[3][6] = {};
+    for (size_t i = 0; i < whole; i += 8) {
+      Lanes x, y, u, v, wi;  // through memcpy: the arrays need not be aligned to 64 bytes
+      std::memcpy(&x, lx + i, sizeof x), std::memcpy(&y, ly + i, sizeof y);
+      std::memcpy(&u, rx + i, sizeof u), std::memcpy(&v, ry + i, sizeof v);
+      std::memcpy(&wi, w + i, sizeof wi);
+      const Lanes left[5] = {x * x, x * y, x, y * y, y};  // and 1: acc[p][5]
+      const Lanes wu = wi * u, wv = wi * v;
+      const Lanes all_right[6] = {wu * u, wu * v, wu, wv * v, wv, wi};
+      for (int p = 0; p < 3; ++p) {
+        const Lanes right = all_right[3 * half + p];
+        for (int q = 0; q < 5; ++q) acc[p][q] += right * left[q];
+        acc[p][5] += right;
       }
-      double total = 0.0;
-      for (; i < n; ++i) total += w[i] * ar[i] * ac[i];
-      for (int k = 0; k < 8; ++k) total += partial[k];
-      sum[r][c] = sum[c][r] = total;
+    }
+    for (int p = 0; p < 3; ++p) {
+      for (int q = 0; q < 6; ++q) {
+        double total = 0.0;
+        for (int lane = 0; lane < 8; ++lane) total += acc[p][q][lane];
+        sums[3 * half + p][q] = total;
+      }
+    }
+  }
+  for (size_t i = whole; i < n; ++i) {
+    const double left[6] = {lx[i] * lx[i], lx[i] * ly[i], lx[i], ly[i] * ly[i], ly[i], 1.0};
+    const double wu = w[i] * rx[i], wv = w[i] * ry[i];
+    const double right[6] = {wu * rx[i], wu * ry[i], wu, wv * ry[i], wv, w[i]};
+    for (int p = 0; p < 6; ++p) {
+      for (int q = 0; q < 6; ++q) sums[p][q] += right[p] * left[q];
     }
   }
 }
 
-/// The sum of w a a^T over at most `rows` weighted rows a, kept by column until it is summed.
-class NormalEquations {
- public:
-  /// Columns of `rows` entries, 8 doubles more than a multiple of 64 apart, so that no two of
-  /// the nine are a multiple of 4 KiB apart (stores to columns at such distances alias in the
-  /// cache and take several times as long).
-  explicit NormalEquations(size_t rows)
-      : rows_(rows),
-        stride_((rows + 63) / 64 * 64 + 8),
-        a_(new double[9 * stride_]),  // left uninitialised: only the rows set are read
-        w_(new double[rows]) {}
-  /// All rows of x_r^T F x_l = 0 at once (also the columns homographyNormal combines), column
-  /// by column (so that it vectorises): n correspondences (n x 2 arrays, column-major) and
-  /// their weights.
-  void setEpipolarRows(const Eigen::MatrixX2d& left, const Eigen::MatrixX2d& right,
-                       const Eigen::VectorXd& weights) {
-    used_ = std::min(rows_, size_t(left.rows()));
-    const double *lx = left.col(0).data(), *ly = left.col(1).data();
-    const double *rx = right.col(0).data(), *ry = right.col(1).data();
-    double* c[9];
-    for (int k = 0; k < 9; ++k) c[k] = a_.get() + size_t(k) * stride_;
-    for (size_t i = 0; i < used_; ++i) {
-      c[0][i] = rx[i] * lx[i], c[1][i] = rx[i] * ly[i], c[2][i] = rx[i];
-      c[3][i] = ry[i] * lx[i], c[4][i] = ry[i] * ly[i], c[5][i] = ry[i];
-      c[6][i] = lx[i], c[7][i] = ly[i], c[8][i] = 1.0;
-      w_[i] = weights(Eigen::Index(i));
+/// sum_i w_i a_i a_i^T for the rows a = (rx lx, rx ly, rx, ry lx, ry ly, ry, lx, ly, 1) of
+/// x_r^T F x_l = 0 (F's nine row-major entries; also the columns homographyNormal combines), n
+/// correspondences (n x 2 arrays, column-major) with their weights. a is r (x) l for r = (rx, ry,
+/// 1) and l = (lx, ly, 1), so entry (3 i + j, 3 k + m) is sum w r_i r_k l_j l_m: 36 sums of
+/// monomials give all 81 entries.
+Matrix9d epipolarGram(const Eigen::MatrixX2d& left, const Eigen::MatrixX2d& right,
+                      const Eigen::VectorXd& weights) {
+  double sums[6][6];
+  monomialSums(left.col(0).data(), left.col(1).data(), right.col(0).data(), right.col(1).data(),
+               weights.data(), size_t(left.rows()), sums);
+  Matrix9d G;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      for (int k = 0; k < 3; ++k) {
+        for (int m = 0; m < 3; ++m) G(3 * i + j, 3 * k + m) = sums[kMonomial[i][k]][kMonomial[j][m]];
+      }
     }
   }
-  /// sum_i w_i a_i a_i^T over the rows set.
-  Matrix9d gram() const {
-    double sum[9][9];
-    weightedGram(a_.get(), w_.get(), used_, stride_, sum);
-    Matrix9d normal;
-    for (int r = 0; r < 9; ++r) {
-      for (int c = 0; c < 9; ++c) normal(r, c) = sum[r][c];
-    }
-    return normal;
-  }
-
- private:
-  size_t rows_, stride_, used_ = 0;
-  std::unique_ptr<double[]> a_, w_;
-};
+  return G;
+}
 
 /// The eigenvector of the smallest eigenvalue of a normal matrix: by inverse iteration from
 /// `start` (a model near the answer, row-major) when given, which is a few 9x9 solves instead of
@@ -373,9 +378,7 @@ bool leastSquaresFundamental(const Eigen::MatrixX2d& left, const Eigen::MatrixX2
                              const Eigen::VectorXd& weights, Eigen::Matrix3d* F,
                              const Eigen::Matrix3d* start) {
   if (left.rows() < 8 || right.rows() != left.rows() || weights.size() != left.rows()) return false;
-  NormalEquations normal(size_t(left.rows()));
-  normal.setEpipolarRows(left, right, weights);
-  *F = rankTwo(fromRowMajor(smallestEigenvector(normal.gram(), start)));
+  *F = rankTwo(fromRowMajor(smallestEigenvector(epipolarGram(left, right, weights), start)));
   return finiteMatrix(*F);
 }
 
@@ -383,9 +386,7 @@ bool leastSquaresHomography(const Eigen::MatrixX2d& left, const Eigen::MatrixX2d
                             const Eigen::VectorXd& weights, Eigen::Matrix3d* H,
                             const Eigen::Matrix3d* start) {
   if (left.rows() < 4 || right.rows() != left.rows() || weights.size() != left.rows()) return false;
-  NormalEquations normal(size_t(left.rows()));
-  normal.setEpipolarRows(left, right, weights);
-  *H = fromRowMajor(smallestEigenvector(homographyNormal(normal.gram()), start));
+  *H = fromRowMajor(smallestEigenvector(homographyNormal(epipolarGram(left, right, weights)), start));
   return finiteMatrix(*H) && std::abs(H->determinant()) > 1e-12 * std::pow(H->norm(), 3);
 }
 
