@@ -11,8 +11,12 @@ namespace sift_hull {
 struct PointPairs {
   std::vector<float> left_x, left_y, right_x, right_y;
   size_t size() const { return left_x.size(); }
-  void push(float lx, float ly, float rx, float ry);
-  void reserve(size_t n);
+  void push(float lx, float ly, float rx, float ry) {  // inline: called once per match
+    left_x.push_back(lx), left_y.push_back(ly), right_x.push_back(rx), right_y.push_back(ry);
+  }
+  void reserve(size_t n) {
+    left_x.reserve(n), left_y.reserve(n), right_x.reserve(n), right_y.reserve(n);
+  }
 };
 
 /// One motion between two images, in pixels: a fundamental matrix (x_r^T F x_l = 0) or a

@@ -290,14 +290,6 @@ std::vector<double> realCubicRoots(double c3, double c2, double c1, double c0) {
 
 }  // namespace
 
-void PointPairs::push(float lx, float ly, float rx, float ry) {
-  left_x.push_back(lx), left_y.push_back(ly), right_x.push_back(rx), right_y.push_back(ry);
-}
-
-void PointPairs::reserve(size_t n) {
-  left_x.reserve(n), left_y.reserve(n), right_x.reserve(n), right_y.reserve(n);
-}
-
 double modelResidual(const TwoViewModel& model, double lx, double ly, double rx, double ry) {
   const Eigen::Matrix3d& M = model.matrix;
   const Eigen::Vector3d l(lx, ly, 1.0), r(rx, ry, 1.0);

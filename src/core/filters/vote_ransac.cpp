@@ -91,6 +91,8 @@ FitSet fitSetOf(const PutativeMatches& input, const std::vector<size_t>& finite,
 
 FitSet subsetOf(const FitSet& set, const std::vector<int>& members) {
   FitSet sub;
+  sub.pairs.reserve(members.size());
+  sub.rotation_deg.reserve(members.size()), sub.log2_scale.reserve(members.size());
   for (int i : members) {
     sub.pairs.push(set.pairs.left_x[i], set.pairs.left_y[i], set.pairs.right_x[i],
                    set.pairs.right_y[i]);
@@ -113,15 +115,21 @@ uint32_t orderedBits(float value) {
 std::vector<std::pair<float, int>> sortedByValue(const std::vector<float>& values,
                                                  const std::vector<int>& candidates) {
   const size_t n = candidates.size();
+  if (n == 0) return {};
   std::vector<uint64_t> keys(n), scratch(n);
   for (size_t k = 0; k < n; ++k) {
     keys[k] = uint64_t(orderedBits(values[size_t(candidates[k])])) << 32 | uint32_t(k);
   }
-  for (int shift = 32; shift < 64; shift += 8) {
-    size_t count[257] = {};
-    for (uint64_t key : keys) ++count[((key >> shift) & 255u) + 1];
-    for (size_t d = 1; d < 257; ++d) count[d] += count[d - 1];
-    for (uint64_t key : keys) scratch[count[(key >> shift) & 255u]++] = key;
+  size_t count[4][257] = {};  // the four digits' counts, from one pass over the keys
+  for (uint64_t key : keys) {
+    for (int digit = 0; digit < 4; ++digit) ++count[digit][((key >> (32 + 8 * digit)) & 255u) + 1];
+  }
+  for (int digit = 0; digit < 4; ++digit) {
+    const int shift = 32 + 8 * digit;
+    size_t* start = count[digit];
+    if (start[((keys[0] >> shift) & 255u) + 1] == n) continue;  // one digit for all: in order
+    for (size_t d = 1; d < 257; ++d) start[d] += start[d - 1];
+    for (uint64_t key : keys) scratch[start[(key >> shift) & 255u]++] = key;
     keys.swap(scratch);
   }
   std::vector<std::pair<float, int>> sorted(n);
