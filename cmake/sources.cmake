@@ -14,6 +14,7 @@ set(SIFT_HULL_CORE_SOURCES
   src/core/features/nearest_neighbours.cpp
   src/core/features/sift.cpp
   src/core/features/triangulation.cpp
+  src/core/filters/densest_window.cpp
   src/core/filters/epipolar.cpp
   src/core/filters/filter.cpp
   src/core/filters/gms.cpp
@@ -75,6 +76,7 @@ set(SIFT_HULL_EVAL_SOURCES
 # width the CPU dispatch picks, the scalar and AVX2 distance look-ups must round alike, and the
 # two-view residual kernels (vote_ransac) must score a model alike on every CPU.
 set(SIFT_HULL_EXACT_FLOAT_SOURCES
+  src/core/filters/densest_window.cpp
   src/core/filters/gsc.cpp
   src/core/filters/guided.cpp
   src/core/filters/local_consistency.cpp

@@ -252,8 +252,8 @@ constexpr int kRefitsPerNewBest = 1;
 /// Iteratively reweighted least squares from the best model while the score improves; `r2`:
 /// the best model's squared residuals.
 void reweight(const PointPairs& pairs, const Normalised& n, const TwoViewFitSettings& s,
-              const std::vector<uint8_t>& counted, float reach2, std::vector<float> r2,
-              Best* best, size_t max_points = kMaxRefitPoints, int max_refits = kMaxRefits) {
+              const std::vector<uint8_t>& counted, float reach2, std::vector<float> r2, Best* best,
+              size_t max_points = kMaxRefitPoints, int max_refits = kMaxRefits) {
   const float t2 = static_cast<float>(s.max_residual_px * s.max_residual_px);
   const size_t minimum = s.homography ? 4 : 8;
   std::vector<float> candidate_r2;

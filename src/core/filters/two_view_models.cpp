@@ -189,7 +189,8 @@ Matrix9d epipolarGram(const Eigen::MatrixX2d& left, const Eigen::MatrixX2d& righ
   for (int i = 0; i < 3; ++i) {
     for (int j = 0; j < 3; ++j) {
       for (int k = 0; k < 3; ++k) {
-        for (int m = 0; m < 3; ++m) G(3 * i + j, 3 * k + m) = sums[kMonomial[i][k]][kMonomial[j][m]];
+        for (int m = 0; m < 3; ++m)
+          G(3 * i + j, 3 * k + m) = sums[kMonomial[i][k]][kMonomial[j][m]];
       }
     }
   }
@@ -381,7 +382,8 @@ bool leastSquaresHomography(const Eigen::MatrixX2d& left, const Eigen::MatrixX2d
                             const Eigen::VectorXd& weights, Eigen::Matrix3d* H,
                             const Eigen::Matrix3d* start) {
   if (left.rows() < 4 || right.rows() != left.rows() || weights.size() != left.rows()) return false;
-  *H = fromRowMajor(smallestEigenvector(homographyNormal(epipolarGram(left, right, weights)), start));
+  *H = fromRowMajor(
+      smallestEigenvector(homographyNormal(epipolarGram(left, right, weights)), start));
   return finiteMatrix(*H) && std::abs(H->determinant()) > 1e-12 * std::pow(H->norm(), 3);
 }
 
