@@ -76,10 +76,12 @@ TEST(DensestWindow, AWindowAcrossZeroDegreesCountsBothSides) {
 }
 
 TEST(DensestWindow, TiesGoToTheLowestIndexAndNoCandidatesGiveNone) {
-  const std::vector<float> values{10.f, 50.f, 10.f, 50.f};
+  // Index 0 (50) and index 1 (10) each see two; the lower index wins although its value is the
+  // larger and comes later in sorted order.
+  const std::vector<float> values{50.f, 10.f, 50.f, 10.f};
   size_t count = 0;
   EXPECT_EQ(detail::densestWindow(values, {1, 2, 3, 0}, 1.0, 0.0, &count),
-            (std::vector<int>{2, 0}));  // 0 and 1 both see two: index 0's window
+            (std::vector<int>{2, 0}));
   EXPECT_EQ(count, 2u);
   EXPECT_TRUE(detail::densestWindow(values, {}, 1.0, 0.0, &count).empty());
   EXPECT_EQ(count, 0u);

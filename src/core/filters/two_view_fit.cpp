@@ -70,7 +70,7 @@ __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default"))) vo
     FloatLanes e;
     std::memcpy(&e, r2 + i, sizeof e);
     const IntLanes within = e <= limit;  // -1 where true
-    partial += within ? e : limit;       // min(e, t2); NaN: t2
+    partial += limit < e ? limit : e;    // std::min(e, t2): NaN stays NaN
     IntLanes mask;
     for (int k = 0; k < 8; ++k) mask[k] = counted[i + size_t(k)];
     count += within & mask;  // the mask is 0 or 1
@@ -78,7 +78,7 @@ __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default"))) vo
   double sum = 0.0;
   size_t total = 0;
   for (size_t i = whole; i < n; ++i) {
-    sum += r2[i] <= t2 ? r2[i] : t2, total += (r2[i] <= t2) & counted[i];
+    sum += std::min(r2[i], t2), total += (r2[i] <= t2) & counted[i];
   }
   for (int k = 0; k < 8; ++k) sum += partial[k], total += size_t(count[k]);
   *cost = sum, *inliers = total;
