@@ -10,6 +10,8 @@
 #include <ros/ros.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <std_srvs/Empty.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_listener.h>
 #include <visualization_msgs/MarkerArray.h>
 
 #include <cmath>
@@ -219,6 +221,12 @@ TEST_F(HullOctomapTest, ClearBbxFreesTheBoxUntilResetAndRefusesBadBoxes) {
   tf_.sendTransform(ros_conversions::cameraPoseMessage(
       PinholeCamera::fromCentre(camera.K(), camera.R() * turn.transpose(), turn * camera.centre()),
       "world", "camera_turned", {}));
+  // The view only once tf here has the new frame: the node drops a view whose pose has not come
+  // within ~pose_timeout_s, and under load the static transform can come later than the view.
+  tf2_ros::Buffer buffer;
+  tf2_ros::TransformListener listener(buffer);
+  ASSERT_TRUE(waitFor([&] { return buffer.canTransform("world", "camera_turned", ros::Time(0)); }))
+      << "the turned camera's pose did not reach tf";
   const ros::Time turned =
       publishView(0, [](sensor_msgs::Image* image, sensor_msgs::CameraInfo* info) {
         image->header.frame_id = info->header.frame_id = "camera_turned";
