@@ -9,6 +9,7 @@ set(SIFT_HULL_CORE_SOURCES
   src/core/geometry/camera_set.cpp
   src/core/geometry/correspondence.cpp
   src/core/geometry/distortion.cpp
+  src/core/features/byte_neighbours.cpp
   src/core/features/feature_cache.cpp
   src/core/features/matching.cpp
   src/core/features/nearest_neighbours.cpp

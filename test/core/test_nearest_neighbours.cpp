@@ -1,5 +1,7 @@
 // Exact nearest neighbours by matrix product against OpenCV's brute force and a scalar reference:
-// the same neighbours up to exact ties (counted) and float rounding, across block boundaries.
+// the same neighbours up to exact ties (counted) and float rounding, across block boundaries. The
+// integer kernel (byte descriptors, AVX-512 VNNI) exactly, ties included; the float32 kernel for
+// everything else.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -12,6 +14,7 @@
 #include <vector>
 
 #include "common/test_data.h"
+#include "features/neighbour_kernels.h"
 #include "sift_hull/features/matching.h"
 #include "sift_hull/features/nearest_neighbours.h"
 #include "sift_hull/features/sift.h"
@@ -68,6 +71,128 @@ int compareNeighbours(const std::vector<TwoNearest>& got, const std::vector<TwoN
     differ += got[i].best != want[i].best;
   }
   return differ;
+}
+
+/// Byte-valued descriptors drawn from `levels` values spread over [0, 255]: few levels give many
+/// exactly equal distances.
+cv::Mat byteDescriptors(int rows, int cols, int levels, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_int_distribution<int> level(0, levels - 1);
+  cv::Mat m(rows, cols, CV_32F);
+  for (int i = 0; i < rows; ++i) {
+    for (int k = 0; k < cols; ++k) m.at<float>(i, k) = static_cast<float>(level(rng) * 255 / (levels - 1));
+  }
+  return m;
+}
+
+/// Integer squared distances, the two smallest per query and the nearest query per reference,
+/// the lowest index first among equals: what the integer kernel must give exactly.
+struct IntegerReference {
+  std::vector<int> best, second, reverse;
+};
+
+IntegerReference integerReference(const cv::Mat& q, const cv::Mat& r) {
+  IntegerReference out{std::vector<int>(q.rows, -1), std::vector<int>(q.rows, -1),
+                       std::vector<int>(r.rows, -1)};
+  std::vector<int64_t> reverse_best(r.rows, std::numeric_limits<int64_t>::max());
+  for (int i = 0; i < q.rows; ++i) {
+    int64_t b1 = std::numeric_limits<int64_t>::max(), b2 = b1;
+    for (int j = 0; j < r.rows; ++j) {
+      int64_t d2 = 0;
+      for (int k = 0; k < q.cols; ++k) {
+        const int64_t d = static_cast<int64_t>(q.at<float>(i, k)) - static_cast<int64_t>(r.at<float>(j, k));
+        d2 += d * d;
+      }
+      if (d2 < b1) {
+        b2 = b1, out.second[i] = out.best[i], b1 = d2, out.best[i] = j;
+      } else if (d2 < b2) {
+        b2 = d2, out.second[i] = j;
+      }
+      if (d2 < reverse_best[j]) reverse_best[j] = d2, out.reverse[j] = i;
+    }
+  }
+  return out;
+}
+
+TEST(ExactNearestNeighbours, ByteKernelIsExactWithTiesAndOddShapes) {
+  if (!detail::byteKernelAvailable()) {
+    GTEST_SKIP() << "this CPU has no AVX-512 VNNI: the integer kernel does not run here";
+  }
+  int cases = 0;
+  for (int cols : {1, 5, 128, 130}) {
+    for (auto [nq, nr] : {std::pair{1, 1}, {1, 2}, {7, 15}, {17, 33}, {65, 31}, {300, 100},
+                          {129, 545}}) {
+      for (int levels : {2, 4, 256}) {
+        const unsigned seed = static_cast<unsigned>(cols * 1000 + nq * 7 + nr + levels);
+        const cv::Mat q = byteDescriptors(nq, cols, levels, seed);
+        const cv::Mat r = byteDescriptors(nr, cols, levels, seed + 1);
+        detail::NeighbourIndices got;
+        ASSERT_TRUE(detail::byteNearestNeighbours(q, r, true, &got));
+        const IntegerReference want = integerReference(q, r);
+        const std::string what = std::to_string(nq) + " x " + std::to_string(nr) + ", " +
+                                 std::to_string(cols) + " columns, " + std::to_string(levels) +
+                                 " levels";
+        EXPECT_EQ(got.best, want.best) << what;
+        EXPECT_EQ(got.second, want.second) << what;
+        EXPECT_EQ(got.reverse, want.reverse) << what;
+        ++cases;
+      }
+    }
+  }
+  EXPECT_EQ(cases, 84);
+}
+
+TEST(ExactNearestNeighbours, ByteKernelSumsStayExactAtItsWidestDescriptors) {
+  if (!detail::byteKernelAvailable()) {
+    GTEST_SKIP() << "this CPU has no AVX-512 VNNI: the integer kernel does not run here";
+  }
+  // All 0 against all 255 over 1,024 columns: the largest squared distance, 66,585,600.
+  cv::Mat q(3, detail::kMaxByteColumns, CV_32F, cv::Scalar(0.0f));
+  q.row(1).setTo(255.0f);
+  q.at<float>(2, 0) = 255.0f;
+  const cv::Mat r = q.clone();
+  detail::NeighbourIndices got;
+  ASSERT_TRUE(detail::byteNearestNeighbours(q, r, true, &got));
+  EXPECT_EQ(got.best, (std::vector<int>{0, 1, 2}));
+  EXPECT_EQ(got.second, (std::vector<int>{2, 2, 0}));
+  EXPECT_EQ(got.reverse, (std::vector<int>{0, 1, 2}));
+  const NearestNeighbours full = exactNearestNeighbours(q, r, false);
+  EXPECT_FLOAT_EQ(full.forward[1].second_distance, std::sqrt(1023.0f) * 255.0f);
+  // One column more, a fraction, a negative value, 256 or NaN: the float32 kernel's business.
+  cv::Mat wide(2, detail::kMaxByteColumns + 1, CV_32F, cv::Scalar(1.0f));
+  EXPECT_FALSE(detail::byteNearestNeighbours(wide, wide, false, &got));
+  for (float bad : {0.5f, -1.0f, 256.0f, std::numeric_limits<float>::quiet_NaN()}) {
+    cv::Mat odd = byteDescriptors(20, 128, 256, 3);
+    odd.at<float>(19, 127) = bad;
+    EXPECT_FALSE(detail::byteNearestNeighbours(odd, r.colRange(0, 128), false, &got)) << bad;
+    EXPECT_FALSE(detail::byteNearestNeighbours(r.colRange(0, 128), odd, false, &got)) << bad;
+  }
+}
+
+TEST(ExactNearestNeighbours, BothKernelsGiveTheSameNeighbours) {
+  // Whichever kernel exactNearestNeighbours picks, the float32 one agrees up to exact ties.
+  const cv::Mat q = byteDescriptors(700, 128, 256, 11), r = byteDescriptors(900, 128, 256, 12);
+  const NearestNeighbours a = exactNearestNeighbours(q, r, true);
+  const NearestNeighbours b = float32NearestNeighbours(q, r, true);
+  EXPECT_LE(compareNeighbours(a.forward, b.forward, 1e-3f), 7);
+  ASSERT_EQ(a.reverse_nearest.size(), b.reverse_nearest.size());
+  int differ = 0;
+  for (size_t j = 0; j < a.reverse_nearest.size(); ++j)
+    differ += a.reverse_nearest[j] != b.reverse_nearest[j];
+  EXPECT_LE(differ, 9);
+  // Real-valued descriptors always take the float32 kernel: identical results.
+  const cv::Mat qr = randomDescriptors(300, 64, false, 5), rr = randomDescriptors(200, 64, false, 6);
+  const NearestNeighbours c = exactNearestNeighbours(qr, rr, true);
+  const NearestNeighbours d = float32NearestNeighbours(qr, rr, true);
+  for (size_t i = 0; i < c.forward.size(); ++i) {
+    EXPECT_EQ(c.forward[i].best, d.forward[i].best);
+    EXPECT_EQ(c.forward[i].second, d.forward[i].second);
+  }
+  EXPECT_EQ(c.reverse_nearest, d.reverse_nearest);
+  // The kernel named for reports is the one taken.
+  EXPECT_EQ(exactNearestNeighboursKernel(q, r).rfind("int8", 0) == 0,
+            detail::byteKernelAvailable());
+  EXPECT_EQ(exactNearestNeighboursKernel(qr, rr).rfind("float32 OpenBLAS", 0), 0u);
 }
 
 TEST(ExactNearestNeighbours, MatchesTheScalarReferenceAcrossBlockBoundaries) {

@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "common/parallel.h"
+#include "features/neighbour_kernels.h"
 
 namespace sift_hull {
 namespace {
@@ -141,9 +142,9 @@ float l2(const cv::Mat& a, int i, const cv::Mat& b, int j) {
 }
 
 /// The reported pair: distances recomputed directly, ordered by them.
-TwoNearest finish(const Running& running, const cv::Mat& queries, int query,
+TwoNearest finish(int best, int second, const cv::Mat& queries, int query,
                   const cv::Mat& references) {
-  TwoNearest result{running.best_index, running.second_index, kInf, kInf};
+  TwoNearest result{best, second, kInf, kInf};
   if (result.best >= 0) result.best_distance = l2(queries, query, references, result.best);
   if (result.second >= 0) result.second_distance = l2(queries, query, references, result.second);
   if (result.second >= 0 && result.second_distance < result.best_distance) {
@@ -153,21 +154,28 @@ TwoNearest finish(const Running& running, const cv::Mat& queries, int query,
   return result;
 }
 
-}  // namespace
-
-NearestNeighbours exactNearestNeighbours(const cv::Mat& queries, const cv::Mat& references,
-                                         bool with_reverse) {
-  NearestNeighbours result;
+/// Empty sets answer without a kernel; anything but two CV_32F matrices of equal columns throws.
+bool checkedTrivial(const cv::Mat& queries, const cv::Mat& references, bool with_reverse,
+                    NearestNeighbours* result) {
   if (queries.rows == 0 || references.rows == 0) {
-    result.forward.assign(static_cast<size_t>(queries.rows), TwoNearest{-1, -1, kInf, kInf});
-    if (with_reverse) result.reverse_nearest.assign(static_cast<size_t>(references.rows), -1);
-    return result;
+    result->forward.assign(static_cast<size_t>(queries.rows), TwoNearest{-1, -1, kInf, kInf});
+    if (with_reverse) result->reverse_nearest.assign(static_cast<size_t>(references.rows), -1);
+    return true;
   }
   if (queries.type() != CV_32F || references.type() != CV_32F || queries.cols != references.cols ||
       queries.dims != 2 || references.dims != 2) {
     throw std::invalid_argument(
         "exactNearestNeighbours: descriptors must be CV_32F, equal columns");
   }
+  return false;
+}
+
+}  // namespace
+
+NearestNeighbours float32NearestNeighbours(const cv::Mat& queries, const cv::Mat& references,
+                                         bool with_reverse) {
+  NearestNeighbours result;
+  if (checkedTrivial(queries, references, with_reverse, &result)) return result;
   // OpenBLAS's own threads would spin between calls and compete with the caller's work (SIFT of
   // the next image): one BLAS thread per call, the blocks on threads of ours.
   static std::once_flag single_threaded_blas;
@@ -188,8 +196,35 @@ NearestNeighbours exactNearestNeighbours(const cv::Mat& queries, const cv::Mat& 
   });
   if (with_reverse) result.reverse_nearest = mergeReverse(reverse);
   result.forward.reserve(static_cast<size_t>(nq));
-  for (int i = 0; i < nq; ++i) result.forward.push_back(finish(running[i], queries, i, references));
+  for (int i = 0; i < nq; ++i) {
+    result.forward.push_back(
+        finish(running[i].best_index, running[i].second_index, queries, i, references));
+  }
   return result;
+}
+
+NearestNeighbours exactNearestNeighbours(const cv::Mat& queries, const cv::Mat& references,
+                                         bool with_reverse) {
+  NearestNeighbours result;
+  if (checkedTrivial(queries, references, with_reverse, &result)) return result;
+  detail::NeighbourIndices indices;
+  if (!detail::byteNearestNeighbours(queries, references, with_reverse, &indices)) {
+    return float32NearestNeighbours(queries, references, with_reverse);
+  }
+  result.reverse_nearest = std::move(indices.reverse);
+  result.forward.reserve(static_cast<size_t>(queries.rows));
+  for (int i = 0; i < queries.rows; ++i) {
+    result.forward.push_back(finish(indices.best[i], indices.second[i], queries, i, references));
+  }
+  return result;
+}
+
+std::string exactNearestNeighboursKernel(const cv::Mat& queries, const cv::Mat& references) {
+  if (detail::byteKernelAvailable() && queries.rows > 0 && references.rows > 0 &&
+      detail::holdsBytes(queries) && detail::holdsBytes(references)) {
+    return "int8 AVX-512 VNNI";
+  }
+  return std::string("float32 OpenBLAS sgemm (") + openblas_get_corename() + " kernels)";
 }
 
 }  // namespace sift_hull
