@@ -135,6 +135,9 @@ TEST_F(HullNodeTest, ASilhouetteWhosePoseComesAfterTheTimeoutIsReportedAndNotCar
              error.find("pose_timeout_s") != std::string::npos;
     });
   })) << "no error for a pose that did not come in time";
+  EXPECT_GE(test::diagnosticValue(nh_, "hull", "views without pose", [](double n) { return n >= 1; }),
+            1.0)
+      << "the dropped view is not counted in /diagnostics";
   const PinholeCamera camera = turnedCamera(views_[0].view.camera);
   tf_.sendTransform(ros_conversions::cameraPoseMessage(camera, "world", "camera_late", {}));
   ros::WallDuration(2.0).sleep();  // the pose is in tf now: the view would be carved by then

@@ -20,6 +20,7 @@
 #include <string>
 
 #include "common/test_data.h"
+#include "diagnostics_wait.h"
 #include "hull_node_fixture.h"
 #include "ros_wait.h"
 #include "sift_hull/BoundingBoxQuery.h"
@@ -231,7 +232,10 @@ TEST_F(HullOctomapTest, ClearBbxFreesTheBoxUntilResetAndRefusesBadBoxes) {
       publishView(0, [](sensor_msgs::Image* image, sensor_msgs::CameraInfo* info) {
         image->header.frame_id = info->header.frame_id = "camera_turned";
       });
-  ASSERT_TRUE(octomapStampedAtLeast(turned)) << "the turned view was not carved";
+  ASSERT_TRUE(octomapStampedAtLeast(turned))
+      << "the turned view was not carved; the node's /diagnostics count "
+      << test::diagnosticValue(nh_, "hull", "views without pose", [](double) { return true; }, 5.0)
+      << " views without pose (dropped after ~pose_timeout_s)";
   EXPECT_EQ(stateAt(*readMap(*last_octomap_), 0.0, 0.0, 0.0), 0);
   EXPECT_EQ(stateAt(*readMap(*last_octomap_), 0.0, 0.0, 0.5), 1);
   ASSERT_NO_FATAL_FAILURE(carveSphere());  // ~reset, then the views again

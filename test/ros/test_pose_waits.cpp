@@ -1,5 +1,6 @@
 // The hull node's record of silhouettes waiting for their pose: reported once after the timeout,
-// refused when the pose comes too late, forgotten when tf gives up, bounded in size.
+// refused when the pose comes too late, forgotten when tf gives up (a dropped view counted once),
+// bounded in size.
 
 #include <gtest/gtest.h>
 
@@ -30,8 +31,13 @@ TEST(PoseWaits, ForgetsWhatTfGaveUpOnAndStaysBounded) {
   for (int i = 0; i < 5; ++i) waits.arrived("camera", i, t0 + milliseconds(i));
   EXPECT_EQ(waits.size(), 3u);
   EXPECT_TRUE(waits.posed("camera", 0.0));  // forgotten as the oldest: unknown
-  waits.forget("camera", 4.0);
+  EXPECT_TRUE(waits.forget("camera", 4.0));  // not reported yet: the caller counts it
   EXPECT_EQ(waits.size(), 2u);
+  // Reported by expire() already: forgetting it must not count the same view twice.
+  EXPECT_EQ(waits.expire(t0 + milliseconds(1100)).size(), 2u);
+  EXPECT_FALSE(waits.forget("camera", 3.0));
+  EXPECT_TRUE(waits.forget("camera", 9.0));  // never seen (or forgotten as the oldest)
+  EXPECT_EQ(waits.size(), 1u);
 }
 
 TEST(PoseWaits, NoTimeoutWhenNotPositive) {

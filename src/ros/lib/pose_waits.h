@@ -36,10 +36,15 @@ class PoseWaits {
     return in_time;
   }
 
-  /// tf gave up on it (dropped from its queue): forgets the wait.
-  void forget(const std::string& frame, double stamp_s) {
+  /// tf gave up on it (dropped from its queue): forgets the wait. False when expire() has
+  /// already reported it, so that a dropped view is counted once.
+  bool forget(const std::string& frame, double stamp_s) {
     std::lock_guard<std::mutex> lock(mutex_);
-    waits_.erase({frame, stamp_s});
+    const auto found = waits_.find({frame, stamp_s});
+    if (found == waits_.end()) return true;
+    const bool unreported = !found->second.expired;
+    waits_.erase(found);
+    return unreported;
   }
 
   /// The frame ids of the waits that passed the timeout since the last call, each once.

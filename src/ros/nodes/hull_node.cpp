@@ -120,6 +120,7 @@ void HullNode::onArrival(const sensor_msgs::ImageConstPtr& silhouette) {
 
 void HullNode::reportPoseTimeouts() {
   for (const std::string& frame : pose_waits_.expire(PoseWaits::Clock::now())) {
+    ++views_without_pose_;
     log_.error("hull: dropped a silhouette: ",
                "no pose of '" + frame + "' in '" + config_.world_frame + "' within " +
                    shortNumber(config_.pose_timeout_s) + " s (~pose_timeout_s)");
@@ -133,7 +134,8 @@ void HullNode::onPoseTooLate(const sensor_msgs::ImageConstPtr& silhouette) {
 
 void HullNode::onPoseMissing(const sensor_msgs::ImageConstPtr& silhouette,
                              tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
-  pose_waits_.forget(silhouette->header.frame_id, silhouette->header.stamp.toSec());
+  if (pose_waits_.forget(silhouette->header.frame_id, silhouette->header.stamp.toSec()))
+    ++views_without_pose_;
   const char* why = reason == tf2_ros::filter_failure_reasons::EmptyFrameID ? "empty frame id"
                     : reason == tf2_ros::filter_failure_reasons::OutTheBack
                         ? "older than the transforms tf keeps"
@@ -212,6 +214,7 @@ void HullNode::reportDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& st
   reportQueue(work_.counts(), "views", &status);
   status.add("views redundant", redundant_views_.load());
   status.add("views refused", refused_views_.load());
+  status.add("views without pose", views_without_pose_.load());
   status.add("free voxels (surface_points)", free_voxels_.load());
   status.add("last view carve ms", last_carve_ms_.load());
   status.add("last view publish ms", last_publish_ms_.load());

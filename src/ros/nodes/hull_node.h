@@ -183,6 +183,8 @@ class HullNode {
   std::atomic<double> last_carve_ms_{0.0}, last_publish_ms_{0.0}, last_view_stamp_{0.0};
   std::atomic<size_t> redundant_views_{0};
   std::atomic<size_t> refused_views_{0};
+  /// Views dropped because their pose did not come within ~pose_timeout_s, or never.
+  std::atomic<size_t> views_without_pose_{0};
   WorkQueue<View> work_;
   PairingWatch pairing_;  ///< silhouettes and camera_infos that arrive but do not pair
   NodeDiagnostics diagnostics_;
