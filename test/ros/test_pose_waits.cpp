@@ -36,7 +36,8 @@ TEST(PoseWaits, ForgetsWhatTfGaveUpOnAndStaysBounded) {
   // Reported by expire() already: forgetting it must not count the same view twice.
   EXPECT_EQ(waits.expire(t0 + milliseconds(1100)).size(), 2u);
   EXPECT_FALSE(waits.forget("camera", 3.0));
-  EXPECT_TRUE(waits.forget("camera", 9.0));  // never seen (or forgotten as the oldest)
+  EXPECT_FALSE(waits.forget("camera", 9.0));  // never seen
+  EXPECT_FALSE(waits.forget("camera", 4.0));  // forgotten already
   EXPECT_EQ(waits.size(), 1u);
 }
 

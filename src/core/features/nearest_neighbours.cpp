@@ -221,7 +221,8 @@ NearestNeighbours exactNearestNeighbours(const cv::Mat& queries, const cv::Mat& 
 
 std::string exactNearestNeighboursKernel(const cv::Mat& queries, const cv::Mat& references) {
   if (detail::byteKernelAvailable() && queries.rows > 0 && references.rows > 0 &&
-      detail::holdsBytes(queries) && detail::holdsBytes(references)) {
+      queries.cols > 0 && queries.cols == references.cols && detail::holdsBytes(queries) &&
+      detail::holdsBytes(references)) {
     return "int8 AVX-512 VNNI";
   }
   return std::string("float32 OpenBLAS sgemm (") + openblas_get_corename() + " kernels)";

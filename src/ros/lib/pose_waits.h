@@ -36,12 +36,14 @@ class PoseWaits {
     return in_time;
   }
 
-  /// tf gave up on it (dropped from its queue): forgets the wait. False when expire() has
-  /// already reported it, so that a dropped view is counted once.
+  /// tf gave up on it (dropped from its queue): forgets the wait. True when this is the first
+  /// word of its loss: false when expire() has reported it already or the wait is unknown, so
+  /// that a dropped view is counted once. (The wait is always known in the node: its capacity
+  /// is four times tf's queue, which drops a silhouette before this would.)
   bool forget(const std::string& frame, double stamp_s) {
     std::lock_guard<std::mutex> lock(mutex_);
     const auto found = waits_.find({frame, stamp_s});
-    if (found == waits_.end()) return true;
+    if (found == waits_.end()) return false;
     const bool unreported = !found->second.expired;
     waits_.erase(found);
     return unreported;
