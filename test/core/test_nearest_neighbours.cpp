@@ -89,11 +89,13 @@ cv::Mat byteDescriptors(int rows, int cols, int levels, unsigned seed) {
 /// the lowest index first among equals: what the integer kernel must give exactly.
 struct IntegerReference {
   std::vector<int> best, second, reverse;
+  std::vector<int32_t> best_squared, second_squared;  ///< -1 where there is no neighbour
 };
 
 IntegerReference integerReference(const cv::Mat& q, const cv::Mat& r) {
   IntegerReference out{std::vector<int>(q.rows, -1), std::vector<int>(q.rows, -1),
-                       std::vector<int>(r.rows, -1)};
+                       std::vector<int>(r.rows, -1), std::vector<int32_t>(q.rows, -1),
+                       std::vector<int32_t>(q.rows, -1)};
   std::vector<int64_t> reverse_best(r.rows, std::numeric_limits<int64_t>::max());
   for (int i = 0; i < q.rows; ++i) {
     int64_t b1 = std::numeric_limits<int64_t>::max(), b2 = b1;
@@ -110,6 +112,8 @@ IntegerReference integerReference(const cv::Mat& q, const cv::Mat& r) {
       }
       if (d2 < reverse_best[j]) reverse_best[j] = d2, out.reverse[j] = i;
     }
+    if (out.best[i] >= 0) out.best_squared[i] = static_cast<int32_t>(b1);
+    if (out.second[i] >= 0) out.second_squared[i] = static_cast<int32_t>(b2);
   }
   return out;
 }
@@ -126,7 +130,7 @@ TEST(ExactNearestNeighbours, ByteKernelIsExactWithTiesAndOddShapes) {
         const unsigned seed = static_cast<unsigned>(cols * 1000 + nq * 7 + nr + levels);
         const cv::Mat q = byteDescriptors(nq, cols, levels, seed);
         const cv::Mat r = byteDescriptors(nr, cols, levels, seed + 1);
-        detail::NeighbourIndices got;
+        detail::ExactNeighbours got;
         ASSERT_TRUE(detail::byteNearestNeighbours(q, r, true, &got));
         const IntegerReference want = integerReference(q, r);
         const std::string what = std::to_string(nq) + " x " + std::to_string(nr) + ", " +
@@ -135,6 +139,8 @@ TEST(ExactNearestNeighbours, ByteKernelIsExactWithTiesAndOddShapes) {
         EXPECT_EQ(got.best, want.best) << what;
         EXPECT_EQ(got.second, want.second) << what;
         EXPECT_EQ(got.reverse, want.reverse) << what;
+        EXPECT_EQ(got.best_squared, want.best_squared) << what;
+        EXPECT_EQ(got.second_squared, want.second_squared) << what;
         ++cases;
       }
     }
@@ -151,7 +157,7 @@ TEST(ExactNearestNeighbours, ByteKernelSumsStayExactAtItsWidestDescriptors) {
   q.row(1).setTo(255.0f);
   q.at<float>(2, 0) = 255.0f;
   const cv::Mat r = q.clone();
-  detail::NeighbourIndices got;
+  detail::ExactNeighbours got;
   ASSERT_TRUE(detail::byteNearestNeighbours(q, r, true, &got));
   EXPECT_EQ(got.best, (std::vector<int>{0, 1, 2}));
   EXPECT_EQ(got.second, (std::vector<int>{2, 2, 0}));

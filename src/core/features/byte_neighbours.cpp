@@ -62,9 +62,9 @@ struct PackedReferences {
 };
 
 struct PackedQueries {
-  int rows = 0, groups = 0;  // rows padded to a whole tile
-  Aligned<int8_t> bytes;     // rows x groups x 4
-  Aligned<int32_t> norm2;    // rows: ||q||^2, kFar for padding
+  int groups = 0;
+  Aligned<int8_t> bytes;   // rows (padded to a whole tile) x groups x 4
+  Aligned<int32_t> norm2;  // per row: ||q||^2, kFar for padding
 };
 
 bool packReferences(const cv::Mat& r, PackedReferences* out) {
@@ -95,7 +95,7 @@ bool packReferences(const cv::Mat& r, PackedReferences* out) {
 bool packQueries(const cv::Mat& q, PackedQueries* out) {
   const int d = q.cols, groups = (d + 3) / 4;
   const int rows = (q.rows + kTileQueries - 1) / kTileQueries * kTileQueries;
-  out->rows = rows, out->groups = groups;
+  out->groups = groups;
   out->bytes = alignedArray<int8_t>(static_cast<size_t>(rows) * groups * 4);
   out->norm2 = alignedArray<int32_t>(static_cast<size_t>(rows));
   std::fill_n(out->bytes.get(), static_cast<size_t>(rows) * groups * 4, int8_t{0});
@@ -211,7 +211,7 @@ SIFT_HULL_VNNI void tile(const PackedQueries& q, const PackedReferences& r, int 
 
 /// A query's two nearest from its 16 lanes: smallest distance first, the lower index among
 /// equals; padding references (kFar and beyond) are never chosen.
-void reduceLanes(const ForwardState& state, int s, int* best, int* second) {
+void reduceLanes(const ForwardState& state, int s, int32_t norm2, ExactNeighbours* out, int query) {
   struct Candidate {
     int32_t value;
     int32_t index;
@@ -232,7 +232,10 @@ void reduceLanes(const ForwardState& state, int s, int* best, int* second) {
     offer({state.best[s][l], state.best_index[s][l]});
     offer({state.second[s][l], state.second_index[s][l]});
   }
-  *best = first.index, *second = next.index;
+  out->best[query] = first.index, out->second[query] = next.index;
+  // The lanes hold distance - ||q||^2: the squared distances are exact integers.
+  out->best_squared[query] = first.index >= 0 ? first.value + norm2 : -1;
+  out->second_squared[query] = next.index >= 0 ? next.value + norm2 : -1;
 }
 
 void initialise(ForwardState* state) {
@@ -246,7 +249,7 @@ void initialise(ForwardState* state) {
 
 /// One block of queries against every reference: chunks of panels, each swept by every tile.
 void scanBlock(const PackedQueries& q, const PackedReferences& r, int first, int count,
-               ForwardState* state, ReverseState* reverse, NeighbourIndices* out) {
+               ForwardState* state, ReverseState* reverse, ExactNeighbours* out) {
   initialise(state);
   const int tiles = (count + kTileQueries - 1) / kTileQueries;
   for (int p0 = 0; p0 < r.panels; p0 += kChunkPanels) {
@@ -258,7 +261,7 @@ void scanBlock(const PackedQueries& q, const PackedReferences& r, int first, int
     }
   }
   for (int s = 0; s < count; ++s) {
-    reduceLanes(*state, s, &out->best[first + s], &out->second[first + s]);
+    reduceLanes(*state, s, q.norm2[first + s], out, first + s);
   }
 }
 
@@ -271,9 +274,14 @@ bool byteKernelAvailable() {
   return available;
 }
 
+bool byteKernelFits(const cv::Mat& queries, const cv::Mat& references) {
+  return byteKernelAvailable() && queries.type() == CV_32F && references.type() == CV_32F &&
+         queries.dims == 2 && references.dims == 2 && queries.cols == references.cols &&
+         queries.cols >= 1 && queries.cols <= kMaxByteColumns && queries.rows >= 1 &&
+         references.rows >= 1;
+}
+
 bool holdsBytes(const cv::Mat& descriptors) {
-  if (descriptors.type() != CV_32F || descriptors.dims != 2 || descriptors.cols > kMaxByteColumns)
-    return false;
   for (int i = 0; i < descriptors.rows; ++i) {
     const float* row = descriptors.ptr<float>(i);
     for (int k = 0; k < descriptors.cols; ++k) {
@@ -284,18 +292,16 @@ bool holdsBytes(const cv::Mat& descriptors) {
 }
 
 bool byteNearestNeighbours(const cv::Mat& queries, const cv::Mat& references, bool with_reverse,
-                           NeighbourIndices* out) {
-  if (!byteKernelAvailable() || queries.type() != CV_32F || references.type() != CV_32F ||
-      queries.cols != references.cols || queries.cols < 1 || queries.cols > kMaxByteColumns ||
-      queries.rows < 1 || references.rows < 1) {
-    return false;
-  }
+                           ExactNeighbours* out) {
+  if (!byteKernelFits(queries, references)) return false;
   PackedQueries q;
   PackedReferences r;
   if (!packReferences(references, &r) || !packQueries(queries, &q)) return false;
   const int nq = queries.rows;
   out->best.assign(static_cast<size_t>(nq), -1);
   out->second.assign(static_cast<size_t>(nq), -1);
+  out->best_squared.assign(static_cast<size_t>(nq), -1);
+  out->second_squared.assign(static_cast<size_t>(nq), -1);
   const int blocks = (nq + kBlockQueries - 1) / kBlockQueries;
   const int threads = std::max(1, std::min<int>(std::thread::hardware_concurrency(), blocks));
   std::vector<ReverseState> reverse;
@@ -331,6 +337,8 @@ bool byteNearestNeighbours(const cv::Mat& queries, const cv::Mat& references, bo
 #else  // not x86-64: the float32 path serves every descriptor
 
 bool byteKernelAvailable() { return false; }
+
+bool byteKernelFits(const cv::Mat&, const cv::Mat&) { return false; }
 
 bool holdsBytes(const cv::Mat&) { return false; }
 

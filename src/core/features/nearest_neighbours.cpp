@@ -3,6 +3,7 @@
 #include <cblas.h>
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <mutex>
 #include <opencv2/core/hal/intrin.hpp>
@@ -142,9 +143,9 @@ float l2(const cv::Mat& a, int i, const cv::Mat& b, int j) {
 }
 
 /// The reported pair: distances recomputed directly, ordered by them.
-TwoNearest finish(int best, int second, const cv::Mat& queries, int query,
+TwoNearest finish(const Running& running, const cv::Mat& queries, int query,
                   const cv::Mat& references) {
-  TwoNearest result{best, second, kInf, kInf};
+  TwoNearest result{running.best_index, running.second_index, kInf, kInf};
   if (result.best >= 0) result.best_distance = l2(queries, query, references, result.best);
   if (result.second >= 0) result.second_distance = l2(queries, query, references, result.second);
   if (result.second >= 0 && result.second_distance < result.best_distance) {
@@ -196,10 +197,7 @@ NearestNeighbours float32NearestNeighbours(const cv::Mat& queries, const cv::Mat
   });
   if (with_reverse) result.reverse_nearest = mergeReverse(reverse);
   result.forward.reserve(static_cast<size_t>(nq));
-  for (int i = 0; i < nq; ++i) {
-    result.forward.push_back(
-        finish(running[i].best_index, running[i].second_index, queries, i, references));
-  }
+  for (int i = 0; i < nq; ++i) result.forward.push_back(finish(running[i], queries, i, references));
   return result;
 }
 
@@ -207,21 +205,26 @@ NearestNeighbours exactNearestNeighbours(const cv::Mat& queries, const cv::Mat& 
                                          bool with_reverse) {
   NearestNeighbours result;
   if (checkedTrivial(queries, references, with_reverse, &result)) return result;
-  detail::NeighbourIndices indices;
-  if (!detail::byteNearestNeighbours(queries, references, with_reverse, &indices)) {
+  detail::ExactNeighbours exact;
+  if (!detail::byteNearestNeighbours(queries, references, with_reverse, &exact)) {
     return float32NearestNeighbours(queries, references, with_reverse);
   }
-  result.reverse_nearest = std::move(indices.reverse);
+  // The kernel's squared distances are exact integers: their square roots are what a direct
+  // recomputation would give.
+  const auto root = [](int32_t squared) {
+    return squared < 0 ? kInf : static_cast<float>(std::sqrt(static_cast<double>(squared)));
+  };
+  result.reverse_nearest = std::move(exact.reverse);
   result.forward.reserve(static_cast<size_t>(queries.rows));
-  for (int i = 0; i < queries.rows; ++i) {
-    result.forward.push_back(finish(indices.best[i], indices.second[i], queries, i, references));
+  for (size_t i = 0; i < static_cast<size_t>(queries.rows); ++i) {
+    result.forward.push_back({exact.best[i], exact.second[i], root(exact.best_squared[i]),
+                              root(exact.second_squared[i])});
   }
   return result;
 }
 
 std::string exactNearestNeighboursKernel(const cv::Mat& queries, const cv::Mat& references) {
-  if (detail::byteKernelAvailable() && queries.rows > 0 && references.rows > 0 &&
-      queries.cols > 0 && queries.cols == references.cols && detail::holdsBytes(queries) &&
+  if (detail::byteKernelFits(queries, references) && detail::holdsBytes(queries) &&
       detail::holdsBytes(references)) {
     return "int8 AVX-512 VNNI";
   }
