@@ -342,7 +342,7 @@ bool byteKernelFits(const cv::Mat&, const cv::Mat&) { return false; }
 
 bool holdsBytes(const cv::Mat&) { return false; }
 
-bool byteNearestNeighbours(const cv::Mat&, const cv::Mat&, bool, NeighbourIndices*) {
+bool byteNearestNeighbours(const cv::Mat&, const cv::Mat&, bool, ExactNeighbours*) {
   return false;
 }
 
