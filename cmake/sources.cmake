@@ -5,6 +5,7 @@
 # Included by the package's CMakeLists.txt and by test/sanitize/CMakeLists.txt, so that both build
 # the libraries from the same lists (docs/ARCHITECTURE.md).
 set(SIFT_HULL_CORE_SOURCES
+  src/core/common/settings.cpp
   src/core/geometry/camera.cpp
   src/core/geometry/camera_set.cpp
   src/core/geometry/correspondence.cpp
@@ -18,6 +19,7 @@ set(SIFT_HULL_CORE_SOURCES
   src/core/filters/densest_window.cpp
   src/core/filters/epipolar.cpp
   src/core/filters/filter.cpp
+  src/core/filters/filter_settings.cpp
   src/core/filters/gms.cpp
   src/core/filters/gsc.cpp
   src/core/filters/guided.cpp
@@ -34,6 +36,7 @@ set(SIFT_HULL_CORE_SOURCES
   src/core/hull/field_sampling.cpp
   src/core/hull/hull_octomap.cpp
   src/core/hull/hull_pipeline.cpp
+  src/core/hull/hull_settings.cpp
   src/core/hull/hull_stream.cpp
   src/core/hull/hull_view.cpp
   src/core/hull/marching_cubes.cpp
@@ -47,6 +50,7 @@ set(SIFT_HULL_CORE_SOURCES
   src/core/hull/silhouette.cpp
   src/core/refine/dense_matching.cpp
   src/core/refine/free_space.cpp
+  src/core/refine/refine_settings.cpp
   src/core/refine/surface_points.cpp
 )
 set(SIFT_HULL_IO_SOURCES

@@ -23,31 +23,13 @@ ArgParser::ArgParser(std::string command, std::string summary)
 
 void ArgParser::addFlag(const std::string& name, const std::string& help) {
   order_.push_back(name);
-  specs_[name] = {"", help, "", {}};
+  specs_[name] = {"", help, ""};
 }
 
 void ArgParser::addOption(const std::string& name, const std::string& value_name,
                           const std::string& help, const std::string& default_value) {
   order_.push_back(name);
-  specs_[name] = {value_name, help, default_value, {}};
-}
-
-void ArgParser::addDeprecatedAlias(const std::string& old_name,
-                                   const std::vector<std::string>& names) {
-  if (names.empty() || specs_.count(old_name) > 0) {
-    throw std::logic_error("addDeprecatedAlias: bad alias --" + old_name);
-  }
-  std::string uses;
-  for (const std::string& name : names) {
-    const auto spec = specs_.find(name);
-    if (spec == specs_.end() || !spec->second.replaced_by.empty() ||
-        spec->second.value_name.empty() != specs_.at(names.front()).value_name.empty()) {
-      throw std::logic_error("addDeprecatedAlias: --" + old_name + " cannot stand for --" + name);
-    }
-    uses += (uses.empty() ? "--" : " and --") + name;
-  }
-  order_.push_back(old_name);
-  specs_[old_name] = {specs_.at(names.front()).value_name, "deprecated: use " + uses, "", names};
+  specs_[name] = {value_name, help, default_value};
 }
 
 void ArgParser::addPositional(const std::string& name, const std::string& help) {
@@ -62,7 +44,6 @@ bool ArgParser::parse(const std::vector<std::string>& args) {
     }
   }
   size_t next_positional = 0;
-  std::vector<std::pair<std::string, std::string>> aliased;  // (deprecated name, value)
   for (size_t i = 0; i < args.size(); ++i) {
     const std::string& arg = args[i];
     if (arg.rfind("--", 0) != 0) {
@@ -87,41 +68,12 @@ bool ArgParser::parse(const std::vector<std::string>& args) {
     } else {
       throw UsageError("--" + name + " needs a value (" + spec->second.value_name + ")");
     }
-    if (spec->second.replaced_by.empty()) {
-      store(name, value);
-    } else {
-      aliased.emplace_back(name, value);
-    }
+    store(name, value);
   }
   if (next_positional < positionals_.size()) {
     throw UsageError("missing argument " + positionals_[next_positional].first);
   }
-  resolveAliases(aliased);
   return true;
-}
-
-void ArgParser::resolveAliases(const std::vector<std::pair<std::string, std::string>>& given) {
-  std::vector<std::string> warned;
-  std::map<std::string, bool> given_directly;
-  for (const auto& [old_name, value] : given) {
-    const std::vector<std::string>& names = specs_.at(old_name).replaced_by;
-    std::string uses, ignored_for;
-    for (const std::string& name : names) {
-      uses += (uses.empty() ? "--" : " and --") + name;
-      if (given_directly.count(name) == 0) given_directly[name] = values_.count(name) > 0;
-      if (given_directly[name]) {
-        ignored_for += (ignored_for.empty() ? "--" : ", --") + name;
-      } else {
-        store(name, value);
-      }
-    }
-    if (std::find(warned.begin(), warned.end(), old_name) != warned.end()) continue;
-    warned.push_back(old_name);
-    std::cerr << program_name << " " << command_ << ": warning: --" << old_name
-              << " is deprecated, use " << uses;
-    if (!ignored_for.empty()) std::cerr << " (" << ignored_for << ", given too, wins)";
-    std::cerr << '\n';
-  }
 }
 
 std::string ArgParser::help() const {
@@ -138,18 +90,8 @@ std::string ArgParser::help() const {
         << spec.help;
     if (!spec.default_value.empty()) out << " (default: " << spec.default_value << ")";
   };
-  for (const std::string& name : order_) {
-    if (specs_.at(name).replaced_by.empty()) option(name);
-  }
+  for (const std::string& name : order_) option(name);
   out << "\n  --help\n      show this text\n";
-  bool deprecated = false;
-  for (const std::string& name : order_) {
-    if (specs_.at(name).replaced_by.empty()) continue;
-    if (!deprecated) out << "\nDeprecated names, still accepted with a warning on stderr:";
-    deprecated = true;
-    option(name);
-  }
-  if (deprecated) out << "\n";
   return out.str();
 }
 

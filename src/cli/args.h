@@ -27,14 +27,9 @@ class ArgParser {
   void addOption(const std::string& name, const std::string& value_name, const std::string& help,
                  const std::string& default_value = "");
   void addPositional(const std::string& name, const std::string& help);
-  /// An old name of the options (or flags) `names`, added before: a value given with it goes to
-  /// each of them that is not given itself, with a deprecation warning on stderr naming them.
-  /// --help lists it as deprecated.
-  void addDeprecatedAlias(const std::string& old_name, const std::vector<std::string>& names);
 
   /// Returns false, after printing the help text on stdout, when --help is among the arguments.
-  /// Throws UsageError for unknown options, missing values or missing positionals. Deprecated
-  /// names are warned about on stderr (stdout stays the command's output).
+  /// Throws UsageError for unknown options, missing values or missing positionals.
   bool parse(const std::vector<std::string>& args);
   std::string help() const;
 
@@ -54,15 +49,12 @@ class ArgParser {
     std::string value_name;  // empty for a flag
     std::string help;
     std::string default_value;
-    std::vector<std::string> replaced_by;  // non-empty for a deprecated alias
   };
   std::string command_, summary_;
   std::vector<std::string> order_;
   std::map<std::string, Spec> specs_;
   std::vector<std::pair<std::string, std::string>> positionals_;
   void store(const std::string& name, const std::string& value);
-  /// Hands the values given with deprecated aliases to their new names, warning on stderr.
-  void resolveAliases(const std::vector<std::pair<std::string, std::string>>& given);
 
   std::map<std::string, std::string> values_;  ///< the last value of each option
   std::map<std::string, std::vector<std::string>> repeated_values_;

@@ -73,7 +73,6 @@ int runScene(const std::vector<std::string>& args) {
   parser.addOption("seed", "S", "texture and camera jitter seed", std::to_string(defaults.seed));
   parser.addOption("camera-distance-m", "M", "camera distance from the object's centre in metres",
                    numberText(defaults.camera_distance_m));
-  parser.addDeprecatedAlias("distance", {"camera-distance-m"});
   parser.addOption("background", "NAME",
                    "what the rays missing the object see: " + joined(sceneBackgrounds()) +
                        " (blue: uniform dark blue; textured: coloured blobs)",

@@ -6,7 +6,9 @@
 
 #include "sift_hull/hull/hull_config.h"
 #include "sift_hull/hull/hull_pipeline.h"
+#include "sift_hull/hull/hull_stream.h"
 #include "sift_hull/hull/silhouette.h"
+#include "setting_options.h"
 #include "sift_hull/io/view_list.h"
 #include "silhouette_options.h"
 
@@ -66,58 +68,29 @@ HullInput runLengthViewSetFromArgs(const ArgParser& parser) {
 }
 
 void addHullOptions(ArgParser* parser) {
-  const HullConfig defaults;
-  std::ostringstream slack;
-  slack << defaults.distance_slack_px;
-  parser->addOption("max-depth", "L", "octree depth: resolution = cube edge / 2^L",
-                    std::to_string(defaults.max_depth));
-  parser->addDeprecatedAlias("depth", {"max-depth"});
-  parser->addOption("resolution-m", "M",
-                    "finest cell edge in metres instead of --max-depth (octomap_server's "
-                    "resolution): the least depth whose cube of such cells holds the box; 0 = "
-                    "from --max-depth",
-                    "0");
-  parser->addFlag("carve-outside-image", "views carve what they see outside their image");
-  parser->addOption("distance-slack-px", "PX",
-                    "margin added to a cell's projected radius, in pixels", slack.str());
-  parser->addDeprecatedAlias("slack", {"distance-slack-px"});
-  parser->addOption("distance-reduction", "S",
-                    "image pixels per distance-map element: 0 = per view from the voxel's "
-                    "projected size, 1 = full resolution, 2..15 = forced",
-                    std::to_string(defaults.distance_reduction));
-  parser->addOption("threads", "N", "threads for distance transforms, carving and meshing",
-                    std::to_string(defaults.threads));
+  addSettingOptions(parser, settingsOf<HullConfig>());
   parser->addOption("box", "XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX",
                     "bounding box in world units instead of solving the LP");
 }
 
 HullConfig hullConfigFromArgs(const ArgParser& parser) {
   HullConfig config;
-  config.max_depth = parser.getInt("max-depth");
-  config.resolution_m = parser.getDouble("resolution-m");
-  config.carve_outside_image = parser.flag("carve-outside-image");
-  config.distance_slack_px = parser.getDouble("distance-slack-px");
-  config.threads = parser.getInt("threads");
-  config.distance_reduction = parser.getInt("distance-reduction");
+  settingsFromArgs(parser, settingsOf<HullConfig>(), &config);
   validateOptions(config);
   return config;
 }
 
 std::optional<Box3d> boxFromArgs(const ArgParser& parser) {
   if (!parser.has("box")) return std::nullopt;
-  std::istringstream in(parser.get("box"));
-  double values[6];
-  char comma = ',';
-  for (int i = 0; i < 6; ++i) {
-    if ((i > 0 && !(in >> comma)) || comma != ',' || !(in >> values[i])) {
-      throw UsageError("--box expects six comma-separated numbers");
-    }
+  const Setting<HullStreamConfig>* box = settingsOf<HullStreamConfig>().find("box");
+  HullStreamConfig config;
+  try {
+    box->set(&config, optionValue(parser, box->info));
+  } catch (const std::invalid_argument& error) {
+    throw UsageError("--" + std::string(error.what()));
   }
-  Box3d box;
-  box.min_W = Eigen::Vector3d(values[0], values[1], values[2]);
-  box.max_W = Eigen::Vector3d(values[3], values[4], values[5]);
-  if (!(box.size().array() > 0.0).all()) throw UsageError("--box: each max must exceed its min");
-  return box;
+  if (!config.box) throw UsageError("--box expects six comma-separated numbers");
+  return config.box;
 }
 
 namespace {

@@ -1,5 +1,5 @@
 // sift_hull: the offline program, which links no ROS library (the ROS tools are sift_hull_ros,
-// src/cli/ros).
+// src/ros/tools).
 #include "commands.h"
 
 namespace sift_hull {

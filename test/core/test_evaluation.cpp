@@ -348,50 +348,28 @@ TEST(MatchCommand, ScoresFiltersOnASceneAndDrawsFigures) {
   EXPECT_FALSE(cv::imread(out_dir + "/histograms.png").empty());
 }
 
-TEST(MatchCommand, OldFlagNamesStillWorkWithAWarningOnStderr) {
+TEST(MatchCommand, FilterFlagsAreTheSettingNamesAndOldNamesAreRefused) {
   const std::string scene = writtenScene();
   const std::string match = "match " + scene + "/view_0000.png " + scene + "/view_0001.png" +
                             " --gt-scene " + scene +
                             " --json --filter gsc --filter ransac --filter magsac --filter gms ";
-  const auto kept = [&](const std::string& flags, std::string* err) {
-    std::string out;
-    EXPECT_EQ(test::runProgram(match + flags, &out, err), 0) << *err;
-    const nlohmann::json result = nlohmann::json::parse(out);  // stdout holds it alone
-    std::map<std::string, int> counts;
-    for (const auto& [name, run] : result["filters"].items()) {
-      counts[name] = run["kept"].get<int>();
-    }
-    return counts;
-  };
-  std::string new_err, old_err, err;
-  const std::map<std::string, int> with_new = kept(
-      "--max-histogram-distance 0 --ransac-max-epipolar-px 3 --magsac-max-epipolar-px 3 "
-      "--grid-cells 10 --with-rotation --with-scale --backend flann "
-      "--max-descriptor-distance 300 --sigma-px 1.5",
-      &new_err);
-  const std::map<std::string, int> with_old = kept(
-      "--gsc-max-distance 0 --ransac-px 3 --gms-cells 10 --gms-rotation --gms-scale "
-      "--matcher flann --max-distance 300 --sigma 1.5",
-      &old_err);
-  EXPECT_EQ(with_old, with_new);
-  EXPECT_LT(with_new.at("gsc"), 3);  // histograms equal to the last bin: hardly any
-  EXPECT_EQ(new_err.find("deprecated"), std::string::npos) << new_err;
-  for (const char* warning :
-       {"warning: --gsc-max-distance is deprecated, use --max-histogram-distance\n",
-        "warning: --ransac-px is deprecated, use --ransac-max-epipolar-px and "
-        "--magsac-max-epipolar-px\n",
-        "warning: --gms-cells is deprecated, use --grid-cells\n",
-        "warning: --gms-rotation is deprecated, use --with-rotation\n",
-        "warning: --gms-scale is deprecated, use --with-scale\n",
-        "warning: --matcher is deprecated, use --backend\n",
-        "warning: --max-distance is deprecated, use --max-descriptor-distance\n",
-        "warning: --sigma is deprecated, use --sigma-px\n"}) {
-    EXPECT_NE(old_err.find(warning), std::string::npos) << warning << " not in " << old_err;
+  std::string out, err;
+  ASSERT_EQ(test::runProgram(match +
+                                 "--gsc-max-histogram-distance 0 --ransac-max-epipolar-px 3 "
+                                 "--magsac-max-epipolar-px 3 --gms-grid-cells 10 "
+                                 "--gms-with-rotation --gms-with-scale --backend flann "
+                                 "--max-descriptor-distance 300 --sigma-px 1.5",
+                             &out, &err),
+            0)
+      << err;
+  const nlohmann::json result = nlohmann::json::parse(out);  // stdout holds it alone
+  EXPECT_LT(result["filters"]["gsc"]["kept"].get<int>(), 3);  // histograms equal to the last bin
+  EXPECT_GT(result["filters"]["magsac"]["kept"].get<int>(), 20);
+  for (const char* old : {"--gsc-max-distance 0", "--ransac-px 3", "--gms-cells 10", "--sigma 1.5",
+                          "--max-histogram-distance 0", "--grid-cells 10"}) {
+    EXPECT_EQ(test::runProgram(match + old, &out, &err), 2) << old;
+    EXPECT_NE(err.find("unknown option"), std::string::npos) << err;
   }
-  // --ransac-px sets both inlier thresholds, but not one given by its own name.
-  const std::map<std::string, int> mixed = kept("--ransac-px 3 --magsac-max-epipolar-px 1", &err);
-  EXPECT_NE(err.find("(--magsac-max-epipolar-px, given too, wins)"), std::string::npos) << err;
-  EXPECT_EQ(mixed, kept("--ransac-max-epipolar-px 3", &err));
 }
 
 TEST(MatchCommand, MissingImageExitsWithOne) {

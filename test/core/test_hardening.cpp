@@ -285,7 +285,7 @@ TEST_F(HostileCommandLine, OutOfRangeSettingsAreUsageErrors) {
   EXPECT_EQ(hull("--threads 100000", &err), 2);
   EXPECT_EQ(hull("--views ,", &err), 2);
   const std::string left = *scene_ + "/view_0000.png", right = *scene_ + "/view_0001.png";
-  EXPECT_EQ(test::runProgram("match " + left + " " + right + " --filter gms --grid-cells 100000",
+  EXPECT_EQ(test::runProgram("match " + left + " " + right + " --filter gms --gms-grid-cells 100000",
                              &out, &err),
             2);
   EXPECT_EQ(test::runProgram("match " + left + " " + right + " --filter +gsc", &out, &err), 2);

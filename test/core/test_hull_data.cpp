@@ -89,7 +89,7 @@ TEST(HullCommand, WritesMeshOctreeAndRenderOfASyntheticScene) {
   }
 }
 
-TEST(HullCommand, OldFlagNamesStillWorkWithAWarningOnStderr) {
+TEST(HullCommand, FlagsAreTheSettingNamesAndOldNamesAreRefused) {
   const std::string dir = test::temporaryDirectory();
   std::string out, err;
   ASSERT_EQ(test::runProgram("scene --out " + dir + " --views 8 --size 320x240", &out, &err), 0)
@@ -101,32 +101,17 @@ TEST(HullCommand, OldFlagNamesStillWorkWithAWarningOnStderr) {
     EXPECT_EQ(test::runProgram(hull + flags, &json, errors), 0) << *errors;
     return nlohmann::json::parse(json);  // stdout holds the JSON object alone
   };
-  std::string new_err, old_err, both_err;
+  std::string new_err, err;
   const nlohmann::json with_new =
       run("--max-depth 5 --distance-slack-px 3 --dilate-px 3 --erode-px 1", &new_err);
-  const nlohmann::json with_old = run("--depth 5 --slack 3 --dilate 3 --erode 1", &old_err);
   const nlohmann::json with_defaults = run("--max-depth 5", &err);
   EXPECT_EQ(with_new["max_depth"], 5);
-  EXPECT_EQ(with_old["max_depth"], 5);
-  EXPECT_EQ(with_old["occupied_leaves"], with_new["occupied_leaves"]);
-  EXPECT_EQ(with_old["mesh"]["faces"], with_new["mesh"]["faces"]);
   // measured: 1607 and 1537 leaves
   EXPECT_NE(with_new["occupied_leaves"], with_defaults["occupied_leaves"]);
-  EXPECT_EQ(new_err.find("deprecated"), std::string::npos) << new_err;
-  for (const char* warning : {"warning: --depth is deprecated, use --max-depth\n",
-                              "warning: --slack is deprecated, use --distance-slack-px\n",
-                              "warning: --dilate is deprecated, use --dilate-px\n",
-                              "warning: --erode is deprecated, use --erode-px\n"}) {
-    EXPECT_NE(old_err.find(warning), std::string::npos) << warning << " not in " << old_err;
+  std::string json;
+  for (const char* old : {"--depth 5", "--slack 3", "--dilate 3", "--erode 1"}) {
+    EXPECT_EQ(test::runProgram(hull + old, &json, &err), 2) << old;
   }
-  // Both names given: the new one wins, whatever the order.
-  const nlohmann::json with_both = run("--max-depth 5 --depth 4", &both_err);
-  EXPECT_EQ(with_both["max_depth"], 5);
-  EXPECT_NE(both_err.find("--depth is deprecated, use --max-depth (--max-depth, given too, wins)"),
-            std::string::npos)
-      << both_err;
-  ASSERT_EQ(test::runProgram("hull --help", &out, &err), 0);
-  EXPECT_NE(out.find("--depth L\n      deprecated: use --max-depth"), std::string::npos) << out;
 }
 
 TEST(HullCommand, ReportsTooFewViewsClearly) {

@@ -44,7 +44,7 @@ std::vector<double> referenceLsc(const PutativeMatches& input, const LscConfig& 
   for (size_t m = 0; m < input.matches.size(); ++m) {
     left.push_back(input.left(m).pt), right.push_back(input.right(m).pt);
   }
-  const size_t k = config.lsc_neighbours;
+  const size_t k = config.neighbours;
   const auto near_left = referenceNeighbours(left, k), near_right = referenceNeighbours(right, k);
   std::vector<double> support(input.matches.size());
   for (size_t m = 0; m < input.matches.size(); ++m) {
@@ -55,8 +55,8 @@ std::vector<double> referenceLsc(const PutativeMatches& input, const LscConfig& 
       const double px = from.x + scale * (std::cos(angle) * offset.x - std::sin(angle) * offset.y);
       const double py = from.y + scale * (std::sin(angle) * offset.x + std::cos(angle) * offset.y);
       const double tolerance =
-          config.lsc_max_relative_error * scale * std::hypot(offset.x, offset.y) +
-          config.lsc_min_tolerance_px;
+          config.max_relative_error * scale * std::hypot(offset.x, offset.y) +
+          config.min_tolerance_px;
       return std::hypot(to.x - px, to.y - py) <= tolerance;
     };
     size_t agree = 0;
@@ -114,7 +114,7 @@ TEST(Lsc, EqualsThePlainReference) {
     const std::vector<double> slow = referenceLsc(input.putative, config);
     size_t differ = 0;
     for (size_t m = 0; m < slow.size(); ++m)
-      differ += fast.keep[m] != (slow[m] >= config.lsc_min_support);
+      differ += fast.keep[m] != (slow[m] >= config.min_support);
     EXPECT_LE(differ, slow.size() / 500) << "float rounding only, outliers " << outliers;
   }
 }
@@ -178,7 +178,7 @@ TEST(LocalGsc, HistogramOverTheNeighbourUnionMatchesItsDefinition) {
     input.matches.emplace_back(int(i), int(i), 0.f);
   }
   LocalGscConfig config;
-  config.local_gsc_neighbours = 2;
+  config.neighbours = 2;
   const FilterResult shifted = filterLocalGsc(input, config);
   for (double score : shifted.score) EXPECT_EQ(score, 0.0);
   // Swapping two right points breaks the layout around them.
@@ -215,7 +215,7 @@ TEST(Guided, ASimilarityPairIsFittedByTheHomography) {
 TEST(Guided, RejudgesEveryPutativeNotOnlyTheSurvivors) {
   const LabelledMatches input = synthetic(0.3, 29);
   FilterConfigs strict;
-  strict.lsc.lsc_min_support = 0.9;  // lsc alone then drops many inliers
+  strict.lsc.min_support = 0.9;  // lsc alone then drops many inliers
   const FilterResult lsc = makeFilter("lsc", strict)->apply(input.putative);
   const FilterResult guided = makeFilter("guided", strict)->apply(input.putative);
   EXPECT_GT(scoreFilter(input.truth, guided).correct_kept,
@@ -248,12 +248,12 @@ TEST(Guided, TinyAndDegenerateInputsKeepNothingWithoutThrowing) {
 
 TEST(LocalFilters, RejectInvalidConfigs) {
   std::vector<FilterConfigs> bad(6);
-  bad[0].lsc.lsc_neighbours = 0;
-  bad[1].lsc.lsc_min_support = 1.5;
-  bad[2].lsc.lsc_max_relative_error = NAN;
-  bad[3].local_gsc.local_gsc_neighbours = 5000;
-  bad[4].guided.guided_min_model_inliers = 3;
-  bad[5].guided.guided_max_transfer_px = 0.0;
+  bad[0].lsc.neighbours = 0;
+  bad[1].lsc.min_support = 1.5;
+  bad[2].lsc.max_relative_error = NAN;
+  bad[3].local_gsc.neighbours = 5000;
+  bad[4].guided.min_model_inliers = 3;
+  bad[5].guided.max_transfer_px = 0.0;
   for (const FilterConfigs& configs : bad) EXPECT_THROW(validate(configs), std::invalid_argument);
 }
 

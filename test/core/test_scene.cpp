@@ -317,18 +317,14 @@ TEST(SceneCommand, WritesTheSceneAndReportsJson) {
   EXPECT_EQ(cv::imread(dir + "/masks/view_0002.png").size(), cv::Size(64, 48));
 }
 
-TEST(SceneCommand, TheOldDistanceFlagStillWorksWithAWarningOnStderr) {
+TEST(SceneCommand, TheCameraDistanceFlagIsReadAndTheOldNameRefused) {
   const std::string dir = test::temporaryDirectory();
   std::string out, err;
   const std::string scene = "scene --views 3 --size 64x48 --out " + dir;
   ASSERT_EQ(test::runProgram(scene + "/new --camera-distance-m 5", &out, &err), 0) << err;
-  EXPECT_EQ(err.find("deprecated"), std::string::npos) << err;
-  ASSERT_EQ(test::runProgram(scene + "/old --distance 5", &out, &err), 0) << err;
-  EXPECT_NE(err.find("warning: --distance is deprecated, use --camera-distance-m\n"),
-            std::string::npos)
-      << err;
   EXPECT_EQ(readScene(dir + "/new").config.camera_distance_m, 5.0);
-  EXPECT_EQ(readScene(dir + "/old").config.camera_distance_m, 5.0);
+  EXPECT_EQ(test::runProgram(scene + "/old --distance 5", &out, &err), 2);
+  EXPECT_NE(err.find("unknown option --distance"), std::string::npos) << err;
 }
 
 TEST(SceneCommand, RejectsBadArgumentsWithUsageErrors) {

@@ -97,7 +97,7 @@ TEST(VoteRansac, KeepsWhatThePlainReferenceKeepsUnderItsMotions) {
     double nearest_edge = INFINITY;
     for (const TwoViewModel& motion : motions) {
       const double limit =
-          motion.homography ? c.guided.guided_max_transfer_px : c.magsac.max_epipolar_px;
+          motion.homography ? c.guided.max_transfer_px : c.magsac.max_epipolar_px;
       const double r = modelResidual(motion, a.x, a.y, b.x, b.y);
       keep = keep || r <= limit;
       nearest_edge = std::min(nearest_edge, std::abs(r - limit));
@@ -230,12 +230,12 @@ TEST(VoteRansac, TinyAndDegenerateInputsKeepNothingWithoutThrowing) {
 
 TEST(VoteRansac, RejectsInvalidConfigs) {
   std::vector<FilterConfigs> bad(6);
-  bad[0].vote_ransac.vote_ransac_max_angle_deg = 0.0;
-  bad[1].vote_ransac.vote_ransac_max_angle_deg = 181.0;
-  bad[2].vote_ransac.vote_ransac_max_scale_ratio = 1.0;
-  bad[3].vote_ransac.vote_ransac_max_scale_ratio = INFINITY;
-  bad[4].vote_ransac.vote_ransac_max_fit_points = 15;
-  bad[5].vote_ransac.vote_ransac_max_angle_deg = NAN;
+  bad[0].vote_ransac.max_angle_deg = 0.0;
+  bad[1].vote_ransac.max_angle_deg = 181.0;
+  bad[2].vote_ransac.max_scale_ratio = 1.0;
+  bad[3].vote_ransac.max_scale_ratio = INFINITY;
+  bad[4].vote_ransac.max_fit_points = 15;
+  bad[5].vote_ransac.max_angle_deg = NAN;
   for (const FilterConfigs& configs : bad) EXPECT_THROW(validate(configs), std::invalid_argument);
 }
 

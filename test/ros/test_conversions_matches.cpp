@@ -110,7 +110,7 @@ TEST(SettingsJson, HoldsEverySettingUnderItsParameterName) {
   matching.ratio = 0.7;
   matching.max_descriptor_distance = 250.0;
   FilterConfigs filters;
-  filters.epipolar.max_epipolar_px = 1.5;
+  filters.epipolar.max_distance_px = 1.5;
   filters.gsc.max_histogram_distance = 0.25;
   filters.ransac.max_epipolar_px = 0.75;
   filters.magsac.max_iterations = 500;
@@ -119,12 +119,12 @@ TEST(SettingsJson, HoldsEverySettingUnderItsParameterName) {
       nlohmann::json::parse(ros_conversions::settingsJson(matching, filters));
   EXPECT_DOUBLE_EQ(json.at("ratio").get<double>(), 0.7);
   EXPECT_DOUBLE_EQ(json.at("max_descriptor_distance").get<double>(), 250.0);
-  EXPECT_DOUBLE_EQ(json.at("max_epipolar_px").get<double>(), 1.5);
-  EXPECT_DOUBLE_EQ(json.at("max_histogram_distance").get<double>(), 0.25);
+  EXPECT_DOUBLE_EQ(json.at("epipolar_max_distance_px").get<double>(), 1.5);
+  EXPECT_DOUBLE_EQ(json.at("gsc_max_histogram_distance").get<double>(), 0.25);
   EXPECT_DOUBLE_EQ(json.at("ransac_max_epipolar_px").get<double>(), 0.75);
   EXPECT_DOUBLE_EQ(json.at("magsac_max_epipolar_px").get<double>(), filters.magsac.max_epipolar_px);
   EXPECT_EQ(json.at("magsac_max_iterations").get<int>(), 500);
-  EXPECT_EQ(json.at("grid_cells").get<int>(), 12);
+  EXPECT_EQ(json.at("gms_grid_cells").get<int>(), 12);
   // Each key is the name of a parameter that config/matcher.yaml states (one name per setting).
   std::ifstream yaml(std::string(SIFT_HULL_SOURCE_DIR) + "/config/matcher.yaml");
   ASSERT_TRUE(yaml.good());

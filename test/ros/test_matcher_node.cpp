@@ -177,7 +177,7 @@ TEST_F(MatcherNodeTest, ThresholdsChangeAtRunTime) {
   ASSERT_GT(keptByGsc(), 20u);
   dynamic_reconfigure::Reconfigure change;
   dynamic_reconfigure::DoubleParameter threshold;
-  threshold.name = "max_histogram_distance";
+  threshold.name = "gsc_max_histogram_distance";
   threshold.value = 0.0;
   change.request.config.doubles.push_back(threshold);
   ASSERT_TRUE(ros::service::waitForService("/matcher/set_parameters", ros::Duration(kDeadline_s)));
@@ -185,7 +185,7 @@ TEST_F(MatcherNodeTest, ThresholdsChangeAtRunTime) {
   stamp = publishPair(left_.image, right_.image);
   ASSERT_TRUE(answeredAtLeast(stamp));
   EXPECT_LT(keptByGsc(), 3u);  // histograms equal to the last bin: hardly any
-  EXPECT_NE(last_->filter_settings.find("\"max_histogram_distance\":0.0"), std::string::npos)
+  EXPECT_NE(last_->filter_settings.find("\"gsc_max_histogram_distance\":0.0"), std::string::npos)
       << last_->filter_settings;
 }
 

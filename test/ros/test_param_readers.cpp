@@ -1,13 +1,12 @@
 // The parameter readers against a real parameter server: the parameter files in config/ restate
 // the config structs' defaults and state every parameter the readers read, unset parameters give
 // those defaults, set ones are read, a parameter of the wrong type or value is an error rather
-// than a silent default, and renamed parameters are still read under their old names, with a
-// warning.
+// than a silent default, and filter settings are named by their filter.
 
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 
-#include <algorithm>
+#include <cmath>
 #include <functional>
 #include <set>
 #include <string>
@@ -39,10 +38,6 @@ std::set<std::string> namesRead(const std::function<void(const ros::NodeHandle&)
   ReadLog log;
   read(nh);
   return log.names;
-}
-
-bool contains(const std::vector<std::string>& lines, const std::string& line) {
-  return std::find(lines.begin(), lines.end(), line) != lines.end();
 }
 
 void expectDefaultHull(const ros::NodeHandle& nh) {
@@ -95,7 +90,7 @@ void expectDefaultMatcher(const ros::NodeHandle& nh) {
   EXPECT_EQ(read.matching.backend, standard.matching.backend);
   const FilterConfigs& f = read.filters;
   const FilterConfigs& g = standard.filters;
-  EXPECT_EQ(f.epipolar.max_epipolar_px, g.epipolar.max_epipolar_px);
+  EXPECT_EQ(f.epipolar.max_distance_px, g.epipolar.max_distance_px);
   EXPECT_EQ(f.gsc.max_histogram_distance, g.gsc.max_histogram_distance);
   EXPECT_EQ(f.gsc.threads, g.gsc.threads);
   for (const auto& [got, want] : {std::pair(f.ransac, g.ransac), std::pair(f.magsac, g.magsac)}) {
@@ -110,22 +105,22 @@ void expectDefaultMatcher(const ros::NodeHandle& nh) {
   EXPECT_EQ(f.gsc.max_support, g.gsc.max_support);
   EXPECT_EQ(f.ransac.seed, g.ransac.seed);
   EXPECT_EQ(f.magsac.seed, g.magsac.seed);
-  EXPECT_EQ(f.lsc.lsc_neighbours, g.lsc.lsc_neighbours);
-  EXPECT_EQ(f.lsc.lsc_max_relative_error, g.lsc.lsc_max_relative_error);
-  EXPECT_EQ(f.lsc.lsc_min_tolerance_px, g.lsc.lsc_min_tolerance_px);
-  EXPECT_EQ(f.lsc.lsc_min_support, g.lsc.lsc_min_support);
-  EXPECT_EQ(f.local_gsc.local_gsc_neighbours, g.local_gsc.local_gsc_neighbours);
-  EXPECT_EQ(f.local_gsc.local_gsc_max_histogram_distance,
-            g.local_gsc.local_gsc_max_histogram_distance);
-  EXPECT_EQ(f.guided.guided_max_transfer_px, g.guided.guided_max_transfer_px);
-  EXPECT_EQ(f.guided.guided_homography_share, g.guided.guided_homography_share);
-  EXPECT_EQ(f.guided.guided_max_models, g.guided.guided_max_models);
-  EXPECT_EQ(f.guided.guided_min_model_inliers, g.guided.guided_min_model_inliers);
-  EXPECT_EQ(f.guided.guided_min_support, g.guided.guided_min_support);
-  EXPECT_EQ(f.guided.guided_max_fit_points, g.guided.guided_max_fit_points);
-  EXPECT_EQ(f.vote_ransac.vote_ransac_max_angle_deg, g.vote_ransac.vote_ransac_max_angle_deg);
-  EXPECT_EQ(f.vote_ransac.vote_ransac_max_scale_ratio, g.vote_ransac.vote_ransac_max_scale_ratio);
-  EXPECT_EQ(f.vote_ransac.vote_ransac_max_fit_points, g.vote_ransac.vote_ransac_max_fit_points);
+  EXPECT_EQ(f.lsc.neighbours, g.lsc.neighbours);
+  EXPECT_EQ(f.lsc.max_relative_error, g.lsc.max_relative_error);
+  EXPECT_EQ(f.lsc.min_tolerance_px, g.lsc.min_tolerance_px);
+  EXPECT_EQ(f.lsc.min_support, g.lsc.min_support);
+  EXPECT_EQ(f.local_gsc.neighbours, g.local_gsc.neighbours);
+  EXPECT_EQ(f.local_gsc.max_histogram_distance,
+            g.local_gsc.max_histogram_distance);
+  EXPECT_EQ(f.guided.max_transfer_px, g.guided.max_transfer_px);
+  EXPECT_EQ(f.guided.homography_share, g.guided.homography_share);
+  EXPECT_EQ(f.guided.max_models, g.guided.max_models);
+  EXPECT_EQ(f.guided.min_model_inliers, g.guided.min_model_inliers);
+  EXPECT_EQ(f.guided.min_support, g.guided.min_support);
+  EXPECT_EQ(f.guided.max_fit_points, g.guided.max_fit_points);
+  EXPECT_EQ(f.vote_ransac.max_angle_deg, g.vote_ransac.max_angle_deg);
+  EXPECT_EQ(f.vote_ransac.max_scale_ratio, g.vote_ransac.max_scale_ratio);
+  EXPECT_EQ(f.vote_ransac.max_fit_points, g.vote_ransac.max_fit_points);
 }
 
 TEST(ParameterReaders, TheParameterFilesRestateTheStructDefaults) {
@@ -245,87 +240,6 @@ TEST(ParameterReaders, WrongTypesAndValuesAreErrors) {
                std::invalid_argument);
 }
 
-TEST(ParameterReaders, OldNamesAreReadWithAWarning) {
-  ros::NodeHandle nh("/old_names");
-  nh.setParam("depth", 6);
-  nh.setParam("slack_px", 2.5);
-  nh.setParam("matcher", "flann");
-  nh.setParam("gsc_max_histogram_distance", 0.3);
-  nh.setParam("gsc_threads", 3);
-  nh.setParam("robust_confidence", 0.95);
-  nh.setParam("robust_max_iterations", 500);
-  nh.setParam("gms_grid_cells", 10);
-  nh.setParam("gms_threshold_factor", 4.0);
-  nh.setParam("gms_with_rotation", true);
-  nh.setParam("gms_with_scale", true);
-  ReadLog log;
-  const HullStreamConfig hull = readHullStreamConfig(nh);
-  EXPECT_EQ(hull.hull.max_depth, 6);
-  EXPECT_EQ(hull.hull.distance_slack_px, 2.5);
-  const MatcherSettings matcher = readMatcherSettings(nh);
-  EXPECT_EQ(matcher.matching.backend, "flann");
-  const FilterConfigs& f = matcher.filters;
-  EXPECT_EQ(f.gsc.max_histogram_distance, 0.3);
-  EXPECT_EQ(f.gsc.threads, 3);
-  for (const RobustFitConfig& robust : {f.ransac, f.magsac}) {
-    EXPECT_EQ(robust.confidence, 0.95);
-    EXPECT_EQ(robust.max_iterations, 500);
-  }
-  EXPECT_EQ(f.gms.grid_cells, 10);
-  EXPECT_EQ(f.gms.threshold_factor, 4.0);
-  EXPECT_TRUE(f.gms.with_rotation);
-  EXPECT_TRUE(f.gms.with_scale);
-  for (const char* warning :
-       {"~depth is deprecated, use ~max_depth", "~slack_px is deprecated, use ~distance_slack_px",
-        "~matcher is deprecated, use ~backend",
-        "~gsc_max_histogram_distance is deprecated, use ~max_histogram_distance",
-        "~gsc_threads is deprecated, use ~threads",
-        "~robust_confidence is deprecated, use ~ransac_confidence",
-        "~robust_confidence is deprecated, use ~magsac_confidence",
-        "~robust_max_iterations is deprecated, use ~ransac_max_iterations",
-        "~robust_max_iterations is deprecated, use ~magsac_max_iterations",
-        "~gms_grid_cells is deprecated, use ~grid_cells",
-        "~gms_threshold_factor is deprecated, use ~threshold_factor",
-        "~gms_with_rotation is deprecated, use ~with_rotation",
-        "~gms_with_scale is deprecated, use ~with_scale"}) {
-    EXPECT_TRUE(contains(log.warnings, warning)) << warning;
-  }
-  EXPECT_EQ(log.warnings.size(), 13u);
-  EXPECT_EQ(log.names.count("depth"), 0u);  // old names are not among the names read
-  ros::NodeHandle wrong_type("/old_name_wrong_type");
-  wrong_type.setParam("depth", 6.5);
-  EXPECT_THROW(readHullStreamConfig(wrong_type), std::invalid_argument);
-}
-
-TEST(ParameterReaders, TheNewNameWinsOverTheOldOne) {
-  ros::NodeHandle nh("/both_names");
-  nh.setParam("depth", 6);
-  nh.setParam("max_depth", 7);
-  nh.setParam("gsc_threads", 3);
-  nh.setParam("threads", 4);
-  nh.setParam("robust_confidence", 0.95);
-  nh.setParam("magsac_confidence", 0.9);
-  ReadLog log;
-  EXPECT_EQ(readHullStreamConfig(nh).hull.max_depth, 7);
-  const FilterConfigs filters = readMatcherSettings(nh).filters;
-  EXPECT_EQ(filters.gsc.threads, 4);
-  EXPECT_EQ(filters.ransac.confidence, 0.95);  // its own name is not set: the old one applies
-  EXPECT_EQ(filters.magsac.confidence, 0.9);
-  EXPECT_TRUE(contains(log.warnings,
-                       "~depth is deprecated, use ~max_depth (both are set: ~depth is ignored)"));
-  EXPECT_TRUE(contains(log.warnings, "~robust_confidence is deprecated, use ~ransac_confidence"));
-  EXPECT_TRUE(contains(log.warnings,
-                       "~robust_confidence is deprecated, use ~magsac_confidence "
-                       "(both are set: ~robust_confidence is ignored)"));
-  // Both set to one value (hull.launch with its deprecated `depth` arg): no conflict to report.
-  ros::NodeHandle same("/same_value");
-  same.setParam("depth", 6);
-  same.setParam("max_depth", 6);
-  ReadLog same_log;
-  EXPECT_EQ(readHullStreamConfig(same).hull.max_depth, 6);
-  EXPECT_EQ(same_log.warnings, std::vector<std::string>{"~depth is deprecated, use ~max_depth"});
-}
-
 /// The message of the std::invalid_argument that `read` throws ("" when it throws none).
 std::string refusal(const std::function<void()>& read) {
   try {
@@ -334,6 +248,44 @@ std::string refusal(const std::function<void()>& read) {
     return e.what();
   }
   return "";
+}
+
+TEST(ParameterReaders, FilterSettingsAreNamedByTheirFilter) {
+  ros::NodeHandle nh("/filter_names");
+  nh.setParam("epipolar_max_distance_px", 3.0);
+  nh.setParam("gsc_max_histogram_distance", 0.3);
+  nh.setParam("gsc_threads", 3);
+  nh.setParam("ransac_confidence", 0.95);
+  nh.setParam("magsac_max_iterations", 500);
+  nh.setParam("gms_grid_cells", 10);
+  nh.setParam("lsc_max_relative_error", 0.5);
+  nh.setParam("vote_ransac_max_fit_points", 300);
+  ReadLog log;
+  const FilterConfigs f = readMatcherSettings(nh).filters;
+  EXPECT_EQ(f.epipolar.max_distance_px, 3.0);
+  EXPECT_EQ(f.gsc.max_histogram_distance, 0.3);
+  EXPECT_EQ(f.gsc.threads, 3);
+  EXPECT_EQ(f.ransac.confidence, 0.95);
+  EXPECT_EQ(f.magsac.confidence, FilterConfigs().magsac.confidence);  // each instance its own
+  EXPECT_EQ(f.magsac.max_iterations, 500);
+  EXPECT_EQ(f.gms.grid_cells, 10);
+  EXPECT_EQ(f.lsc.max_relative_error, 0.5);
+  EXPECT_EQ(f.vote_ransac.max_fit_points, 300);
+  for (const char* bare : {"grid_cells", "max_histogram_distance", "max_relative_error"}) {
+    EXPECT_EQ(log.names.count(bare), 0u) << bare;
+  }
+}
+
+TEST(ParameterReaders, AValueOutOfRangeIsRefusedNamingItsParameter) {
+  ros::NodeHandle nh("/out_of_range");
+  nh.setParam("lsc_min_support", 2.0);
+  const std::string refused = refusal([&] { readMatcherSettings(nh); });
+  EXPECT_NE(refused.find("~lsc_min_support must be"), std::string::npos) << refused;
+  EXPECT_NE(refused.find("[0, 1]"), std::string::npos) << refused;
+  ros::NodeHandle nan("/not_a_number");
+  nan.setParam("max_descriptor_distance", std::nan(""));
+  EXPECT_NE(refusal([&] { readMatcherSettings(nan); }).find("~max_descriptor_distance"),
+            std::string::npos);
 }
 
 TEST(ParameterReaders, OctomapServersNamesAreReadOrRefusedNamingOurs) {

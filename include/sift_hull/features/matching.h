@@ -10,14 +10,15 @@
 
 #include "sift_hull/features/sift.h"
 #include "sift_hull/geometry/camera.h"
+#include "sift_hull/settings.h"
 
 namespace sift_hull {
 
 /// Euclidean nearest-neighbour matching of descriptors from the left image to the right one.
 struct MatchConfig {
   /// Largest descriptor distance kept (SIFT descriptors have norm 512); raising it gives denser,
-  /// dirtier matches. Infinity keeps every nearest neighbour.
-  double max_descriptor_distance = std::numeric_limits<double>::infinity();
+  /// dirtier matches. 0 keeps every nearest neighbour.
+  double max_descriptor_distance = 0.0;
   /// Lowe's ratio test: keep when nearest < ratio * second nearest. 1 (or more) turns it off.
   double ratio = 0.8;
   bool cross_check = false;  ///< keep only mutual nearest neighbours
@@ -25,6 +26,9 @@ struct MatchConfig {
   /// BFMatcher) or "flann" (approximate, kd-trees).
   std::string backend = "blas";
 };
+/// Its settings: names, units, ranges, help (sift_hull/settings.h).
+template <>
+const SettingTable<MatchConfig>& settingsOf<MatchConfig>();
 
 /// Throws std::invalid_argument naming the first bad field.
 void validate(const MatchConfig& config);

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "sift_hull/limits.h"
+#include "sift_hull/settings.h"
 
 namespace sift_hull {
 
@@ -18,6 +19,9 @@ struct SiftConfig {
   /// pair, so 25 megapixels (a 6000x4000 photo) keep a pair within 4 GiB.
   size_t max_image_pixels = limits::kDefaultMaxImagePixels;
 };
+/// Its settings: names, units, ranges, help (sift_hull/settings.h).
+template <>
+const SettingTable<SiftConfig>& settingsOf<SiftConfig>();
 
 /// Throws std::invalid_argument naming the first bad field.
 void validate(const SiftConfig& config);

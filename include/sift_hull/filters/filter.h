@@ -14,6 +14,7 @@
 #include "sift_hull/filters/ratio.h"
 #include "sift_hull/filters/robust_fit.h"
 #include "sift_hull/filters/vote_ransac.h"
+#include "sift_hull/settings.h"
 
 namespace sift_hull {
 
@@ -33,6 +34,9 @@ struct FilterConfigs {
   GuidedConfig guided;
   VoteRansacConfig vote_ransac;
 };
+/// Its settings: names, units, ranges, help (sift_hull/settings.h).
+template <>
+const SettingTable<FilterConfigs>& settingsOf<FilterConfigs>();
 
 /// Throws std::invalid_argument naming the first bad field.
 void validate(const FilterConfigs& configs);

@@ -2,6 +2,7 @@
 
 #include "sift_hull/features/matching.h"
 #include "sift_hull/filters/filter_result.h"
+#include "sift_hull/settings.h"
 
 namespace sift_hull {
 
@@ -13,6 +14,11 @@ struct GmsConfig {
   bool with_rotation = false;     ///< try the 8 rotations of the 3x3 neighbourhood
   bool with_scale = false;        ///< try 5 relative grid scales of the right image
 };
+/// Its settings: names, units, ranges, help (sift_hull/settings.h).
+template <>
+const SettingTable<GmsConfig>& settingsOf<GmsConfig>();
+/// Throws std::invalid_argument for a setting outside its range.
+void validate(const GmsConfig& config);
 
 FilterResult filterGms(const PutativeMatches& input, const GmsConfig& config);
 

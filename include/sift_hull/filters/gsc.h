@@ -5,6 +5,7 @@
 
 #include "sift_hull/features/matching.h"
 #include "sift_hull/filters/filter_result.h"
+#include "sift_hull/settings.h"
 
 namespace sift_hull {
 
@@ -18,6 +19,9 @@ struct GscConfig {
   /// sees the same sampled points left and right), O(N M) instead of O(N^2).
   int max_support = 0;
 };
+/// Its settings: names, units, ranges, help (sift_hull/settings.h).
+template <>
+const SettingTable<GscConfig>& settingsOf<GscConfig>();
 
 FilterResult filterGsc(const PutativeMatches& input, const GscConfig& config);
 

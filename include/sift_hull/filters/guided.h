@@ -4,6 +4,7 @@
 #include "sift_hull/filters/filter_result.h"
 #include "sift_hull/filters/local_consistency.h"
 #include "sift_hull/filters/robust_fit.h"
+#include "sift_hull/settings.h"
 
 namespace sift_hull {
 
@@ -17,15 +18,18 @@ namespace sift_hull {
 /// guided_max_transfer_px both ways) and its lsc support is at least guided_min_support.
 /// Score: the smallest residual over the models, px (NaN when no model was found: none kept).
 struct GuidedConfig {
-  double guided_max_transfer_px = 3.0;
-  double guided_homography_share = 0.9;
-  int guided_max_models = 2;
-  int guided_min_model_inliers = 20;
-  double guided_min_support = 0.1;
+  double max_transfer_px = 3.0;
+  double homography_share = 0.9;
+  int max_models = 2;
+  int min_model_inliers = 20;
+  double min_support = 0.1;
   /// MAGSAC fits its models to at most this many of lsc's survivors (a random sample drawn with
   /// magsac_seed), so that its time does not grow with N; every match is judged afterwards.
-  int guided_max_fit_points = 200;
+  int max_fit_points = 200;
 };
+/// Its settings: names, units, ranges, help (sift_hull/settings.h).
+template <>
+const SettingTable<GuidedConfig>& settingsOf<GuidedConfig>();
 
 /// Everything the guided filter uses: its own settings, lsc's and MAGSAC's.
 struct GuidedFilterConfig {

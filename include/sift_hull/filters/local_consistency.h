@@ -2,6 +2,7 @@
 
 #include "sift_hull/features/matching.h"
 #include "sift_hull/filters/filter_result.h"
+#include "sift_hull/settings.h"
 
 namespace sift_hull {
 
@@ -14,11 +15,14 @@ namespace sift_hull {
 /// when the score is at least lsc_min_support. O(N K). Invariant to rotating, scaling and shifting
 /// either image; uses no geometry of the pair, so it holds for several motions and for planes.
 struct LscConfig {
-  int lsc_neighbours = 16;               ///< K: nearest matches looked at in each image
-  double lsc_max_relative_error = 0.35;  ///< tolerance as a share of the neighbour's distance
-  double lsc_min_tolerance_px = 2.0;     ///< tolerance floor, px
-  double lsc_min_support = 0.25;         ///< kept when at least this share of neighbours agrees
+  int neighbours = 16;               ///< K: nearest matches looked at in each image
+  double max_relative_error = 0.35;  ///< tolerance as a share of the neighbour's distance
+  double min_tolerance_px = 2.0;     ///< tolerance floor, px
+  double min_support = 0.25;         ///< kept when at least this share of neighbours agrees
 };
+/// Its settings: names, units, ranges, help (sift_hull/settings.h).
+template <>
+const SettingTable<LscConfig>& settingsOf<LscConfig>();
 
 /// Throws std::invalid_argument naming the first bad field.
 void validate(const LscConfig& config);
@@ -31,9 +35,12 @@ FilterResult filterLsc(const PutativeMatches& input, const LscConfig& config);
 /// most local_gsc_max_histogram_distance. Robust to perspective, which bends GSC's global layout.
 /// O(N K).
 struct LocalGscConfig {
-  int local_gsc_neighbours = 16;
-  double local_gsc_max_histogram_distance = 0.35;
+  int neighbours = 16;
+  double max_histogram_distance = 0.35;
 };
+/// Its settings: names, units, ranges, help (sift_hull/settings.h).
+template <>
+const SettingTable<LocalGscConfig>& settingsOf<LocalGscConfig>();
 
 void validate(const LocalGscConfig& config);
 FilterResult filterLocalGsc(const PutativeMatches& input, const LocalGscConfig& config);

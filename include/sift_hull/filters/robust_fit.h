@@ -6,6 +6,7 @@
 
 #include "sift_hull/features/matching.h"
 #include "sift_hull/filters/filter_result.h"
+#include "sift_hull/settings.h"
 
 namespace sift_hull {
 
@@ -21,6 +22,9 @@ struct RobustFitConfig {
   /// same answer; evaluate-filters reports the mean over seeds 0 to 4.
   int seed = 0;
 };
+/// Its settings: names, units, ranges, help (sift_hull/settings.h).
+template <>
+const SettingTable<RobustFitConfig>& settingsOf<RobustFitConfig>();
 
 /// F between the points of the valid matches by MAGSAC (OpenCV's USAC with the settings of its
 /// USAC_MAGSAC flag and config.seed); empty when there are fewer than 8 or it fails.

@@ -5,6 +5,7 @@
 #include "sift_hull/filters/guided.h"
 #include "sift_hull/filters/robust_fit.h"
 #include "sift_hull/filters/two_view_models.h"
+#include "sift_hull/settings.h"
 
 namespace sift_hull {
 
@@ -41,10 +42,13 @@ namespace sift_hull {
 /// Score: the smallest residual over the motions, px (NaN when none was found: none kept).
 /// Its time hardly grows with N beyond the fit set: steps 5 and 6 are a few residuals per match.
 struct VoteRansacConfig {
-  double vote_ransac_max_angle_deg = 30.0;   ///< half width of the rotation vote's window, deg
-  double vote_ransac_max_scale_ratio = 2.0;  ///< half width of the scale vote's window (factor)
-  int vote_ransac_max_fit_points = 500;      ///< size of the fit set (a random sample)
+  double max_angle_deg = 30.0;   ///< half width of the rotation vote's window, deg
+  double max_scale_ratio = 2.0;  ///< half width of the scale vote's window (factor)
+  int max_fit_points = 500;      ///< size of the fit set (a random sample)
 };
+/// Its settings: names, units, ranges, help (sift_hull/settings.h).
+template <>
+const SettingTable<VoteRansacConfig>& settingsOf<VoteRansacConfig>();
 
 /// Everything the filter uses: its vote, the motion settings it shares with guided and the fit
 /// settings it shares with magsac (threshold, confidence, iterations, seed).

@@ -1,5 +1,7 @@
 #pragma once
 
+#include "sift_hull/settings.h"
+
 namespace sift_hull {
 
 /// Octree carving settings.
@@ -29,6 +31,9 @@ struct HullConfig {
   int distance_reduction = 0;
   int threads = 2;  ///< for carving and for the mesh's field samples
 };
+/// Its settings: names, units, ranges, help (sift_hull/settings.h).
+template <>
+const SettingTable<HullConfig>& settingsOf<HullConfig>();
 
 /// Throws std::invalid_argument naming the first bad field.
 void validate(const HullConfig& config);

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "sift_hull/hull/octree.h"
+#include "sift_hull/settings.h"
 
 namespace sift_hull {
 
@@ -31,6 +32,9 @@ struct HullStreamConfig {
   /// are sampled at the reduction it allows, distanceReduction); later views are refused.
   int max_views = 1000;
 };
+/// Its settings: names, units, ranges, help (sift_hull/settings.h).
+template <>
+const SettingTable<HullStreamConfig>& settingsOf<HullStreamConfig>();
 
 /// Throws std::invalid_argument for a negative or non-finite distance, an angle outside
 /// [0, 180] degrees, view counts below 2 (waiting) or 1, or a box the octree cannot hold.

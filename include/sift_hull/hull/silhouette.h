@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "sift_hull/hull/run_length_mask.h"
+#include "sift_hull/settings.h"
 
 namespace sift_hull {
 
@@ -28,6 +29,9 @@ struct SilhouetteConfig {
   int dilate_px = 10;
   int erode_px = 7;
 };
+/// Its settings: names, units, ranges, help (sift_hull/settings.h).
+template <>
+const SettingTable<SilhouetteConfig>& settingsOf<SilhouetteConfig>();
 
 /// Throws std::invalid_argument for a threshold outside [0, 1] or a radius outside
 /// [0, limits::kMaxMorphologyRadiusPx].

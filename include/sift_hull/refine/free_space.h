@@ -6,6 +6,7 @@
 #include "sift_hull/geometry/camera.h"
 #include "sift_hull/hull/octree.h"
 #include "sift_hull/refine/surface_points.h"
+#include "sift_hull/settings.h"
 
 namespace sift_hull {
 
@@ -36,6 +37,9 @@ struct FreeSpaceConfig {
   /// at most a quarter of it), which is added to the margin there.
   double bulge_fraction = 0.25;
 };
+/// Its settings: names, units, ranges, help (sift_hull/settings.h).
+template <>
+const SettingTable<FreeSpaceConfig>& settingsOf<FreeSpaceConfig>();
 
 /// Throws std::invalid_argument naming the first bad field.
 void validate(const FreeSpaceConfig& config);

@@ -6,6 +6,7 @@
 
 #include "sift_hull/geometry/camera.h"
 #include "sift_hull/hull/octree.h"
+#include "sift_hull/settings.h"
 
 namespace sift_hull {
 
@@ -26,6 +27,9 @@ struct SurfacePointConfig {
   /// finest voxels of the hull, to confirm each other.
   double confirm_radius_voxels = 2.0;
 };
+/// Its settings: names, units, ranges, help (sift_hull/settings.h).
+template <>
+const SettingTable<SurfacePointConfig>& settingsOf<SurfacePointConfig>();
 
 /// Throws std::invalid_argument naming the first bad field.
 void validate(const SurfacePointConfig& config);

@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "sift_hull/features/nearest_neighbours.h"
+#include "sift_hull/settings.h"
 
 namespace sift_hull {
 namespace {
@@ -37,14 +38,39 @@ std::vector<int> reverseNearest(const cv::Mat& left, const cv::Mat& right,
   return nearest;
 }
 
+/// The largest descriptor distance kept: max_descriptor_distance, or infinity for 0 (no limit).
+double descriptorLimit(const MatchConfig& config) {
+  return config.max_descriptor_distance > 0.0 ? config.max_descriptor_distance
+                                              : std::numeric_limits<double>::infinity();
+}
+
 }  // namespace
 
-void validate(const MatchConfig& config) {
-  require(config.max_descriptor_distance > 0.0, "max_descriptor_distance must be > 0");
-  require(config.ratio > 0.0, "ratio must be > 0 (1 turns the test off)");
-  require(config.backend == "blas" || config.backend == "brute-force" || config.backend == "flann",
-          "backend must be 'blas', 'brute-force' or 'flann', not '" + config.backend + "'");
+template <>
+const SettingTable<MatchConfig>& settingsOf<MatchConfig>() {
+  static const SettingTable<MatchConfig> table = [] {
+    SettingTable<MatchConfig> t;
+    t.add("ratio", &MatchConfig::ratio, "",
+          "Lowe's ratio test: a match is kept when its descriptor distance is below this times "
+          "the second nearest's; 1 turns the test off")
+        .above(0.0, 1.0)
+        .tunedAtRunTime();
+    t.add("max_descriptor_distance", &MatchConfig::max_descriptor_distance, "",
+          "largest SIFT descriptor distance kept (descriptors have norm 512); 0: no limit")
+        .range(0.0, 1024.0)
+        .tunedAtRunTime();
+    t.add("cross_check", &MatchConfig::cross_check, "", "keep only mutual nearest neighbours")
+        .tunedAtRunTime();
+    t.add("backend", &MatchConfig::backend, "",
+          "nearest neighbours: blas (exact, by matrix product), brute-force (exact, OpenCV's "
+          "BFMatcher) or flann (approximate, kd-trees)")
+        .oneOf({"blas", "brute-force", "flann"});
+    return t;
+  }();
+  return table;
 }
+
+void validate(const MatchConfig& config) { checkSettings(config, "MatchConfig"); }
 
 namespace {
 
@@ -109,7 +135,7 @@ std::vector<cv::DMatch> matchAlongEpipolarLines(const Features& left, const Feat
         second = distance;
       }
     }
-    if (best_j < 0 || best > config.max_descriptor_distance) continue;
+    if (best_j < 0 || best > descriptorLimit(config)) continue;
     if (config.ratio < 1.0 && std::isfinite(second) && !(best < config.ratio * second)) continue;
     matches.emplace_back(static_cast<int>(i), best_j, best);
   }
@@ -125,7 +151,7 @@ std::vector<cv::DMatch> matchByMatrixProduct(const cv::Mat& left, const cv::Mat&
   std::vector<cv::DMatch> matches;
   for (size_t i = 0; i < nn.forward.size(); ++i) {
     const TwoNearest& n = nn.forward[i];
-    if (n.best < 0 || n.best_distance > config.max_descriptor_distance) continue;
+    if (n.best < 0 || n.best_distance > descriptorLimit(config)) continue;
     if (config.ratio < 1.0 && n.second >= 0 &&
         !(n.best_distance < config.ratio * n.second_distance))
       continue;
@@ -153,7 +179,7 @@ std::vector<cv::DMatch> matchDescriptors(const cv::Mat& left, const cv::Mat& rig
   for (const std::vector<cv::DMatch>& candidates : neighbours) {
     if (candidates.empty()) continue;
     const cv::DMatch& best = candidates.front();
-    if (best.distance > config.max_descriptor_distance) continue;
+    if (best.distance > descriptorLimit(config)) continue;
     if (!passesRatio(candidates, config.ratio)) continue;
     if (config.cross_check && reverse[best.trainIdx] != best.queryIdx) continue;
     matches.push_back(best);

@@ -9,10 +9,6 @@
 namespace sift_hull {
 namespace {
 
-void require(bool condition, const std::string& message) {
-  if (!condition) throw std::invalid_argument("SiftConfig: " + message);
-}
-
 cv::Mat greyImage(const cv::Mat& image) {
   if (image.empty()) throw std::invalid_argument("detectSift: empty image");
   if (image.depth() != CV_8U) throw std::invalid_argument("detectSift: image must be 8-bit");
@@ -30,18 +26,32 @@ cv::Mat greyImage(const cv::Mat& image) {
 
 }  // namespace
 
-void validate(const SiftConfig& config) {
-  require(config.max_features >= 0, "max_features must be >= 0");
-  require(config.octave_layers >= 1 && config.octave_layers <= limits::kMaxOctaveLayers,
-          "octave_layers must be in [1, " + std::to_string(limits::kMaxOctaveLayers) + "]");
-  require(config.contrast_threshold >= 0.0 && std::isfinite(config.contrast_threshold),
-          "contrast_threshold must be finite and >= 0");
-  require(config.edge_threshold > 0.0 && std::isfinite(config.edge_threshold),
-          "edge_threshold must be finite and > 0");
-  require(config.sigma_px > 0.0 && std::isfinite(config.sigma_px),
-          "sigma_px must be finite and > 0");
-  require(config.max_image_pixels >= 1, "max_image_pixels must be >= 1");
+template <>
+const SettingTable<SiftConfig>& settingsOf<SiftConfig>() {
+  static const SettingTable<SiftConfig> table = [] {
+    SettingTable<SiftConfig> t;
+    t.add("max_features", &SiftConfig::max_features, "",
+          "SIFT keypoints kept, the strongest; 0 keeps all")
+        .atLeast(0);
+    t.add("octave_layers", &SiftConfig::octave_layers, "", "SIFT scales per octave")
+        .range(1, limits::kMaxOctaveLayers);
+    t.add("contrast_threshold", &SiftConfig::contrast_threshold, "",
+          "SIFT threshold on the DoG response (image values in [0, 1]), divided by octave_layers")
+        .atLeast(0.0);
+    t.add("edge_threshold", &SiftConfig::edge_threshold, "",
+          "SIFT: largest principal-curvature ratio kept")
+        .above(0.0);
+    t.add("sigma_px", &SiftConfig::sigma_px, "px", "SIFT: blur of the first octave's base image")
+        .above(0.0);
+    t.add("max_image_pixels", &SiftConfig::max_image_pixels, "pixels",
+          "larger images are refused (SIFT needs about 75 bytes per pixel of a pair)")
+        .atLeast(1);
+    return t;
+  }();
+  return table;
 }
+
+void validate(const SiftConfig& config) { checkSettings(config, "SiftConfig"); }
 
 void checkImageSize(const cv::Mat& image, const SiftConfig& config) {
   const size_t pixels = static_cast<size_t>(image.cols) * static_cast<size_t>(image.rows);

@@ -69,10 +69,10 @@ FilterResult filterEpipolar(const PutativeMatches& input, const EpipolarConfig& 
         "the epipolar filter needs calibration (a fundamental matrix for the pair)");
   }
   if (!input.cameras || (!input.cameras->first.distorted() && !input.cameras->second.distorted())) {
-    return keepNearEpipolarLines(input, *input.F_right_left, config.max_epipolar_px);
+    return keepNearEpipolarLines(input, *input.F_right_left, config.max_distance_px);
   }
   return keepNearDistortedEpipolarLines(input, *input.F_right_left, input.cameras->first,
-                                        input.cameras->second, config.max_epipolar_px);
+                                        input.cameras->second, config.max_distance_px);
 }
 
 }  // namespace sift_hull

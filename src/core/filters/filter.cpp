@@ -119,24 +119,6 @@ size_t FilterResult::keptCount() const {
   return count;
 }
 
-void validate(const FilterConfigs& configs) {
-  require(configs.epipolar.max_epipolar_px > 0.0, "epipolar.max_epipolar_px must be > 0");
-  require(configs.gsc.max_histogram_distance >= 0.0, "gsc.max_histogram_distance must be >= 0");
-  require(configs.gsc.threads >= 0 && configs.gsc.threads <= limits::kMaxThreads,
-          "gsc.threads must be in [0, " + std::to_string(limits::kMaxThreads) + "] (0: all)");
-  validate(configs.ransac, "ransac");
-  validate(configs.magsac, "magsac");
-  require(configs.gms.grid_cells >= 3 && configs.gms.grid_cells <= limits::kMaxGmsGridCells,
-          "gms.grid_cells must be in [3, " + std::to_string(limits::kMaxGmsGridCells) + "]");
-  require(configs.gms.threshold_factor > 0.0 && std::isfinite(configs.gms.threshold_factor),
-          "gms.threshold_factor must be finite and > 0");
-  require(configs.gsc.max_support >= 0 && configs.gsc.max_support <= 1000000,
-          "gsc.max_support must be in [0, 1000000] (0: exact)");
-  validate(configs.lsc);
-  validate(configs.local_gsc);
-  validate(configs.guided);
-  validate(configs.vote_ransac);
-}
 
 const std::vector<std::string>& filterNames() {
   static const std::vector<std::string> names = {"ratio",  "epipolar",    "gsc", "ransac",

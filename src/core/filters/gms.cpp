@@ -264,14 +264,6 @@ std::vector<double> bestScores(const std::vector<NormalisedMatch>& matches,
   return best;
 }
 
-void validateGmsConfig(const GmsConfig& config) {
-  limits::requireInRange("GmsConfig::grid_cells (a 3x3 neighbourhood at least)", config.grid_cells,
-                         3, limits::kMaxGmsGridCells);
-  if (!std::isfinite(config.threshold_factor) || config.threshold_factor <= 0.0) {
-    throw std::invalid_argument("GmsConfig::threshold_factor must be finite and positive, got " +
-                                std::to_string(config.threshold_factor));
-  }
-}
 
 void validateImageSize(const cv::Size& size, const std::string& which) {
   if (size.width <= 0 || size.height <= 0) {
@@ -283,7 +275,7 @@ void validateImageSize(const cv::Size& size, const std::string& which) {
 }  // namespace
 
 FilterResult filterGms(const PutativeMatches& input, const GmsConfig& config) {
-  validateGmsConfig(config);
+  validate(config);
   FilterResult result;
   if (input.matches.empty()) return result;  // no grid needed, so image sizes are not checked
   validateImageSize(input.left_image_size, "left_image_size");

@@ -43,7 +43,7 @@ bool explains(const Motion& motion, const cv::Point2f& a, const cv::Point2f& b,
               const GuidedFilterConfig& config) {
   const double r = residual(motion, a, b);
   return r <=
-         (motion.homography ? config.guided.guided_max_transfer_px : config.magsac.max_epipolar_px);
+         (motion.homography ? config.guided.max_transfer_px : config.magsac.max_epipolar_px);
 }
 
 /// The better motion (F or H) for the points, when any fits at least guided_min_model_inliers.
@@ -52,7 +52,7 @@ std::optional<Motion> fitMotion(const std::vector<cv::Point2f>& left,
                                 const GuidedFilterConfig& config, size_t* inliers) {
   const cv::Mat F = magsacFundamentalMatrix(left, right, config.magsac);
   const cv::Mat H =
-      magsacHomography(left, right, config.guided.guided_max_transfer_px, config.magsac);
+      magsacHomography(left, right, config.guided.max_transfer_px, config.magsac);
   std::optional<Motion> fundamental, homography;
   if (F.rows >= 3 && F.cols == 3) {
     fundamental = Motion{};
@@ -68,9 +68,9 @@ std::optional<Motion> fitMotion(const std::vector<cv::Point2f>& left,
     if (fundamental) count[0] += explains(*fundamental, left[i], right[i], config);
     if (homography) count[1] += explains(*homography, left[i], right[i], config);
   }
-  const bool use_h = homography && count[1] >= config.guided.guided_homography_share * count[0];
+  const bool use_h = homography && count[1] >= config.guided.homography_share * count[0];
   *inliers = count[use_h ? 1 : 0];
-  if (*inliers < static_cast<size_t>(config.guided.guided_min_model_inliers)) return std::nullopt;
+  if (*inliers < static_cast<size_t>(config.guided.min_model_inliers)) return std::nullopt;
   return use_h ? homography : fundamental;
 }
 
@@ -78,7 +78,7 @@ std::optional<Motion> fitMotion(const std::vector<cv::Point2f>& left,
 std::vector<Motion> fitMotions(std::vector<cv::Point2f> left, std::vector<cv::Point2f> right,
                                const GuidedFilterConfig& config) {
   std::vector<Motion> motions;
-  while (static_cast<int>(motions.size()) < config.guided.guided_max_models) {
+  while (static_cast<int>(motions.size()) < config.guided.max_models) {
     size_t inliers = 0;
     const std::optional<Motion> motion = fitMotion(left, right, config, &inliers);
     if (!motion) break;
@@ -95,19 +95,6 @@ std::vector<Motion> fitMotions(std::vector<cv::Point2f> left, std::vector<cv::Po
 
 }  // namespace
 
-void validate(const GuidedConfig& config) {
-  require(config.guided_max_transfer_px > 0.0 && config.guided_max_transfer_px <= 1000.0,
-          "guided_max_transfer_px must be in (0, 1000]");
-  require(config.guided_homography_share >= 0.0 && config.guided_homography_share <= 10.0,
-          "guided_homography_share must be in [0, 10]");
-  require(config.guided_max_models >= 1 && config.guided_max_models <= 8,
-          "guided_max_models must be in [1, 8]");
-  require(config.guided_min_model_inliers >= 8, "guided_min_model_inliers must be >= 8");
-  require(config.guided_min_support >= 0.0 && config.guided_min_support <= 1.0,
-          "guided_min_support must be in [0, 1]");
-  require(config.guided_max_fit_points >= 16 && config.guided_max_fit_points <= 1000000,
-          "guided_max_fit_points must be in [16, 1000000]");
-}
 
 FilterResult filterGuided(const PutativeMatches& input, const GuidedFilterConfig& config) {
   validate(config.guided);
@@ -116,7 +103,7 @@ FilterResult filterGuided(const PutativeMatches& input, const GuidedFilterConfig
   for (size_t m = 0; m < input.matches.size(); ++m) {
     if (local.keep[m]) kept.push_back(m);
   }
-  const size_t sample = static_cast<size_t>(config.guided.guided_max_fit_points);
+  const size_t sample = static_cast<size_t>(config.guided.max_fit_points);
   if (kept.size() > sample) {
     std::mt19937 random(static_cast<unsigned>(config.magsac.seed));
     std::shuffle(kept.begin(), kept.end(), random);
@@ -138,7 +125,7 @@ FilterResult filterGuided(const PutativeMatches& input, const GuidedFilterConfig
       explained = explained || explains(motion, a, b, config);
     }
     result.score[m] = best;
-    result.keep[m] = explained && local.score[m] >= config.guided.guided_min_support;
+    result.keep[m] = explained && local.score[m] >= config.guided.min_support;
   }
   return result;
 }

@@ -54,8 +54,8 @@ bool lands(const cv::Point2f& from, const cv::Point2f& offset, float s, float c,
   const float py = from.y + s * (sn * offset.x + c * offset.y);
   const float ex = to.x - px, ey = to.y - py;
   const float distance = s * std::sqrt(offset.x * offset.x + offset.y * offset.y);
-  const float tolerance = static_cast<float>(config.lsc_max_relative_error) * distance +
-                          static_cast<float>(config.lsc_min_tolerance_px);
+  const float tolerance = static_cast<float>(config.max_relative_error) * distance +
+                          static_cast<float>(config.min_tolerance_px);
   return ex * ex + ey * ey <= tolerance * tolerance;
 }
 
@@ -130,33 +130,17 @@ BothNeighbours neighboursInBoth(const LocalMatches& local, size_t k) {
 
 }  // namespace
 
-void validate(const LscConfig& config) {
-  require(config.lsc_neighbours >= 1 && config.lsc_neighbours <= kMaxNeighbours,
-          "lsc_neighbours must be in [1, " + std::to_string(kMaxNeighbours) + "]");
-  require(config.lsc_max_relative_error >= 0.0 && std::isfinite(config.lsc_max_relative_error),
-          "lsc_max_relative_error must be finite and >= 0");
-  require(config.lsc_min_tolerance_px >= 0.0 && std::isfinite(config.lsc_min_tolerance_px),
-          "lsc_min_tolerance_px must be finite and >= 0");
-  require(config.lsc_min_support >= 0.0 && config.lsc_min_support <= 1.0,
-          "lsc_min_support must be in [0, 1]");
-}
 
-void validate(const LocalGscConfig& config) {
-  require(config.local_gsc_neighbours >= 1 && config.local_gsc_neighbours <= kMaxNeighbours,
-          "local_gsc_neighbours must be in [1, " + std::to_string(kMaxNeighbours) + "]");
-  require(config.local_gsc_max_histogram_distance >= 0.0,
-          "local_gsc_max_histogram_distance must be >= 0");
-}
 
 FilterResult filterLsc(const PutativeMatches& input, const LscConfig& config) {
   validate(config);
   FilterResult result = FilterResult::keepingNone(input.matches.size());
   const LocalMatches local = localMatches(input);
-  const BothNeighbours near = neighboursInBoth(local, static_cast<size_t>(config.lsc_neighbours));
+  const BothNeighbours near = neighboursInBoth(local, static_cast<size_t>(config.neighbours));
   for (size_t i = 0; i < local.index.size(); ++i) {
     const double support = lscSupport(local, near.left, near.right, i, config);
     result.score[local.index[i]] = support;
-    result.keep[local.index[i]] = support >= config.lsc_min_support;
+    result.keep[local.index[i]] = support >= config.min_support;
   }
   return result;
 }
@@ -166,7 +150,7 @@ FilterResult filterLocalGsc(const PutativeMatches& input, const LocalGscConfig& 
   FilterResult result = FilterResult::keepingNone(input.matches.size());
   const LocalMatches local = localMatches(input);
   const BothNeighbours near =
-      neighboursInBoth(local, static_cast<size_t>(config.local_gsc_neighbours));
+      neighboursInBoth(local, static_cast<size_t>(config.neighbours));
   for (size_t i = 0; i < local.index.size(); ++i) {
     const std::vector<int> set = unionOfNeighbours(near.left, near.right, i);
     if (set.empty()) continue;
@@ -174,7 +158,7 @@ FilterResult filterLocalGsc(const PutativeMatches& input, const LocalGscConfig& 
         sectorHistogram(local.left, set, local.left[i], local.left_angle_rad[i]),
         sectorHistogram(local.right, set, local.right[i], local.right_angle_rad[i])};
     result.score[local.index[i]] = h.distance();
-    result.keep[local.index[i]] = h.distance() <= config.local_gsc_max_histogram_distance;
+    result.keep[local.index[i]] = h.distance() <= config.max_histogram_distance;
   }
   return result;
 }

@@ -98,14 +98,6 @@ cv::Mat magsacHomography(const std::vector<cv::Point2f>& left,
   }
 }
 
-void validate(const RobustFitConfig& config, const std::string& name) {
-  requireFit(config.max_epipolar_px > 0.0 && config.max_epipolar_px <= 1000.0,
-             name + ".max_epipolar_px must be in (0, 1000]");
-  requireFit(config.confidence > 0.0 && config.confidence < 1.0,
-             name + ".confidence must be in (0, 1)");
-  requireFit(config.max_iterations >= 1 && config.max_iterations <= 1000000,
-             name + ".max_iterations must be in [1, 1000000]");
-}
 
 FilterResult filterRansac(const PutativeMatches& input, const RobustFitConfig& config) {
   return fitFundamentalMatrix(input, cv::FM_RANSAC, config);

@@ -114,13 +114,13 @@ std::vector<int> votedPool(const FitSet& set, const VoteRansacConfig& config,
   }
   if (voting.empty()) return {};
   size_t count = 0;
-  const double half = config.vote_ransac_max_angle_deg;
+  const double half = config.max_angle_deg;
   const std::vector<int> turned =
       detail::densestWindow(set.rotation_deg, voting, half, 360.0, &count);
   const double even = double(voting.size()) * std::min(1.0, 2.0 * half / 360.0);
   if (require_cluster && double(count) < 2.0 * even) return {};
   return detail::densestWindow(set.log2_scale, turned,
-                               std::log2(config.vote_ransac_max_scale_ratio), 0.0, &count);
+                               std::log2(config.max_scale_ratio), 0.0, &count);
 }
 
 /// How many pairs the model explains when each left point meets the right point of another
@@ -154,10 +154,10 @@ size_t countIn(const std::vector<int>& inliers, const std::vector<int>& pool, si
 TwoViewFit fitHomography(const FitSet& set, const std::vector<int>& pool, const TwoViewFit& F,
                          TwoViewFitSettings settings, const VoteRansacFilterConfig& config,
                          std::mt19937* random) {
-  const double share = config.guided.guided_homography_share;
+  const double share = config.guided.homography_share;
   const int cap = settings.max_iterations;
   settings.homography = true;
-  settings.max_residual_px = config.guided.guided_max_transfer_px;
+  settings.max_residual_px = config.guided.max_transfer_px;
   if (!F.found) return fitTwoViewModel(set.pairs, pool, settings, random);
   const size_t pool_size = pool.empty() ? set.pairs.size() : pool.size();
   const double w = double(countIn(F.inliers, pool, set.pairs.size())) / double(pool_size);
@@ -188,10 +188,10 @@ TwoViewFit fitMotion(const FitSet& set, const std::vector<int>& pool, bool furth
   const size_t pool_size = pool.empty() ? set.pairs.size() : pool.size();
   const TwoViewFit H = fitHomography(set, pool, F, settings, config, random);
   const bool use_h = H.found && (!F.found || H.inliers.size() >=
-                                                 guided.guided_homography_share * F.inliers.size());
+                                                 guided.homography_share * F.inliers.size());
   TwoViewFit chosen = use_h ? H : F;
-  const double threshold = use_h ? guided.guided_max_transfer_px : fit.max_epipolar_px;
-  size_t needed = std::max<size_t>(size_t(guided.guided_min_model_inliers),
+  const double threshold = use_h ? guided.max_transfer_px : fit.max_epipolar_px;
+  size_t needed = std::max<size_t>(size_t(guided.min_model_inliers),
                                    4 * chanceInliers(chosen.model, set.pairs, threshold));
   if (further)
     needed = std::max<size_t>(needed, size_t(std::ceil(kFurtherMotionShare * pool_size)));
@@ -215,7 +215,7 @@ std::vector<int> unexplained(const FitSet& set, const std::vector<int>& inliers)
 
 /// The residual threshold of a motion, px.
 double thresholdOf(const TwoViewModel& motion, const VoteRansacFilterConfig& config) {
-  return motion.homography ? config.guided.guided_max_transfer_px : config.magsac.max_epipolar_px;
+  return motion.homography ? config.guided.max_transfer_px : config.magsac.max_epipolar_px;
 }
 
 /// Whether most inliers of a further motion lie within twice the threshold of an earlier motion:
@@ -238,11 +238,11 @@ bool leftoverOf(const std::vector<TwoViewModel>& earlier, const FitSet& set,
 std::vector<TwoViewModel> fitMotions(FitSet set, const VoteRansacFilterConfig& config) {
   std::mt19937 random(static_cast<unsigned>(config.magsac.seed));
   std::vector<TwoViewModel> motions;
-  while (static_cast<int>(motions.size()) < config.guided.guided_max_models &&
-         set.pairs.size() >= static_cast<size_t>(config.guided.guided_min_model_inliers)) {
+  while (static_cast<int>(motions.size()) < config.guided.max_models &&
+         set.pairs.size() >= static_cast<size_t>(config.guided.min_model_inliers)) {
     const bool further = !motions.empty();
     std::vector<int> pool = votedPool(set, config.vote_ransac, further);
-    const size_t least = 2 * static_cast<size_t>(config.guided.guided_min_model_inliers);
+    const size_t least = 2 * static_cast<size_t>(config.guided.min_model_inliers);
     if (further && pool.size() < least) break;  // no cluster that could hold a further motion
     if (pool.size() < 16) pool.clear();         // too few votes to sample from: sample from all
     const TwoViewFit motion = fitMotion(set, pool, further, config, &random);
@@ -289,15 +289,6 @@ void judge(const PointPairs& all, const std::vector<size_t>& index,
 
 }  // namespace
 
-void validate(const VoteRansacConfig& config) {
-  require(config.vote_ransac_max_angle_deg > 0.0 && config.vote_ransac_max_angle_deg <= 180.0,
-          "vote_ransac_max_angle_deg must be in (0, 180]");
-  require(
-      config.vote_ransac_max_scale_ratio > 1.0 && std::isfinite(config.vote_ransac_max_scale_ratio),
-      "vote_ransac_max_scale_ratio must be finite and > 1");
-  require(config.vote_ransac_max_fit_points >= 16 && config.vote_ransac_max_fit_points <= 1000000,
-          "vote_ransac_max_fit_points must be in [16, 1000000]");
-}
 
 namespace {
 
@@ -339,7 +330,7 @@ std::vector<TwoViewModel> motionsOf(const PutativeMatches& input, const PointPai
   validate(config.vote_ransac);
   validate(config.guided);
   validate(config.magsac, "magsac");
-  const size_t max_points = size_t(config.vote_ransac.vote_ransac_max_fit_points);
+  const size_t max_points = size_t(config.vote_ransac.max_fit_points);
   std::vector<TwoViewModel> motions = fitMotions(
       fitSetOf(input, index, max_points, static_cast<unsigned>(config.magsac.seed)), config);
   if (all.size() > max_points) {

@@ -29,18 +29,6 @@ std::string cameraProblem(const PinholeCamera& camera) {
 
 }  // namespace
 
-void validate(const HullStreamConfig& config) {
-  validate(config.hull);
-  if (!(config.min_view_distance_m >= 0.0) || !std::isfinite(config.min_view_distance_m)) {
-    throw std::invalid_argument("min_view_distance_m must be finite and at least 0");
-  }
-  if (!(config.min_view_angle_deg >= 0.0 && config.min_view_angle_deg <= 180.0)) {
-    throw std::invalid_argument("min_view_angle_deg must lie in [0, 180]");
-  }
-  if (config.max_waiting_views < 2) throw std::invalid_argument("max_waiting_views must be >= 2");
-  if (config.max_views < 1) throw std::invalid_argument("max_views must be >= 1");
-  if (config.box) HullCube::forConfig(*config.box, config.hull);  // throws for a bad box
-}
 
 HullStream::HullStream(HullStreamConfig config) : config_(std::move(config)) { validate(config_); }
 

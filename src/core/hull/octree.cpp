@@ -393,19 +393,5 @@ std::vector<VoxelBlock> occupiedBlocks(const VisualHull& hull) {
   return blocks;
 }
 
-void validate(const HullConfig& config) {
-  limits::requireInRange("HullConfig::max_depth", config.max_depth, 2, limits::kMaxHullDepth);
-  if (!(config.resolution_m >= 0.0) || !std::isfinite(config.resolution_m)) {
-    throw std::invalid_argument(
-        "HullConfig::resolution_m must be finite and >= 0 (0: from max_depth)");
-  }
-  if (!(config.distance_slack_px >= 0.0) || !std::isfinite(config.distance_slack_px)) {
-    throw std::invalid_argument("HullConfig::distance_slack_px must be finite and >= 0");
-  }
-  limits::requireInRange("HullConfig::padding_px", config.padding_px, 1, limits::kMaxPaddingPx);
-  limits::requireInRange("HullConfig::threads", config.threads, 1, limits::kMaxThreads);
-  limits::requireInRange("HullConfig::distance_reduction", config.distance_reduction, 0,
-                         kMaxDistanceReduction);
-}
 
 }  // namespace sift_hull

@@ -14,21 +14,6 @@
 
 namespace sift_hull {
 
-void validate(const SilhouetteConfig& config) {
-  if (config.silhouette_method != "threshold" && config.silhouette_method != "background") {
-    throw std::invalid_argument(
-        "SilhouetteConfig::silhouette_method must be threshold or background, not '" +
-        config.silhouette_method + "'");
-  }
-  if (!(config.threshold >= 0.0 && config.threshold <= 1.0)) {
-    throw std::invalid_argument("SilhouetteConfig::threshold must be in [0, 1], got " +
-                                std::to_string(config.threshold));
-  }
-  limits::requireInRange("SilhouetteConfig::dilate_px", config.dilate_px, 0,
-                         limits::kMaxMorphologyRadiusPx);
-  limits::requireInRange("SilhouetteConfig::erode_px", config.erode_px, 0,
-                         limits::kMaxMorphologyRadiusPx);
-}
 
 namespace {
 

@@ -204,24 +204,6 @@ void checkViews(const std::vector<PinholeCamera>& cameras,
 
 }  // namespace
 
-void validate(const FreeSpaceConfig& config) {
-  if (!(config.stop_margin_voxels >= 0.0) || !std::isfinite(config.stop_margin_voxels)) {
-    throw std::invalid_argument("FreeSpaceConfig::stop_margin_voxels must be finite and >= 0");
-  }
-  if (config.min_views < 1) throw std::invalid_argument("FreeSpaceConfig::min_views must be >= 1");
-  if (!(config.keep_radius_voxels >= 0.0) || !std::isfinite(config.keep_radius_voxels)) {
-    throw std::invalid_argument("FreeSpaceConfig::keep_radius_voxels must be finite and >= 0");
-  }
-  if (!(config.bulge_fraction >= 0.0) || !std::isfinite(config.bulge_fraction)) {
-    throw std::invalid_argument("FreeSpaceConfig::bulge_fraction must be finite and >= 0");
-  }
-  if (!(config.max_slant_deg > 0.0) || !(config.max_slant_deg <= 90.0)) {
-    throw std::invalid_argument("FreeSpaceConfig::max_slant_deg must lie in (0, 90]");
-  }
-  if (!(config.max_edge_fraction > 0.0) || !(config.max_edge_fraction <= 1.0)) {
-    throw std::invalid_argument("FreeSpaceConfig::max_edge_fraction must lie in (0, 1]");
-  }
-}
 
 std::vector<Eigen::Vector3i> freeVoxels(const VisualHull& hull,
                                         const std::vector<PinholeCamera>& cameras,

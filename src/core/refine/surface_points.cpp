@@ -92,14 +92,6 @@ std::vector<SurfacePoint> triangulatePair(const PinholeCamera& left, const Pinho
   return points;
 }
 
-void validate(const SurfacePointConfig& config) {
-  if (!(config.max_reprojection_px > 0.0) || !std::isfinite(config.max_reprojection_px)) {
-    throw std::invalid_argument("SurfacePointConfig::max_reprojection_px must be finite and > 0");
-  }
-  if (!(config.confirm_radius_voxels > 0.0) || !std::isfinite(config.confirm_radius_voxels)) {
-    throw std::invalid_argument("SurfacePointConfig::confirm_radius_voxels must be finite and > 0");
-  }
-}
 
 std::vector<SurfacePoint> surfacePoints(const std::vector<PinholeCamera>& cameras,
                                         const std::vector<PairMatches>& pairs,

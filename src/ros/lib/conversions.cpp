@@ -1,5 +1,7 @@
 #include "lib/conversions.h"
 
+#include "sift_hull/settings_json.h"
+
 #include <cv_bridge/cv_bridge.h>
 #include <sensor_msgs/image_encodings.h>
 #include <tf2_eigen/tf2_eigen.h>
@@ -225,81 +227,9 @@ sift_hull::Correspondences correspondencesMessage(const std_msgs::Header& left_h
   return out;
 }
 
-namespace {
-
-// One object per config struct, keyed by its field names (RobustFitConfig's prefixed by the
-// FilterConfigs member, as its ROS parameters are); settingsJson merges them.
-
-nlohmann::json toJson(const MatchConfig& config) {
-  return {{"ratio", config.ratio},
-          {"max_descriptor_distance", std::isfinite(config.max_descriptor_distance)
-                                          ? nlohmann::json(config.max_descriptor_distance)
-                                          : nlohmann::json(nullptr)},
-          {"cross_check", config.cross_check},
-          {"backend", config.backend}};
-}
-
-nlohmann::json toJson(const EpipolarConfig& config) {
-  return {{"max_epipolar_px", config.max_epipolar_px}};
-}
-
-nlohmann::json toJson(const GscConfig& config) {
-  return {{"max_histogram_distance", config.max_histogram_distance},
-          {"threads", config.threads},
-          {"max_support", config.max_support}};
-}
-
-nlohmann::json toJson(const RobustFitConfig& config, const std::string& prefix) {
-  return {{prefix + "_max_epipolar_px", config.max_epipolar_px},
-          {prefix + "_confidence", config.confidence},
-          {prefix + "_max_iterations", config.max_iterations},
-          {prefix + "_seed", config.seed}};
-}
-
-nlohmann::json toJson(const LscConfig& config) {
-  return {{"lsc_neighbours", config.lsc_neighbours},
-          {"lsc_max_relative_error", config.lsc_max_relative_error},
-          {"lsc_min_tolerance_px", config.lsc_min_tolerance_px},
-          {"lsc_min_support", config.lsc_min_support}};
-}
-
-nlohmann::json toJson(const LocalGscConfig& config) {
-  return {{"local_gsc_neighbours", config.local_gsc_neighbours},
-          {"local_gsc_max_histogram_distance", config.local_gsc_max_histogram_distance}};
-}
-
-nlohmann::json toJson(const GuidedConfig& config) {
-  return {{"guided_max_transfer_px", config.guided_max_transfer_px},
-          {"guided_homography_share", config.guided_homography_share},
-          {"guided_max_models", config.guided_max_models},
-          {"guided_min_model_inliers", config.guided_min_model_inliers},
-          {"guided_min_support", config.guided_min_support},
-          {"guided_max_fit_points", config.guided_max_fit_points}};
-}
-
-nlohmann::json toJson(const VoteRansacConfig& config) {
-  return {{"vote_ransac_max_angle_deg", config.vote_ransac_max_angle_deg},
-          {"vote_ransac_max_scale_ratio", config.vote_ransac_max_scale_ratio},
-          {"vote_ransac_max_fit_points", config.vote_ransac_max_fit_points}};
-}
-
-nlohmann::json toJson(const GmsConfig& config) {
-  return {{"grid_cells", config.grid_cells},
-          {"threshold_factor", config.threshold_factor},
-          {"with_rotation", config.with_rotation},
-          {"with_scale", config.with_scale}};
-}
-
-}  // namespace
-
 std::string settingsJson(const MatchConfig& matching, const FilterConfigs& filters) {
-  nlohmann::json json = toJson(matching);
-  for (const nlohmann::json& part :
-       {toJson(filters.epipolar), toJson(filters.gsc), toJson(filters.ransac, "ransac"),
-        toJson(filters.magsac, "magsac"), toJson(filters.gms), toJson(filters.lsc),
-        toJson(filters.local_gsc), toJson(filters.guided), toJson(filters.vote_ransac)}) {
-    json.update(part);
-  }
+  nlohmann::json json = sift_hull::settingsJson(settingsOf<MatchConfig>(), matching);
+  json.update(sift_hull::settingsJson(settingsOf<FilterConfigs>(), filters));
   return json.dump();
 }
 

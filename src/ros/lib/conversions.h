@@ -182,7 +182,7 @@ sift_hull::Correspondences correspondencesMessage(const std_msgs::Header& left_h
                                                   const std::vector<FilterResult>& results);
 
 /// The matching and filter settings as the JSON object of Correspondences.filter_settings, keyed
-/// by the names of their ROS parameters (the config fields; ransac_ / magsac_ for RobustFitConfig).
+/// by the names of their settings (sift_hull/settings.h), which are the ROS parameters' names.
 std::string settingsJson(const MatchConfig& matching, const FilterConfigs& filters);
 
 /// A pair's surface points (triangulatePair) and its two cameras (lens distortion dropped: the

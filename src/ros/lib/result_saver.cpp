@@ -17,6 +17,22 @@
 
 namespace sift_hull {
 
+template <>
+const SettingTable<ResultSaverConfig>& settingsOf<ResultSaverConfig>() {
+  static const SettingTable<ResultSaverConfig> table = [] {
+    SettingTable<ResultSaverConfig> t;
+    t.add("bag", &ResultSaverConfig::bag, "", "the bag being played (written by sift_hull_ros bag); required");
+    t.add("out_dir", &ResultSaverConfig::out_dir, "", "where the results are written (created if missing); required");
+    t.add("hull_save_service", &ResultSaverConfig::hull_save_service, "",
+          "hull_node's save service, called at the end");
+    t.add("timeout_s", &ResultSaverConfig::timeout_s, "s",
+          "give up waiting this long after start (wall time) and save what there is")
+        .above(0.0);
+    return t;
+  }();
+  return table;
+}
+
 BagEnd readBagEnd(const std::string& bag_path) {
   rosbag::Bag bag(bag_path, rosbag::bagmode::Read);
   BagEnd end;

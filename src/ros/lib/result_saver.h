@@ -10,6 +10,7 @@
 
 #include "sift_hull/Correspondences.h"
 #include "sift_hull/Octomap.h"
+#include "sift_hull/settings.h"
 
 namespace sift_hull {
 
@@ -21,6 +22,10 @@ struct ResultSaverConfig {
   /// Give up waiting this long after start (wall time) and save what there is.
   double timeout_s = 120.0;
 };
+
+/// Its settings (sift_hull/settings.h): save_results' private parameters.
+template <>
+const SettingTable<ResultSaverConfig>& settingsOf<ResultSaverConfig>();
 
 /// The last view and the last stereo pair in a bag of `sift_hull bag`, by header stamp.
 struct BagEnd {

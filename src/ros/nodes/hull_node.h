@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "lib/node_diagnostics.h"
+#include "nodes/hull_node_config.h"
 #include "lib/pairing_watch.h"
 #include "lib/pose_gate.h"
 #include "lib/pose_waits.h"
@@ -40,35 +41,6 @@
 
 namespace sift_hull {
 
-/// Node settings besides the hull's own (HullStreamConfig).
-struct HullNodeConfig {
-  std::string world_frame = "world";
-  /// Silhouettes waiting for their camera_info or their pose; when more wait, the oldest is
-  /// dropped with an error (a pose that never arrives). Also the views waiting to be carved:
-  /// when more come, the oldest is dropped and counted in /diagnostics.
-  int queue_size = 10;
-  /// A silhouette whose pose is not in tf this long after it arrived is reported and, should the
-  /// pose come later still, not carved. <= 0: wait as long as the queue allows.
-  double pose_timeout_s = 5.0;
-  /// Subscribe `image` (8-bit colour or mono) instead of `silhouette`, and extract each
-  /// silhouette by `recipe` (the Middlebury threshold, dilation and erosion).
-  bool from_image = false;
-  /// The silhouettes are of rectified images (image_proc's image_rect, whose camera_info is the
-  /// raw image's): cameras from P and R, whatever D says. False: raw, K and D, unless D is zero
-  /// and R and P rectify (ros_conversions::cameraInfoGeometry).
-  bool rectified = false;
-  SilhouetteConfig recipe;
-  /// Seconds of wall time between /diagnostics reports (diagnostic_updater's own parameter).
-  double diagnostic_period = 1.0;
-  /// Surface points (`surface_points`) kept for free-space carving; beyond, the oldest pairs'
-  /// points are dropped.
-  int max_surface_points = 200000;
-  /// Wall time between refinements with newly arrived surface points, seconds: each one derives
-  /// the free voxels of every point kept anew.
-  double refine_period_s = 1.0;
-  SurfacePointConfig surface_points;  ///< max_reprojection_px (inside the hull is checked too)
-  FreeSpaceConfig free_space;
-};
 
 /// The hull node: silhouettes (mono8) with the camera_info beside them (the silhouette topic's
 /// namespace + camera_info, image_transport's convention), once tf knows the camera's pose in

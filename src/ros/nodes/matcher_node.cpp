@@ -10,6 +10,7 @@
 
 #include "lib/conversions.h"
 #include "lib/node_diagnostics.h"
+#include "lib/reconfigure_settings.h"
 #include "lib/ros_params.h"
 #include "lib/wall_wait.h"
 #include "sift_hull/eval/match_drawing.h"
@@ -136,24 +137,10 @@ void MatcherNode::reportDiagnostics(diagnostic_updater::DiagnosticStatusWrapper&
 }
 
 void MatcherNode::serveReconfigure() {
-  sift_hull::MatcherConfig config;
-  config.ratio = settings_.matching.ratio;
-  config.max_descriptor_distance =
-      ros_params::descriptorDistanceParam(settings_.matching.max_descriptor_distance);
-  config.cross_check = settings_.matching.cross_check;
-  config.max_histogram_distance = settings_.filters.gsc.max_histogram_distance;
-  config.ransac_max_epipolar_px = settings_.filters.ransac.max_epipolar_px;
-  config.magsac_max_epipolar_px = settings_.filters.magsac.max_epipolar_px;
-  config.max_epipolar_px = settings_.filters.epipolar.max_epipolar_px;
-  config.threshold_factor = settings_.filters.gms.threshold_factor;
-  config.lsc_max_relative_error = settings_.filters.lsc.lsc_max_relative_error;
-  config.lsc_min_support = settings_.filters.lsc.lsc_min_support;
-  config.local_gsc_max_histogram_distance =
-      settings_.filters.local_gsc.local_gsc_max_histogram_distance;
-  config.guided_max_transfer_px = settings_.filters.guided.guided_max_transfer_px;
-  config.guided_min_support = settings_.filters.guided.guided_min_support;
-  config.vote_ransac_max_angle_deg = settings_.filters.vote_ransac.vote_ransac_max_angle_deg;
-  config.vote_ransac_max_scale_ratio = settings_.filters.vote_ransac.vote_ransac_max_scale_ratio;
+  sift_hull::MatcherConfig config = sift_hull::MatcherConfig::__getDefault__();
+  dynamic_reconfigure::Config message =
+      ros_conversions::reconfigureMessage(settingsOf<MatcherSettings>(), settings_);
+  config.__fromMessage__(message);
   reconfigure_ = std::make_unique<dynamic_reconfigure::Server<sift_hull::MatcherConfig>>(
       reconfigure_mutex_, private_nh_);
   reconfigure_->updateConfig(config);
@@ -162,26 +149,13 @@ void MatcherNode::serveReconfigure() {
 }
 
 void MatcherNode::onReconfigure(sift_hull::MatcherConfig& config, uint32_t) {
-  MatcherSettings changed = pipeline()->settings;
-  changed.matching.ratio = config.ratio;
-  changed.matching.max_descriptor_distance =
-      ros_params::descriptorDistanceFromParam(config.max_descriptor_distance);
-  changed.matching.cross_check = config.cross_check;
-  changed.filters.gsc.max_histogram_distance = config.max_histogram_distance;
-  changed.filters.ransac.max_epipolar_px = config.ransac_max_epipolar_px;
-  changed.filters.magsac.max_epipolar_px = config.magsac_max_epipolar_px;
-  changed.filters.epipolar.max_epipolar_px = config.max_epipolar_px;
-  changed.filters.gms.threshold_factor = config.threshold_factor;
-  changed.filters.lsc.lsc_max_relative_error = config.lsc_max_relative_error;
-  changed.filters.lsc.lsc_min_support = config.lsc_min_support;
-  changed.filters.local_gsc.local_gsc_max_histogram_distance =
-      config.local_gsc_max_histogram_distance;
-  changed.filters.guided.guided_max_transfer_px = config.guided_max_transfer_px;
-  changed.filters.guided.guided_min_support = config.guided_min_support;
-  changed.filters.vote_ransac.vote_ransac_max_angle_deg = config.vote_ransac_max_angle_deg;
-  changed.filters.vote_ransac.vote_ransac_max_scale_ratio = config.vote_ransac_max_scale_ratio;
+  const MatcherSettings current = pipeline()->settings;
+  MatcherSettings changed = current;
   std::shared_ptr<const Pipeline> replacement;
   try {
+    dynamic_reconfigure::Config message;
+    config.__toMessage__(message);
+    ros_conversions::applyReconfigure(settingsOf<MatcherSettings>(), message, &changed);
     validate(changed.matching);
     validate(changed.filters);
     replacement = std::make_shared<const Pipeline>(
@@ -189,6 +163,10 @@ void MatcherNode::onReconfigure(sift_hull::MatcherConfig& config, uint32_t) {
                  ros_conversions::settingsJson(changed.matching, changed.filters)});
   } catch (const std::invalid_argument& e) {
     log_.error("matcher: reconfiguration refused: ", e.what());
+    // The server publishes what the callback leaves in `config`: the settings in force.
+    dynamic_reconfigure::Config in_force =
+        ros_conversions::reconfigureMessage(settingsOf<MatcherSettings>(), current);
+    config.__fromMessage__(in_force);
     return;
   }
   std::lock_guard<std::mutex> lock(pipeline_mutex_);

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "lib/image_input.h"
+#include "nodes/matcher_node_config.h"
 #include "lib/node_diagnostics.h"
 #include "lib/pairing_watch.h"
 #include "lib/throttled_log.h"
@@ -37,47 +38,7 @@
 
 namespace sift_hull {
 
-/// Node settings besides the matching's own (SiftConfig, MatchConfig, FilterConfigs).
-struct MatcherNodeConfig {
-  /// Filters to run, by makeFilter name ("gsc", "magsac", "epipolar+gsc", ...). The epipolar
-  /// filter needs `calibrated`.
-  std::vector<std::string> filters = {kDefaultFilter};
-  int queue_size = 10;  ///< images waiting for their partner
-  /// Paired images waiting for a worker; when more come, the oldest pair is dropped (counted in
-  /// /diagnostics), so a stream faster than matching costs neither memory nor latency.
-  int max_waiting_pairs = 2;
-  /// Threads matching pairs side by side; with more than one, correspondences of pairs close in
-  /// time may be published out of stamp order.
-  int workers = 2;
-  bool approximate_sync = false;  ///< pair images by nearest stamps instead of equal ones
-  /// Also take the camera_info beside each image (image_transport's convention: the image topic's
-  /// namespace + camera_info, so left/camera_info and right/camera_info follow remappings of
-  /// left/image and right/image; paired by equal stamps with the images) and the right camera's
-  /// pose relative to the left: from tf when the images' frames differ, from the right P's
-  /// baseline when they share one frame (stereo_image_proc's convention). Gives the epipolar
-  /// filter's F, and the `points` of the matches the first filter keeps.
-  bool calibrated = false;
-  /// The images are rectified (image_proc's image_rect, whose camera_info is the raw image's):
-  /// their cameras are camera_info's P and R, whatever D says. Without it, D all zero with an R or
-  /// P that rectifies counts as rectified too (ros_conversions::cameraInfoGeometry).
-  bool rectified = false;
-  /// Subscribe one `image` topic instead, and match each frame with the one before it (the
-  /// earlier frame is the left image). Not with `calibrated`.
-  bool frame_to_frame = false;
-  /// How the images arrive: "raw", "compressed" (decoded here when no plugin provides it), or
-  /// another installed image_transport plugin.
-  std::string image_transport = "raw";
-  /// Seconds of wall time between /diagnostics reports (diagnostic_updater's own parameter).
-  double diagnostic_period = 1.0;
-};
 
-/// Everything the matcher node is configured with.
-struct MatcherSettings {
-  MatcherNodeConfig node;
-  SiftConfig sift;
-  MatchConfig matching;
-  FilterConfigs filters;
-};
 
 /// The matcher node: a left and a right image, paired by stamp, give SIFT matches and the
 /// verdicts of each filter on them (`correspondences`), and, when someone subscribes, a drawing of

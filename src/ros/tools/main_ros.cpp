@@ -1,5 +1,5 @@
-// sift_hull_ros: the tools that need ROS (bags, the nodes' benchmark), apart from the offline
-// program sift_hull, which links no ROS library.
+// sift_hull_ros: the tools that need ROS (bags, the nodes' benchmark, the files derived from
+// their settings), apart from the offline program sift_hull, which links no ROS library.
 #include "commands.h"
 
 namespace sift_hull {
@@ -7,6 +7,7 @@ namespace cli {
 
 int runBag(const std::vector<std::string>& args);
 int runBenchNodes(const std::vector<std::string>& args);
+int runSettings(const std::vector<std::string>& args);
 
 }  // namespace cli
 }  // namespace sift_hull
@@ -17,7 +18,9 @@ int main(int argc, char** argv) {
       "sift_hull_ros",
       {{"bag", "write calibrated views as a ROS bag that drives both nodes", runBag},
        {"bench-nodes", "time the matcher and hull nodes as processes on topic streams",
-        runBenchNodes}},
+        runBenchNodes},
+       {"settings", "write or check the parameter files and tables derived from the settings",
+        runSettings}},
       "sift_hull",
       {"dataset-info", "scene", "match", "bench-filters", "evaluate-filters", "hull",
        "bench-hull"}};

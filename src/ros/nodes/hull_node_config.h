@@ -1,0 +1,60 @@
+#pragma once
+
+// hull_node's own settings, without ROS, and the table its parameters derive from.
+
+#include <string>
+
+#include "sift_hull/hull/hull_stream.h"
+#include "sift_hull/hull/silhouette.h"
+#include "sift_hull/refine/free_space.h"
+#include "sift_hull/refine/surface_points.h"
+#include "sift_hull/settings.h"
+
+namespace sift_hull {
+
+/// Node settings besides the hull's own (HullStreamConfig).
+struct HullNodeConfig {
+  std::string world_frame = "world";
+  /// Silhouettes waiting for their camera_info or their pose; when more wait, the oldest is
+  /// dropped with an error (a pose that never arrives). Also the views waiting to be carved:
+  /// when more come, the oldest is dropped and counted in /diagnostics.
+  int queue_size = 10;
+  /// A silhouette whose pose is not in tf this long after it arrived is reported and, should the
+  /// pose come later still, not carved. <= 0: wait as long as the queue allows.
+  double pose_timeout_s = 5.0;
+  /// Subscribe `image` (8-bit colour or mono) instead of `silhouette`, and extract each
+  /// silhouette by `recipe` (the Middlebury threshold, dilation and erosion).
+  bool from_image = false;
+  /// The silhouettes are of rectified images (image_proc's image_rect, whose camera_info is the
+  /// raw image's): cameras from P and R, whatever D says. False: raw, K and D, unless D is zero
+  /// and R and P rectify (ros_conversions::cameraInfoGeometry).
+  bool rectified = false;
+  SilhouetteConfig recipe;
+  /// Seconds of wall time between /diagnostics reports (diagnostic_updater's own parameter).
+  double diagnostic_period = 1.0;
+  /// Surface points (`surface_points`) kept for free-space carving; beyond, the oldest pairs'
+  /// points are dropped.
+  int max_surface_points = 200000;
+  /// Wall time between refinements with newly arrived surface points, seconds: each one derives
+  /// the free voxels of every point kept anew.
+  double refine_period_s = 1.0;
+  SurfacePointConfig surface_points;  ///< max_reprojection_px (inside the hull is checked too)
+  FreeSpaceConfig free_space;
+};
+
+/// Its settings (sift_hull/settings.h); the silhouette recipe, the surface points and free-space
+/// settings are nested without a prefix.
+template <>
+const SettingTable<HullNodeConfig>& settingsOf<HullNodeConfig>();
+
+/// Everything hull_node is configured with: its private parameters are the settings of both
+/// tables, node first.
+struct HullNodeSettings {
+  HullNodeConfig node;
+  HullStreamConfig stream;
+};
+
+template <>
+const SettingTable<HullNodeSettings>& settingsOf<HullNodeSettings>();
+
+}  // namespace sift_hull
