@@ -126,7 +126,7 @@ TEST_F(CommandOutput, TakesTheResolutionInMetresInsteadOfTheDepth) {
   EXPECT_EQ(result["resolution_m"].get<double>(), 0.05);
   EXPECT_EQ(result["max_depth"].get<int>(), 6);  // a box of about 2 m: 2^6 - 3 cells of 5 cm
   EXPECT_EQ(test::runProgram(hull + "-1", &out, &err), 2);
-  EXPECT_NE(err.find("resolution_m must be finite and >= 0"), std::string::npos) << err;
+  EXPECT_NE(err.find("--resolution-m must be a finite number >= 0, not -1"), std::string::npos) << err;
   EXPECT_EQ(test::runProgram(hull + "0.00001", &out, &err), 1);
   EXPECT_NE(err.find("raise resolution_m (at least"), std::string::npos) << err;
 }

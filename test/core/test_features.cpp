@@ -276,7 +276,7 @@ TEST(MatchDescriptors, RejectsInvalidConfigs) {
   std::vector<MatchConfig> bad(5);
   bad[0].ratio = 0.0;
   bad[1].ratio = -0.5;
-  bad[2].max_descriptor_distance = 0.0;
+  bad[2].max_descriptor_distance = std::nan("");  // 0 is no limit (the default)
   bad[3].max_descriptor_distance = -1.0;
   bad[4].backend = "kd-tree";
   for (const MatchConfig& config : bad) {

@@ -281,7 +281,7 @@ TEST_F(HostileCommandLine, HugeCoordinatesEndInAClearError) {
 TEST_F(HostileCommandLine, OutOfRangeSettingsAreUsageErrors) {
   std::string err, out;
   EXPECT_EQ(hull("--max-depth 12", &err), 2);
-  EXPECT_TRUE(contains(err, "max_depth")) << err;
+  EXPECT_TRUE(contains(err, "--max-depth must be")) << err;
   EXPECT_EQ(hull("--threads 100000", &err), 2);
   EXPECT_EQ(hull("--views ,", &err), 2);
   const std::string left = *scene_ + "/view_0000.png", right = *scene_ + "/view_0001.png";

@@ -101,7 +101,7 @@ TEST(HullCommand, FlagsAreTheSettingNamesAndOldNamesAreRefused) {
     EXPECT_EQ(test::runProgram(hull + flags, &json, errors), 0) << *errors;
     return nlohmann::json::parse(json);  // stdout holds the JSON object alone
   };
-  std::string new_err, err;
+  std::string new_err;
   const nlohmann::json with_new =
       run("--max-depth 5 --distance-slack-px 3 --dilate-px 3 --erode-px 1", &new_err);
   const nlohmann::json with_defaults = run("--max-depth 5", &err);

@@ -37,7 +37,7 @@ TEST(MatcherReconfigure, DefaultsEqualTheConfigStructs) {
   EXPECT_EQ(cfg.bools, table.bools);
   EXPECT_EQ(cfg.ints, table.ints);
   EXPECT_EQ(cfg.strs, table.strs);
-  EXPECT_GE(table.doubles.size(), 15u);
+  EXPECT_GE(table.doubles.size(), 14u);
 }
 
 TEST(MatcherReconfigure, EveryRunTimeSettingGoesBothWays) {
@@ -118,9 +118,9 @@ TEST(SettingsFiles, TheDerivedFilesAreCurrent) {
 
 TEST(SettingsFiles, TheNodeReferenceHasATableForEachNode) {
   const std::string doc = settings_files::withParameterTables(
-      "<!-- BEGIN GENERATED PARAMETERS hull_node -->\nold\n"
+      "<!-- BEGIN GENERATED PARAMETERS hull_node -->\nSTALE TEXT\n"
       "<!-- END GENERATED PARAMETERS hull_node -->\n");
-  EXPECT_EQ(doc.find("old"), std::string::npos);
+  EXPECT_EQ(doc.find("STALE TEXT"), std::string::npos);
   EXPECT_NE(doc.find("| `~max_depth` | integer | `8` | levels | [2, 10] |"), std::string::npos)
       << doc;
   EXPECT_NE(doc.find("| `~box` |"), std::string::npos);

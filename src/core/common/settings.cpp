@@ -22,7 +22,9 @@ void checkNumber(const SettingInfo& info, double value) {
   if (in_range && finite_enough) return;
   std::string text = info.name + " must be ";
   if (!info.allow_infinity) text += "a finite number ";
-  throw std::invalid_argument(text + "in " + settingRangeText(info) + ", not " +
+  const std::string range = settingRangeText(info);
+  const bool interval = range[0] == '[' || range[0] == '(';
+  throw std::invalid_argument(text + (interval ? "in " : "") + range + ", not " +
                               numberText(value));
 }
 
