@@ -4,6 +4,7 @@
 // option --<name with '-' for '_'>, its default the config's value, its help the table's help with
 // unit and range. A boolean whose default is false is a flag; lists are comma-separated.
 
+#include <cctype>
 #include <string>
 
 #include "args.h"
@@ -35,7 +36,8 @@ void addSettingOptions(ArgParser* parser, const SettingTable<Config>& table,
     if (s.info.type == SettingType::kStringList || s.info.type == SettingType::kNumberList) {
       shown = shown.substr(1, shown.size() - 2);  // the brackets
     }
-    const std::string value_name = s.info.unit.empty() ? "VALUE" : s.info.unit;
+    std::string value_name = s.info.unit.empty() ? "VALUE" : s.info.unit;
+    for (char& c : value_name) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
     parser->addOption(optionName(s.info.name), value_name, optionHelp(s.info), shown);
   }
 }

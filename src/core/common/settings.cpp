@@ -8,6 +8,10 @@ namespace {
 
 std::string numberText(double value) {
   if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
+  // Whole numbers in full (1000000, not 1e+06).
+  if (value == std::floor(value) && std::abs(value) < 1e15) {
+    return std::to_string(static_cast<long long>(value));
+  }
   std::ostringstream out;
   out << value;
   return out.str();
