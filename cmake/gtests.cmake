@@ -32,6 +32,7 @@ set(SIFT_HULL_CORE_GTESTS
   test_mesh_render eval
   test_hull eval
   test_free_carving eval
+  test_point_carved_stream eval
   test_refine eval
   test_dense_matching eval
   test_refine_command eval
@@ -44,7 +45,7 @@ set(SIFT_HULL_CORE_GTESTS
   test_mirrored_world eval
   test_distorted_scene eval
 )
-# The harnesses of test/fuzz whose corpus test_fuzz_corpus replays: CamelCase entry point names,
-# file test/fuzz/fuzz_<snake_case>.cpp.
-set(SIFT_HULL_FUZZ_HARNESSES MiddleburyPar ProjectionList Homography Pfm Ply BoundingBox
-  ColmapBinary Npy)
+# The libFuzzer harnesses of test/fuzz, file test/fuzz/fuzz_<name>.cpp; test_fuzz_corpus replays
+# their corpus through them, each entry point renamed fuzz_<name>.
+set(SIFT_HULL_FUZZ_HARNESSES middlebury_par projection_list homography pfm ply bounding_box
+  colmap_binary npy)

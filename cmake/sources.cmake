@@ -50,6 +50,7 @@ set(SIFT_HULL_CORE_SOURCES
   src/core/hull/silhouette.cpp
   src/core/refine/dense_matching.cpp
   src/core/refine/free_space.cpp
+  src/core/refine/point_carved_stream.cpp
   src/core/refine/refine_settings.cpp
   src/core/refine/surface_points.cpp
 )

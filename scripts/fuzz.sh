@@ -17,7 +17,7 @@
 # is non-zero when a harness failed.
 #
 # Environment:
-#   FUZZ_HARNESSES    the harnesses to run (default: all eight), space-separated
+#   FUZZ_HARNESSES    the harnesses to run (default: all of them), space-separated
 #   FUZZ_KEEP_GOING   1: run libFuzzer in fork mode (-fork=1 -ignore_crashes=1 -ignore_timeouts=1
 #                     -ignore_ooms=1), collecting every distinct finding within SECONDS instead
 #                     of stopping at the first (default 0)
@@ -29,10 +29,8 @@ source "$(dirname "${BASH_SOURCE[0]}")/sanitize_common.sh"
 seconds="${1:-30}"
 [[ "$seconds" =~ ^[1-9][0-9]*$ ]] || { echo "usage: scripts/fuzz.sh [SECONDS [RESULTS_DIR]]" >&2; exit 2; }
 results="$(realpath -m "${2:-$sanitize_build/fuzz_results}")"
-harnesses=(${FUZZ_HARNESSES:-fuzz_middlebury_par fuzz_projection_list fuzz_homography fuzz_pfm
-  fuzz_ply fuzz_bounding_box fuzz_colmap_binary fuzz_npy})
 mkdir -p "$results"
-for harness in "${harnesses[@]}" fuzz_build; do rm -f "$results/fuzz-$harness.xml"; done
+rm -f "$results"/fuzz-*.xml
 
 work="$sanitize_build/fuzz"
 findings="$sanitize_build/findings"
@@ -48,6 +46,8 @@ if ! build_sanitized fuzzers "$sanitize_build/fuzz_build.log"; then
   exit 1
 fi
 echo "fuzz: build took $(($(date +%s) - build_start)) s"
+# The build lists every harness of cmake/gtests.cmake (SIFT_HULL_FUZZ_HARNESSES).
+harnesses=(${FUZZ_HARNESSES:-$(cat "$sanitize_build/fuzzers.txt")})
 
 export ASAN_OPTIONS=detect_leaks=1:halt_on_error=1
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1

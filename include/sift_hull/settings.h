@@ -89,6 +89,10 @@ std::string settingText(const SettingValue& value);
 /// "any", "background, threshold").
 std::string settingRangeText(const SettingInfo& info);
 
+/// A setting's help with its unit and range after it, as --help, config/*.yaml, cfg/Matcher.cfg
+/// and the docs give it: "largest distance (px; >= 0)".
+std::string settingDescription(const SettingInfo& info);
+
 /// One setting of Config: what it is, and how to read and write it on a Config.
 template <typename Config>
 struct Setting {

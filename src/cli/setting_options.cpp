@@ -38,13 +38,6 @@ std::string optionName(const std::string& setting_name) {
   return name;
 }
 
-std::string optionHelp(const SettingInfo& info) {
-  std::string note = info.unit;
-  const std::string range = settingRangeText(info);
-  if (range != "any" && range != "true, false") note += (note.empty() ? "" : "; ") + range;
-  return note.empty() ? info.help : info.help + " (" + note + ")";
-}
-
 SettingValue optionValue(const ArgParser& parser, const SettingInfo& info) {
   const std::string option = optionName(info.name);
   switch (info.type) {

@@ -16,9 +16,6 @@ namespace cli {
 /// The option name of a setting: lsc_max_relative_error -> lsc-max-relative-error.
 std::string optionName(const std::string& setting_name);
 
-/// "help (unit; range)" as --help shows it.
-std::string optionHelp(const SettingInfo& info);
-
 /// The value given (or defaulted) for `info`'s option, as its setting's type; throws UsageError
 /// for a value that is not of that type.
 SettingValue optionValue(const ArgParser& parser, const SettingInfo& info);
@@ -29,7 +26,7 @@ void addSettingOptions(ArgParser* parser, const SettingTable<Config>& table,
   for (const Setting<Config>& s : table.settings()) {
     const SettingValue value = s.get(defaults);
     if (s.info.type == SettingType::kBool && !std::get<bool>(value)) {
-      parser->addFlag(optionName(s.info.name), optionHelp(s.info));
+      parser->addFlag(optionName(s.info.name), settingDescription(s.info));
       continue;
     }
     std::string shown = settingText(value);
@@ -38,7 +35,7 @@ void addSettingOptions(ArgParser* parser, const SettingTable<Config>& table,
     }
     std::string value_name = s.info.unit.empty() ? "VALUE" : s.info.unit;
     for (char& c : value_name) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
-    parser->addOption(optionName(s.info.name), value_name, optionHelp(s.info), shown);
+    parser->addOption(optionName(s.info.name), value_name, settingDescription(s.info), shown);
   }
 }
 

@@ -14,14 +14,14 @@
 #include <string>
 #include <vector>
 
-extern "C" int fuzzMiddleburyPar(const uint8_t* data, size_t size);
-extern "C" int fuzzProjectionList(const uint8_t* data, size_t size);
-extern "C" int fuzzHomography(const uint8_t* data, size_t size);
-extern "C" int fuzzPfm(const uint8_t* data, size_t size);
-extern "C" int fuzzPly(const uint8_t* data, size_t size);
-extern "C" int fuzzBoundingBox(const uint8_t* data, size_t size);
-extern "C" int fuzzColmapBinary(const uint8_t* data, size_t size);
-extern "C" int fuzzNpy(const uint8_t* data, size_t size);
+extern "C" int fuzz_middlebury_par(const uint8_t* data, size_t size);
+extern "C" int fuzz_projection_list(const uint8_t* data, size_t size);
+extern "C" int fuzz_homography(const uint8_t* data, size_t size);
+extern "C" int fuzz_pfm(const uint8_t* data, size_t size);
+extern "C" int fuzz_ply(const uint8_t* data, size_t size);
+extern "C" int fuzz_bounding_box(const uint8_t* data, size_t size);
+extern "C" int fuzz_colmap_binary(const uint8_t* data, size_t size);
+extern "C" int fuzz_npy(const uint8_t* data, size_t size);
 
 namespace sift_hull {
 namespace {
@@ -53,14 +53,14 @@ void replay(const std::string& harness, Harness run) {
   }
 }
 
-TEST(FuzzCorpus, MiddleburyPar) { replay("fuzz_middlebury_par", fuzzMiddleburyPar); }
-TEST(FuzzCorpus, ProjectionList) { replay("fuzz_projection_list", fuzzProjectionList); }
-TEST(FuzzCorpus, Homography) { replay("fuzz_homography", fuzzHomography); }
-TEST(FuzzCorpus, Pfm) { replay("fuzz_pfm", fuzzPfm); }
-TEST(FuzzCorpus, Ply) { replay("fuzz_ply", fuzzPly); }
-TEST(FuzzCorpus, BoundingBox) { replay("fuzz_bounding_box", fuzzBoundingBox); }
-TEST(FuzzCorpus, ColmapBinary) { replay("fuzz_colmap_binary", fuzzColmapBinary); }
-TEST(FuzzCorpus, Npy) { replay("fuzz_npy", fuzzNpy); }
+TEST(FuzzCorpus, MiddleburyPar) { replay("fuzz_middlebury_par", fuzz_middlebury_par); }
+TEST(FuzzCorpus, ProjectionList) { replay("fuzz_projection_list", fuzz_projection_list); }
+TEST(FuzzCorpus, Homography) { replay("fuzz_homography", fuzz_homography); }
+TEST(FuzzCorpus, Pfm) { replay("fuzz_pfm", fuzz_pfm); }
+TEST(FuzzCorpus, Ply) { replay("fuzz_ply", fuzz_ply); }
+TEST(FuzzCorpus, BoundingBox) { replay("fuzz_bounding_box", fuzz_bounding_box); }
+TEST(FuzzCorpus, ColmapBinary) { replay("fuzz_colmap_binary", fuzz_colmap_binary); }
+TEST(FuzzCorpus, Npy) { replay("fuzz_npy", fuzz_npy); }
 
 }  // namespace
 }  // namespace sift_hull

@@ -9,6 +9,7 @@
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/PointCloud2.h>
+#include <std_srvs/Empty.h>
 #include <tf2_ros/static_transform_broadcaster.h>
 
 #include <cmath>
@@ -16,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "common/octomap_volume.h"
 #include "lib/conversions.h"
 #include "ros_wait.h"
 #include "sift_hull/Octomap.h"
@@ -65,6 +67,23 @@ class HullNodeTest : public ::testing::Test {
     ASSERT_TRUE(waitFor([&] {
       return silhouette_pub_.getNumSubscribers() > 0 && info_pub_.getNumSubscribers() > 0;
     })) << "the hull node did not subscribe";
+    resetHull();  // each case starts from no hull, whatever ran before it
+  }
+
+  /// Calls ~reset and waits for the empty map it publishes.
+  void resetHull() {
+    std_srvs::Empty reset;
+    ASSERT_TRUE(ros::service::waitForService("/hull/reset", ros::Duration(kDeadline_s)));
+    ASSERT_TRUE(ros::service::call("/hull/reset", reset));
+    ASSERT_TRUE(waitFor([&] { return last_octomap_ && occupiedVolume(*last_octomap_) == 0.0; }))
+        << "no empty map after ~reset";
+  }
+
+  /// Publishes every view; the stamp of the last.
+  ros::Time publishAllViews() {
+    ros::Time last;
+    for (int v = 0; v < kViews; ++v) last = publishView(v);
+    return last;
   }
 
   /// Publishes view `v` with `stamp` (default: now); `change` may spoil the messages first.

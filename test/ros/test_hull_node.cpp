@@ -1,6 +1,6 @@
 // The hull node wired up: synthetic silhouettes, camera_info and tf in; octomap and cloud out;
-// ~reset; bad input answered with an error while later good input still counts. Every wait has a
-// deadline.
+// ~reset; bad input answered with an error while later good input still counts. One behaviour per
+// case, each from an empty hull (the fixture resets it); every wait has a deadline.
 
 #include <geometry_msgs/TransformStamped.h>
 #include <gtest/gtest.h>
@@ -44,37 +44,46 @@ using test::occupiedVolume;
 using test::waitFor;
 namespace rc = ros_conversions;
 
-TEST_F(HullNodeTest, CarvesTheSphereResetsAndSurvivesBadInput) {
-  ros::Time last;
-  for (int v = 0; v < kViews; ++v) last = publishView(v);
-  ASSERT_TRUE(octomapStampedAtLeast(last)) << "no octomap for the last view";
-
-  // The node's hull is the offline one of the same views: the box refitted as views shrank it
-  // (within a cell of the LP box of all views), and near the sphere.
-  const HullInput input = hullInputOf(views_);
+/// The volume OctoMap gives the offline hull of the test's views at depth 6, and its resolution.
+std::pair<double, double> offlineVolumeAndResolution(const std::vector<RenderedView>& views) {
   HullConfig config;
   config.max_depth = 6;
-  const HullResult offline = buildHull(input, config);
-  EXPECT_NEAR(last_octomap_->resolution, offline.hull.cube().resolution_m,
-              0.02 * offline.hull.cube().resolution_m);
-  double offline_m3 = 0.0;
-  const std::unique_ptr<octomap::OcTree> tree = toOctomap(offline.hull);
-  for (auto leaf = tree->begin_leafs(); leaf != tree->end_leafs(); ++leaf) {
-    if (tree->isNodeOccupied(*leaf)) offline_m3 += std::pow(leaf.getSize(), 3);
-  }
+  const HullResult offline = buildHull(hullInputOf(views), config);
+  return {occupiedVolume(rc::octomapMessage(*toOctomap(offline.hull), {})),
+          offline.hull.cube().resolution_m};
+}
+
+const double kSphere_m3 = 4.0 / 3.0 * M_PI * std::pow(0.8, 3);
+
+TEST_F(HullNodeTest, CarvesTheOfflineHullOfTheSameViews) {
+  const ros::Time last = publishAllViews();
+  ASSERT_TRUE(octomapStampedAtLeast(last)) << "no octomap for the last view";
+  // The box refitted as views shrank it (within a cell of the LP box of all views).
+  const auto [offline_m3, resolution_m] = offlineVolumeAndResolution(views_);
+  EXPECT_NEAR(last_octomap_->resolution, resolution_m, 0.02 * resolution_m);
   EXPECT_EQ(last_octomap_->header.frame_id, "world");
   EXPECT_NEAR(occupiedVolume(*last_octomap_), offline_m3, 0.02 * offline_m3);
-  const double sphere_m3 = 4.0 / 3.0 * M_PI * std::pow(0.8, 3);
-  EXPECT_NEAR(occupiedVolume(*last_octomap_), sphere_m3, 0.3 * sphere_m3);
-  ASSERT_TRUE(waitFor([&] { return last_cloud_ && last_cloud_->header.stamp >= last; }));
+  EXPECT_NEAR(occupiedVolume(*last_octomap_), kSphere_m3, 0.3 * kSphere_m3);
+}
+
+TEST_F(HullNodeTest, PublishesTheOccupiedCellsWithTheMap) {
+  const ros::Time last = publishAllViews();
+  ASSERT_TRUE(waitFor([&] { return last_cloud_ && last_cloud_->header.stamp >= last; }))
+      << "no occupied_cells for the last view";
+  EXPECT_EQ(last_cloud_->header.frame_id, "world");
   EXPECT_GT(last_cloud_->width * last_cloud_->height, 100u);
+}
 
-  std_srvs::Empty reset;
-  ASSERT_TRUE(ros::service::waitForService("/hull/reset", ros::Duration(kDeadline_s)));
-  ASSERT_TRUE(ros::service::call("/hull/reset", reset));
-  ASSERT_TRUE(waitFor([&] { return occupiedVolume(*last_octomap_) == 0.0; }));
+TEST_F(HullNodeTest, ResetPublishesAnEmptyMapAndTheNextViewsCarveAnew) {
+  ASSERT_TRUE(octomapStampedAtLeast(publishAllViews()));
+  ASSERT_GT(occupiedVolume(*last_octomap_), 0.0);
+  resetHull();
+  ASSERT_TRUE(octomapStampedAtLeast(publishAllViews())) << "views after ~reset were not carved";
+  const double offline_m3 = offlineVolumeAndResolution(views_).first;
+  EXPECT_NEAR(occupiedVolume(*last_octomap_), offline_m3, 0.02 * offline_m3);
+}
 
-  // Bad input: each is refused with an error, and the node carries on.
+TEST_F(HullNodeTest, RefusesBadViewsAndCarvesTheGoodOnesAfterThem) {
   publishView(
       0, [](sensor_msgs::Image* image, sensor_msgs::CameraInfo*) { image->encoding = "rgb8"; });
   publishView(1, [](sensor_msgs::Image*, sensor_msgs::CameraInfo* info) { info->width = 640; });
@@ -88,15 +97,20 @@ TEST_F(HullNodeTest, CarvesTheSphereResetsAndSurvivesBadInput) {
   publishView(6, [](sensor_msgs::Image* image, sensor_msgs::CameraInfo* info) {
     image->header.frame_id = info->header.frame_id = "camera_nan";
   });
-  // Out of order: newest first. The node carves them all the same.
+  ASSERT_TRUE(octomapStampedAtLeast(publishAllViews())) << "good views after bad ones not carved";
+  const double offline_m3 = offlineVolumeAndResolution(views_).first;
+  EXPECT_NEAR(occupiedVolume(*last_octomap_), offline_m3, 0.02 * offline_m3)
+      << "a bad view changed the hull";
+}
+
+TEST_F(HullNodeTest, CarvesViewsThatArriveNewestFirst) {
   const ros::Time now = ros::Time::now();
   for (int v = 0; v < kViews; ++v) publishView(v, {}, now - ros::Duration(0.1 * v));
-  ASSERT_TRUE(waitFor([&] { return occupiedVolume(*last_octomap_) > 0.5 * sphere_m3; }))
+  ASSERT_TRUE(waitFor([&] { return occupiedVolume(*last_octomap_) > 0.5 * kSphere_m3; }))
       << "views out of order were not carved";
-  ASSERT_TRUE(ros::service::call("/hull/reset", reset));
-  ASSERT_TRUE(waitFor([&] { return occupiedVolume(*last_octomap_) == 0.0; }));
-  for (int v = 0; v < kViews; ++v) last = publishView(v);
-  ASSERT_TRUE(octomapStampedAtLeast(last)) << "good views after bad ones were not carved";
+  ros::WallDuration(1.0).sleep();  // every view carved by then
+  ros::spinOnce();
+  const double offline_m3 = offlineVolumeAndResolution(views_).first;
   EXPECT_NEAR(occupiedVolume(*last_octomap_), offline_m3, 0.02 * offline_m3);
 }
 
@@ -117,14 +131,9 @@ TEST_F(HullNodeTest, ASilhouetteWhosePoseComesAfterTheTimeoutIsReportedAndNotCar
         std::lock_guard<std::mutex> lock(errors_mutex);
         if (log->level == rosgraph_msgs::Log::ERROR) errors.push_back(log->msg);
       });
-  std_srvs::Empty reset;  // views the node has already taken would be left out as redundant
-  ASSERT_TRUE(ros::service::waitForService("/hull/reset", ros::Duration(kDeadline_s)));
-  ASSERT_TRUE(ros::service::call("/hull/reset", reset));
-  ros::Time last;
-  for (int v = 0; v < kViews; ++v) last = publishView(v);
-  ASSERT_TRUE(octomapStampedAtLeast(last));
-  // The node's count of views dropped without pose before this one (the first test's frame
-  // without pose is among them).
+  ASSERT_TRUE(octomapStampedAtLeast(publishAllViews()));
+  // The node's count of views dropped without pose before this one (other cases' frames without
+  // pose may be among them).
   const auto withoutPose = [&](double at_least) {
     return test::diagnosticValue(nh_, "hull", "views without pose",
                                  [at_least](double n) { return n >= at_least; });
@@ -179,12 +188,9 @@ class HullFromImageTest : public HullNodeTest {
 };
 
 TEST_F(HullFromImageTest, ExtractsSilhouettesFromImagesAndCarves) {
-  ros::Time last;
-  for (int v = 0; v < kViews; ++v) last = publishView(v);
-  ASSERT_TRUE(octomapStampedAtLeast(last)) << "no octomap for the last view";
+  ASSERT_TRUE(octomapStampedAtLeast(publishAllViews())) << "no octomap for the last view";
   // The Middlebury recipe on the rendered images gives close to the rendered masks' hull.
-  const double sphere_m3 = 4.0 / 3.0 * M_PI * std::pow(0.8, 3);
-  EXPECT_NEAR(occupiedVolume(*last_octomap_), sphere_m3, 0.3 * sphere_m3);
+  EXPECT_NEAR(occupiedVolume(*last_octomap_), kSphere_m3, 0.3 * kSphere_m3);
 }
 
 /// A stream faster than the node carves at depth 8: 300 views from 300 viewpoints at 100 Hz,

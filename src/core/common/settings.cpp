@@ -106,6 +106,13 @@ std::string settingText(const SettingValue& value) {
   return std::visit(Visitor{}, value);
 }
 
+std::string settingDescription(const SettingInfo& info) {
+  std::string note = info.unit;
+  const std::string range = settingRangeText(info);
+  if (range != "any" && range != "true, false") note += (note.empty() ? "" : "; ") + range;
+  return note.empty() ? info.help : info.help + " (" + note + ")";
+}
+
 std::string settingRangeText(const SettingInfo& info) {
   if (!info.choices.empty()) {
     std::string text;

@@ -15,10 +15,6 @@
 namespace sift_hull {
 namespace {
 
-void require(bool condition, const std::string& message) {
-  if (!condition) throw std::invalid_argument("filter config: " + message);
-}
-
 /// One motion: a fundamental matrix or a homography (right = H left).
 struct Motion {
   bool homography = false;

@@ -14,10 +14,6 @@
 namespace sift_hull {
 namespace {
 
-void require(bool condition, const std::string& message) {
-  if (!condition) throw std::invalid_argument("filter config: " + message);
-}
-
 constexpr int kMaxNeighbours = 1024;
 
 /// The matches whose points, sizes and angles are all finite, with both images' points and each

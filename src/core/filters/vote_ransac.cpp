@@ -16,10 +16,6 @@
 namespace sift_hull {
 namespace {
 
-void require(bool condition, const std::string& message) {
-  if (!condition) throw std::invalid_argument("filter config: " + message);
-}
-
 /// A further motion must explain this share of its voted pool: the clear majority of the cluster
 /// its matches voted for (mismatches of a repeated texture can agree with an F on half of one).
 constexpr double kFurtherMotionShare = 2.0 / 3.0;

@@ -57,14 +57,6 @@ std::string yamlValue(const SettingValue& value) {
   return settingText(value);
 }
 
-/// "help (unit; range)".
-std::string described(const SettingInfo& info) {
-  std::string note = info.unit;
-  const std::string range = settingRangeText(info);
-  if (range != "any" && range != "true, false") note += (note.empty() ? "" : "; ") + range;
-  return note.empty() ? info.help : info.help + " (" + note + ")";
-}
-
 std::string pythonString(const std::string& text) {
   std::string quoted = "\"";
   for (char c : text) quoted += (c == '"' || c == '\\') ? std::string("\\") + c : std::string(1, c);
@@ -88,7 +80,7 @@ std::string cfgLine(const Row& row) {
     value = pythonString(std::get<std::string>(row.value));
   }
   std::string line = "gen.add(" + pythonString(row.info.name) + ", " + type + ", 0, " +
-                     pythonString(described(row.info)) + ", " + value;
+                     pythonString(settingDescription(row.info)) + ", " + value;
   if (row.info.type == SettingType::kInt || row.info.type == SettingType::kDouble) {
     line += ", " + pythonBound(row.info.min) + ", " + pythonBound(row.info.max);
   }
@@ -116,7 +108,7 @@ std::string parameterYaml(const std::string& node) {
   text += "# " + std::string(kDerivedNote) + "\n";
   text += "# Reference: docs/NODES.md.\n";
   for (const Row& row : nodeRows(node)) {
-    text += row.info.name + ": " + yamlValue(row.value) + "  # " + described(row.info) + "\n";
+    text += row.info.name + ": " + yamlValue(row.value) + "  # " + settingDescription(row.info) + "\n";
   }
   return text;
 }

@@ -6,11 +6,8 @@
 #include <sstream>
 
 #include "lib/conversions.h"
-#include "lib/node_diagnostics.h"
 #include "lib/ros_params.h"
 #include "lib/save_paths.h"
-#include "sift_hull/hull/hull_octomap.h"
-#include "sift_hull/hull/mesh.h"
 #include "sift_hull/hull/silhouette.h"
 #include "sift_hull/io/ply.h"
 
@@ -22,11 +19,22 @@ constexpr double kThrottle_s = 5.0;
 constexpr double kPairingPatience_s = 5.0;
 /// Wall time a changed hull may wait for the queue to drain before it is published anyway.
 constexpr double kMaxPublishDelay_s = 1.0;
+/// Wall time a pair's surface points may wait for the pose of their frame in tf.
+constexpr double kSurfacePoseWait_s = 0.5;
 
-std::string shortNumber(double value) {
+std::string pointText(const geometry_msgs::Point& point) {
   std::ostringstream out;
-  out << value;
+  out << "(" << point.x << ", " << point.y << ", " << point.z << ")";
   return out.str();
+}
+
+visualization_msgs::MarkerArray deleteAllMarkers(const std_msgs::Header& header) {
+  visualization_msgs::Marker delete_all;
+  delete_all.header = header;
+  delete_all.action = visualization_msgs::Marker::DELETEALL;
+  visualization_msgs::MarkerArray markers;
+  markers.markers.push_back(delete_all);
+  return markers;
 }
 
 }  // namespace
@@ -40,30 +48,7 @@ HullNode::HullNode(ros::NodeHandle nh, ros::NodeHandle private_nh, HullNodeConfi
     : nh_(nh),
       private_nh_(private_nh),
       config_(std::move(node_config)),
-      stream_(std::move(hull_config)),
-      octomap_pub_(nh_.advertise<sift_hull::Octomap>("octomap_binary", 1, true)),
-      octomap_full_pub_(nh_.advertise<sift_hull::Octomap>(
-          "octomap_full", 1, [this](const ros::SingleSubscriberPublisher&) { publishFullNow(); },
-          ros::SubscriberStatusCallback(), ros::VoidConstPtr(), true)),
-      cloud_pub_(nh_.advertise<sensor_msgs::PointCloud2>(
-          "occupied_cells", 1,
-          [this](const ros::SingleSubscriberPublisher&) { publishCentresNow(&cloud_pub_); },
-          ros::SubscriberStatusCallback(), ros::VoidConstPtr(), true)),
-      centers_pub_(nh_.advertise<sensor_msgs::PointCloud2>(
-          "octomap_point_cloud_centers", 1,
-          [this](const ros::SingleSubscriberPublisher&) { publishCentresNow(&centers_pub_); },
-          ros::SubscriberStatusCallback(), ros::VoidConstPtr(), true)),
-      markers_pub_(nh_.advertise<visualization_msgs::MarkerArray>(
-          "occupied_cells_vis_array", 1,
-          [this](const ros::SingleSubscriberPublisher&) { publishMarkersNow(); },
-          ros::SubscriberStatusCallback(), ros::VoidConstPtr(), true)),
-      free_markers_pub_(nh_.advertise<visualization_msgs::MarkerArray>(
-          "free_cells_vis_array", 1,
-          [this](const ros::SingleSubscriberPublisher&) { publishFreeMarkersNow(); },
-          ros::SubscriberStatusCallback(), ros::VoidConstPtr(), true)),
-      mesh_pub_(nh_.advertise<visualization_msgs::Marker>(
-          "mesh", 1, [this](const ros::SingleSubscriberPublisher&) { publishMeshNow(); },
-          ros::SubscriberStatusCallback(), ros::VoidConstPtr(), true)),
+      hull_(std::move(hull_config), config_.carving),
       work_(config_.queue_size, 1, [this](View& view) { integrate(view); }),
       pairing_({config_.from_image ? "image" : "silhouette", "camera_info"}, kPairingPatience_s,
                "a silhouette pairs with the camera_info of an equal stamp once tf has its "
@@ -73,33 +58,31 @@ HullNode::HullNode(ros::NodeHandle nh, ros::NodeHandle private_nh, HullNodeConfi
                    [this](diagnostic_updater::DiagnosticStatusWrapper& status) {
                      reportDiagnostics(status);
                    }),
-      pose_waits_(config_.pose_timeout_s, 4 * static_cast<size_t>(config_.queue_size)),
       tf_listener_(tf_buffer_),
-      pose_filter_(tf_buffer_, config_.world_frame, config_.queue_size, nh_),
-      pose_gate_(&pose_waits_,
-                 [this](const sensor_msgs::ImageConstPtr& late) { onPoseTooLate(late); }),
+      pose_wait_(
+          nh_, &tf_buffer_, config_.world_frame, static_cast<uint32_t>(config_.queue_size),
+          config_.pose_timeout_s,
+          [this](const sensor_msgs::ImageConstPtr& silhouette,
+                 const sensor_msgs::CameraInfoConstPtr& info,
+                 const Eigen::Isometry3d& T_W_C) { onPosed(silhouette, info, T_W_C); },
+          [this](const std::string&, const std::string& why) {
+            log_.error("hull: dropped a silhouette: ", why);
+          }),
       sync_(config_.queue_size) {
-  pose_timer_ = nh_.createWallTimer(ros::WallDuration(0.2),
-                                    [this](const ros::WallTimerEvent&) { reportPoseTimeouts(); });
+  advertiseOutputs();
   refine_timer_ = nh_.createWallTimer(ros::WallDuration(config_.refine_period_s),
                                       [this](const ros::WallTimerEvent&) { refineIfDue(); });
   advertiseServices();
   subscribe();
 }
 
+// --- Input -------------------------------------------------------------------------------------
+
 void HullNode::subscribe() {
-  pose_filter_.setTolerance(ros::Duration(0.0));
-  pose_filter_.registerFailureCallback(
-      [this](const sensor_msgs::ImageConstPtr& image,
-             tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
-        onPoseMissing(image, reason);
-      });
   silhouette_sub_.registerCallback(&HullNode::onArrival, this);
   info_sub_.registerCallback(&HullNode::onInfoArrival, this);
-  pose_filter_.connectInput(silhouette_sub_);
-  pose_gate_.connectInput(pose_filter_);
-  sync_.connectInput(pose_gate_, info_sub_);
-  sync_.registerCallback(&HullNode::onView, this);
+  sync_.connectInput(silhouette_sub_, info_sub_);
+  sync_.registerCallback(&HullNode::onPair, this);
   surface_points_sub_ = nh_.subscribe("surface_points", static_cast<uint32_t>(config_.queue_size),
                                       &HullNode::onSurfacePoints, this);
   // camera_info beside the image, wherever remapping put it (image_transport's convention).
@@ -108,75 +91,74 @@ void HullNode::subscribe() {
   silhouette_sub_.subscribe(nh_, image_topic, config_.queue_size);
 }
 
+void HullNode::onArrival(const sensor_msgs::ImageConstPtr& silhouette) {
+  pairing_.arrived(0, silhouette->header.stamp.toSec(), PairingWatch::Clock::now());
+}
+
 void HullNode::onInfoArrival(const sensor_msgs::CameraInfoConstPtr& info) {
   pairing_.arrived(1, info->header.stamp.toSec(), PairingWatch::Clock::now());
 }
 
-void HullNode::onArrival(const sensor_msgs::ImageConstPtr& silhouette) {
-  pairing_.arrived(0, silhouette->header.stamp.toSec(), PairingWatch::Clock::now());
-  pose_waits_.arrived(silhouette->header.frame_id, silhouette->header.stamp.toSec(),
-                      PoseWaits::Clock::now());
+void HullNode::onPair(const sensor_msgs::ImageConstPtr& silhouette,
+                      const sensor_msgs::CameraInfoConstPtr& info) {
+  pairing_.paired();
+  pose_wait_.add(silhouette, info);
 }
 
-void HullNode::reportPoseTimeouts() {
-  for (const std::string& frame : pose_waits_.expire(PoseWaits::Clock::now())) {
-    ++views_without_pose_;
-    log_.error("hull: dropped a silhouette: ",
-               "no pose of '" + frame + "' in '" + config_.world_frame + "' within " +
-                   shortNumber(config_.pose_timeout_s) + " s (~pose_timeout_s)");
-  }
+void HullNode::onPosed(const sensor_msgs::ImageConstPtr& silhouette,
+                       const sensor_msgs::CameraInfoConstPtr& info,
+                       const Eigen::Isometry3d& T_W_C) {
+  View view;
+  if (!viewOf(silhouette, *info, T_W_C, &view)) return;
+  pushCounted(&work_, std::move(view), "hull: views waiting to be carved (~queue_size)");
 }
 
-void HullNode::onPoseTooLate(const sensor_msgs::ImageConstPtr& silhouette) {
-  log_.error("hull: view '" + silhouette->header.frame_id + "' ignored: ",
-             "its pose came after ~pose_timeout_s");
-}
-
-void HullNode::onPoseMissing(const sensor_msgs::ImageConstPtr& silhouette,
-                             tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
-  if (pose_waits_.forget(silhouette->header.frame_id, silhouette->header.stamp.toSec()))
-    ++views_without_pose_;
-  const char* why = reason == tf2_ros::filter_failure_reasons::EmptyFrameID ? "empty frame id"
-                    : reason == tf2_ros::filter_failure_reasons::OutTheBack
-                        ? "older than the transforms tf keeps"
-                        : "the transform never arrived";
-  log_.error("hull: dropped a silhouette: ", "no pose of '" + silhouette->header.frame_id +
-                                                 "' in '" + config_.world_frame + "' (" + why +
-                                                 ")");
-}
-
-bool HullNode::cameraOf(const sensor_msgs::Image& silhouette, const sensor_msgs::CameraInfo& info,
-                        PinholeCamera* camera) {
-  Eigen::Isometry3d T_W_C;
-  try {
-    T_W_C = tf2::transformToEigen(tf_buffer_.lookupTransform(
-        config_.world_frame, silhouette.header.frame_id, silhouette.header.stamp));
-  } catch (const tf2::TransformException& e) {
-    log_.error("hull: view ignored: ", e.what());
-    return false;
-  }
+bool HullNode::viewOf(const sensor_msgs::ImageConstPtr& silhouette,
+                      const sensor_msgs::CameraInfo& info, const Eigen::Isometry3d& T_W_C,
+                      View* view) {
+  const std::string& name = silhouette->header.frame_id;
   std::string why_not;
-  if (!ros_conversions::cameraFromInfo(info, T_W_C, cv::Size(silhouette.width, silhouette.height),
-                                       camera, &why_not, config_.rectified)) {
-    log_.error("hull: view '" + silhouette.header.frame_id + "' ignored: ", why_not);
+  view->mask = config_.from_image ? ros_conversions::eightBitImage(silhouette, &why_not)
+                                  : ros_conversions::maskFromImage(*silhouette, &why_not);
+  if (config_.from_image && !view->mask.empty()) {
+    view->mask = silhouetteFromImage(view->mask, config_.recipe);
+  }
+  if (view->mask.empty() ||
+      !ros_conversions::cameraFromInfo(info, T_W_C, cv::Size(silhouette->width, silhouette->height),
+                                       &view->camera, &why_not, config_.rectified)) {
+    log_.error("hull: view '" + name + "' ignored: ", why_not);
     return false;
   }
+  view->name = name;
+  view->stamp = silhouette->header.stamp;
+  view->generation = generation_;
   return true;
 }
 
-void HullNode::onView(const sensor_msgs::ImageConstPtr& silhouette,
-                      const sensor_msgs::CameraInfoConstPtr& info) {
-  pairing_.paired();
-  std::string why_not;
-  const cv::Mat mask = maskOf(silhouette, &why_not);
-  if (mask.empty()) {
-    log_.error("hull: view '" + silhouette->header.frame_id + "' ignored: ", why_not);
+void HullNode::onSurfacePoints(const sift_hull::SurfacePointsConstPtr& message) {
+  Eigen::Isometry3d T_W_F;
+  try {
+    T_W_F = tf2::transformToEigen(
+        tf_buffer_.lookupTransform(config_.world_frame, message->header.frame_id,
+                                   message->header.stamp, ros::Duration(kSurfacePoseWait_s)));
+  } catch (const tf2::TransformException& e) {
+    log_.error("hull: surface points ignored: ", "no pose of '" + message->header.frame_id +
+                                                     "' in '" + config_.world_frame +
+                                                     "' at their stamp (" + e.what() + ")");
     return;
   }
-  View view{silhouette->header.frame_id, {}, mask, silhouette->header.stamp, generation_};
-  if (!cameraOf(*silhouette, *info, &view.camera)) return;
-  pushCounted(&work_, std::move(view), "hull: views waiting to be carved (~queue_size)");
+  PinholeCamera left, right;
+  std::vector<SurfacePoint> points;
+  std::string why_not;
+  if (!ros_conversions::surfacePointsFromMessage(*message, T_W_F, &left, &right, &points,
+                                                 &why_not)) {
+    log_.error("hull: surface points ignored: ", why_not);
+    return;
+  }
+  hull_.addSurfacePoints(left, right, std::move(points), message->header.stamp.toSec());
 }
+
+// --- Work --------------------------------------------------------------------------------------
 
 void HullNode::integrate(View& view) {
   std::lock_guard<std::mutex> lock(hull_mutex_);
@@ -185,13 +167,8 @@ void HullNode::integrate(View& view) {
   const bool changed = carve(view);
   const ros::WallTime carved = ros::WallTime::now();
   last_carve_ms_ = (carved - start).toSec() * 1e3;
-  redundant_views_ = stream_.redundantViews();
   last_view_stamp_ = view.stamp.toSec();
   if (changed) unpublished_stamp_ = view.stamp;
-  if (stream_.hasHull() && stream_.hullGeneration() != refined_generation_) {
-    std::lock_guard<std::mutex> points_lock(points_mutex_);
-    refine_pending_ = refine_pending_ || !pairs_.empty();  // the points carve the new tree too
-  }
   // Waiting, skipped or redundant: the published hull stands. Views queued behind this one refine
   // the hull at once: each state would cost a conversion the next view replaces, so the hull is
   // published when the queue has drained, or kMaxPublishDelay_s after the last publication under
@@ -201,55 +178,30 @@ void HullNode::integrate(View& view) {
       (ros::WallTime::now() - last_publish_wall_).toSec() < kMaxPublishDelay_s) {
     return;
   }
-  try {
-    publish(unpublished_stamp_);
-  } catch (const std::exception& e) {  // e.g. a hull beyond OctoMap's key range
-    unpublished_stamp_ = ros::Time();
-    log_.error("hull: cannot publish the hull: ", e.what());
-  }
+  publishPending();
   last_publish_ms_ = (ros::WallTime::now() - carved).toSec() * 1e3;
-}
-
-void HullNode::reportDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& status) {
-  reportQueue(work_.counts(), "views", &status);
-  status.add("views redundant", redundant_views_.load());
-  status.add("views refused", refused_views_.load());
-  status.add("views without pose", views_without_pose_.load());
-  status.add("free voxels (surface_points)", free_voxels_.load());
-  status.add("last view carve ms", last_carve_ms_.load());
-  status.add("last view publish ms", last_publish_ms_.load());
-  status.add("last view stamp", last_view_stamp_.load());
-  const std::string unpaired = pairing_.problem(PairingWatch::Clock::now());
-  if (!unpaired.empty()) {
-    status.mergeSummary(diagnostic_msgs::DiagnosticStatus::WARN, unpaired);
-    ROS_WARN_THROTTLE(kThrottle_s, "hull: %s", unpaired.c_str());
-  }
-}
-
-cv::Mat HullNode::maskOf(const sensor_msgs::ImageConstPtr& message, std::string* why_not) const {
-  if (!config_.from_image) return ros_conversions::maskFromImage(*message, why_not);
-  const cv::Mat image = ros_conversions::eightBitImage(message, why_not);
-  return image.empty() ? image : silhouetteFromImage(image, config_.recipe);
 }
 
 bool HullNode::carve(const View& view) {
   const std::string& name = view.name;
   try {
-    const HullStream::Outcome outcome = stream_.add(name, view.camera, view.mask);
-    for (const std::string& refusal : stream_.takeRefusals()) {
+    const HullStream::Outcome outcome = hull_.add(name, view.camera, view.mask);
+    const HullStream& stream = hull_.stream();
+    for (const std::string& refusal : hull_.takeRefusals()) {
       log_.error("hull: view refused: ", refusal);
     }
-    refused_views_ = stream_.refusedViews();
+    refused_views_ = stream.refusedViews();
+    redundant_views_ = stream.redundantViews();
     if (outcome == HullStream::Outcome::kWaiting) {
       ROS_INFO_THROTTLE(kThrottle_s, "hull: %zu view(s) waiting for a bounding box: %s",
-                        stream_.waitingViews(), stream_.whyNoBox().c_str());
+                        stream.waitingViews(), stream.whyNoBox().c_str());
     }
     if (outcome == HullStream::Outcome::kSkipped) ROS_INFO("hull: view '%s' skipped", name.c_str());
     if (outcome == HullStream::Outcome::kRedundant) {
       ROS_INFO_THROTTLE(kThrottle_s,
                         "hull: %zu view(s) left out so far: seen from where a view already taken "
                         "was (~min_view_distance_m, ~min_view_angle_deg)",
-                        stream_.redundantViews());
+                        stream.redundantViews());
     }
     return outcome == HullStream::Outcome::kCarved;
   } catch (const std::exception& e) {
@@ -258,41 +210,171 @@ bool HullNode::carve(const View& view) {
   }
 }
 
+void HullNode::refineIfDue() {
+  std::lock_guard<std::mutex> lock(hull_mutex_);
+  if (!hull_.refineDue()) return;
+  try {
+    const PointCarvedStream::Refinement refinement = hull_.refine();
+    free_voxels_ = refinement.free_voxels;
+    publish(std::max(ros::Time(refinement.newest_stamp_s), header_.stamp));
+  } catch (const std::exception& e) {
+    log_.error("hull: cannot carve with the surface points: ", e.what());
+  }
+}
+
+// --- Output ------------------------------------------------------------------------------------
+
+template <typename Message>
+void HullNode::addOutput(const std::string& topic, bool lazy, std::function<Message()> hull,
+                         std::function<Message()> empty) {
+  const size_t index = outputs_.size();
+  Output output;
+  output.lazy = lazy;
+  // Latched, so that a later subscriber gets the newest map; the lazy ones are also sent to each
+  // new subscriber, since they are built only while someone looks.
+  output.pub = lazy ? nh_.advertise<Message>(
+                          topic, 1,
+                          [this, index](const ros::SingleSubscriberPublisher&) {
+                            sendToNewSubscriber(index);
+                          },
+                          ros::SubscriberStatusCallback(), ros::VoidConstPtr(), true)
+                    : nh_.advertise<Message>(topic, 1, true);
+  output.send = [this, index, hull, empty] {
+    outputs_[index].pub.publish(published_ ? hull() : empty());
+  };
+  outputs_.push_back(std::move(output));
+}
+
+void HullNode::advertiseOutputs() {
+  using ros_conversions::octomapFullMessage;
+  using ros_conversions::octomapMessage;
+  using Cloud = sensor_msgs::PointCloud2;
+  using Markers = visualization_msgs::MarkerArray;
+  outputs_.reserve(7);  // no reallocation while a subscriber's callback reads an entry
+  const auto emptyTree = [this] { return octomap::OcTree(empty_resolution_m_); };
+  const auto centres = [this] {
+    return cleared_boxes_.empty() ? ros_conversions::pointCloudMessage(
+                                        publishedCompact(true).occupied_centres_W, header_)
+                                  : ros_conversions::occupiedCellsCloud(publishedTree(), header_);
+  };
+  const auto noCentres = [this, emptyTree] {
+    return ros_conversions::occupiedCellsCloud(emptyTree(), header_);
+  };
+  addOutput<sift_hull::Octomap>(
+      "octomap_binary", false,
+      [this] {  // the compact map needs no OctoMap nodes, unless boxes were cleared
+        return cleared_boxes_.empty() ? octomapMessage(publishedCompact(false), header_)
+                                      : octomapMessage(publishedTree(), header_);
+      },
+      [this, emptyTree] { return octomapMessage(emptyTree(), header_); });
+  addOutput<sift_hull::Octomap>(
+      "octomap_full", true, [this] { return octomapFullMessage(publishedTree(), header_); },
+      [this, emptyTree] { return octomapFullMessage(emptyTree(), header_); });
+  addOutput<Cloud>("occupied_cells", true, centres, noCentres);
+  addOutput<Cloud>("octomap_point_cloud_centers", true, centres, noCentres);
+  addOutput<Markers>(
+      "occupied_cells_vis_array", true,
+      [this] { return ros_conversions::occupiedCellsMarkers(publishedTree(), header_); },
+      [this] { return deleteAllMarkers(header_); });
+  addOutput<Markers>(
+      "free_cells_vis_array", true,
+      [this] { return ros_conversions::freeCellsMarkers(publishedTree(), header_); },
+      [this] { return deleteAllMarkers(header_); });
+  addOutput<visualization_msgs::Marker>(
+      "mesh", true, [this] { return ros_conversions::meshMarker(publishedMesh(), header_); },
+      [this] { return deleteAllMarkers(header_).markers.front(); });
+}
+
+void HullNode::publish(const ros::Time& stamp, bool all) {
+  header_.stamp = stamp;
+  header_.frame_id = config_.world_frame;
+  last_publish_wall_ = ros::WallTime::now();
+  unpublished_stamp_ = ros::Time();
+  tree_.reset();
+  compact_.reset();
+  mesh_.reset();
+  published_ = hull_.stream().hasHull();
+  for (const Output& output : outputs_) {
+    if (all || !output.lazy || output.pub.getNumSubscribers() > 0) output.send();
+  }
+}
+
+void HullNode::publishPending() {
+  if (unpublished_stamp_.isZero()) return;
+  try {
+    publish(unpublished_stamp_);
+  } catch (const std::exception& e) {  // e.g. a hull beyond OctoMap's key range
+    unpublished_stamp_ = ros::Time();
+    log_.error("hull: cannot publish the hull: ", e.what());
+  }
+}
+
+void HullNode::sendToNewSubscriber(size_t output) {
+  std::lock_guard<std::mutex> lock(hull_mutex_);
+  publishPending();  // views carved but not yet published: their map, with their stamp
+  if (!published_) return;
+  try {
+    outputs_[output].send();
+  } catch (const std::exception& e) {  // never into roscpp's callback
+    log_.error("hull: cannot publish the hull: ", e.what());
+  }
+}
+
+const octomap::OcTree& HullNode::publishedTree() {
+  if (!tree_) {
+    tree_ = toOctomap(hull_.stream().hull());
+    for (const Box3d& box : cleared_boxes_) clearBox(box, tree_.get());
+  }
+  return *tree_;
+}
+
+const CompactOctomap& HullNode::publishedCompact(bool centres) {
+  if (!compact_ || (centres && !compact_centres_)) {
+    compact_ = std::make_unique<CompactOctomap>(compactOctomap(hull_.stream().hull(), centres));
+    compact_centres_ = centres;
+  }
+  return *compact_;
+}
+
+const TriangleMesh& HullNode::publishedMesh() {
+  if (!mesh_) mesh_ = std::make_unique<TriangleMesh>(hull_.stream().hull().mesh());
+  return *mesh_;
+}
+
+// --- Services and diagnostics ------------------------------------------------------------------
+
+void HullNode::advertiseServices() {
+  reset_srv_ = private_nh_.advertiseService("reset", &HullNode::reset, this);
+  save_srv_ = private_nh_.advertiseService("save", &HullNode::save, this);
+  // octomap_server's names: the maps in the node's namespace, clearing private.
+  using Request = sift_hull::GetOctomap::Request;
+  using Response = sift_hull::GetOctomap::Response;
+  binary_srv_ = nh_.advertiseService<Request, Response>(
+      "octomap_binary", [this](Request&, Response& response) { return getMap(true, &response); });
+  full_srv_ = nh_.advertiseService<Request, Response>(
+      "octomap_full", [this](Request&, Response& response) { return getMap(false, &response); });
+  clear_bbx_srv_ = private_nh_.advertiseService("clear_bbx", &HullNode::clearBbx, this);
+}
+
 bool HullNode::reset(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
   std::lock_guard<std::mutex> lock(hull_mutex_);
   ++generation_;
   const size_t discarded = work_.clear();  // views from before the reset
-  const double resolution_m = stream_.hasHull() ? stream_.hull().cube().resolution_m
-                              : octree_         ? octree_->getResolution()
-                                                : 0.1;
-  stream_.reset();
-  {
-    std::lock_guard<std::mutex> points_lock(points_mutex_);
-    pairs_.clear();
-    stored_points_ = 0;
-    refine_pending_ = false;
-  }
+  if (hull_.stream().hasHull()) empty_resolution_m_ = hull_.stream().hull().cube().resolution_m;
+  hull_.reset();
   free_voxels_ = 0;
-  unpublished_stamp_ = ros::Time();
-  cleared_boxes_.clear();
   refused_views_ = 0;
-  publishEmpty(resolution_m);
-  octree_.reset();
-  published_ = false;
-  mesh_.reset();
+  cleared_boxes_.clear();
+  publish(ros::Time::now(), true);  // the empty map and no markers, on every output
   ROS_INFO("hull: reset (%zu view(s) waiting to be carved discarded)", discarded);
   return true;
 }
 
 bool HullNode::save(sift_hull::Save::Request& request, sift_hull::Save::Response& response) {
   std::lock_guard<std::mutex> lock(hull_mutex_);
-  try {
-    publishPending();  // views carved but not yet published: saved as published
-  } catch (const std::exception& e) {
-    log_.error("hull: cannot publish the hull: ", e.what());
-  }
-  if (!stream_.hasHull() || !published_) {
-    response.success = false;
+  publishPending();  // views carved but not yet published: saved as published
+  response.success = false;
+  if (!published_) {
     response.message = "no hull yet";
     return true;
   }
@@ -303,10 +385,60 @@ bool HullNode::save(sift_hull::Save::Request& request, sift_hull::Save::Response
     response.success = true;
     response.message = "wrote " + paths.octree + " and " + paths.mesh;
   } catch (const std::exception& e) {
-    response.success = false;
     response.message = e.what();
   }
   return true;
+}
+
+bool HullNode::getMap(bool binary, sift_hull::GetOctomap::Response* response) {
+  std::lock_guard<std::mutex> lock(hull_mutex_);
+  publishPending();
+  if (!published_) {
+    log_.error(binary ? "hull: octomap_binary refused: " : "hull: octomap_full refused: ",
+               "no map yet (no view carved since the start or ~reset)");
+    return false;
+  }
+  response->map = binary ? ros_conversions::octomapMessage(publishedTree(), header_)
+                         : ros_conversions::octomapFullMessage(publishedTree(), header_);
+  return true;
+}
+
+bool HullNode::clearBbx(sift_hull::BoundingBoxQuery::Request& request,
+                        sift_hull::BoundingBoxQuery::Response&) {
+  const Box3d box = ros_conversions::boxFromCorners(request.min, request.max);
+  if (!isValidClearBox(box)) {
+    log_.error("hull: ~clear_bbx refused: ", "min " + pointText(request.min) + " and max " +
+                                                 pointText(request.max) +
+                                                 " must be finite with min <= max on each axis");
+    return false;
+  }
+  std::lock_guard<std::mutex> lock(hull_mutex_);
+  publishPending();
+  cleared_boxes_.push_back(box);  // applied to every later map too, until ~reset
+  if (!published_) {
+    ROS_INFO("hull: ~clear_bbx: no map yet; the box will be cleared in the first one");
+    return true;
+  }
+  publish(ros::Time::now());  // the tree built anew with every cleared box
+  ROS_INFO("hull: ~clear_bbx: cleared %s to %s", pointText(request.min).c_str(),
+           pointText(request.max).c_str());
+  return true;
+}
+
+void HullNode::reportDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  reportQueue(work_.counts(), "views", &status);
+  status.add("views redundant", redundant_views_.load());
+  status.add("views refused", refused_views_.load());
+  status.add("views without pose", pose_wait_.dropped());
+  status.add("free voxels (surface_points)", free_voxels_.load());
+  status.add("last view carve ms", last_carve_ms_.load());
+  status.add("last view publish ms", last_publish_ms_.load());
+  status.add("last view stamp", last_view_stamp_.load());
+  const std::string unpaired = pairing_.problem(PairingWatch::Clock::now());
+  if (!unpaired.empty()) {
+    status.mergeSummary(diagnostic_msgs::DiagnosticStatus::WARN, unpaired);
+    ROS_WARN_THROTTLE(kThrottle_s, "hull: %s", unpaired.c_str());
+  }
 }
 
 }  // namespace sift_hull

@@ -6,8 +6,7 @@
 
 #include "sift_hull/hull/hull_stream.h"
 #include "sift_hull/hull/silhouette.h"
-#include "sift_hull/refine/free_space.h"
-#include "sift_hull/refine/surface_points.h"
+#include "sift_hull/refine/point_carved_stream.h"
 #include "sift_hull/settings.h"
 
 namespace sift_hull {
@@ -32,18 +31,15 @@ struct HullNodeConfig {
   SilhouetteConfig recipe;
   /// Seconds of wall time between /diagnostics reports (diagnostic_updater's own parameter).
   double diagnostic_period = 1.0;
-  /// Surface points (`surface_points`) kept for free-space carving; beyond, the oldest pairs'
-  /// points are dropped.
-  int max_surface_points = 200000;
   /// Wall time between refinements with newly arrived surface points, seconds: each one derives
   /// the free voxels of every point kept anew.
   double refine_period_s = 1.0;
-  SurfacePointConfig surface_points;  ///< max_reprojection_px (inside the hull is checked too)
-  FreeSpaceConfig free_space;
+  /// Free-space carving with the surface points (`surface_points`): how many are kept, which.
+  PointCarvingConfig carving;
 };
 
-/// Its settings (sift_hull/settings.h); the silhouette recipe, the surface points and free-space
-/// settings are nested without a prefix.
+/// Its settings (sift_hull/settings.h); the silhouette recipe and the carving settings are nested
+/// without a prefix.
 template <>
 const SettingTable<HullNodeConfig>& settingsOf<HullNodeConfig>();
 

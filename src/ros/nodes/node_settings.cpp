@@ -27,16 +27,10 @@ const SettingTable<HullNodeConfig>& settingsOf<HullNodeConfig>() {
           "wall time between /diagnostics reports")
         .above(0.0);
     t.nest("", &HullNodeConfig::recipe, settingsOf<SilhouetteConfig>());
-    t.add("max_surface_points", &HullNodeConfig::max_surface_points, "points",
-          "surface points kept for free-space carving; beyond, the oldest pairs' go")
-        .atLeast(1);
     t.add("refine_period_s", &HullNodeConfig::refine_period_s, "s",
           "wall time between refinements with new surface points")
         .above(0.0);
-    // Confirming points by feature tracks needs tracks, which a SurfacePoints message lacks.
-    t.nest("", &HullNodeConfig::surface_points, settingsOf<SurfacePointConfig>(),
-           {"confirm_radius_voxels"});
-    t.nest("", &HullNodeConfig::free_space, settingsOf<FreeSpaceConfig>());
+    t.nest("", &HullNodeConfig::carving, settingsOf<PointCarvingConfig>());
     return t;
   }();
   return table;

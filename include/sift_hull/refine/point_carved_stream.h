@@ -1,0 +1,97 @@
+#pragma once
+
+#include <cstddef>
+#include <deque>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "sift_hull/geometry/camera.h"
+#include "sift_hull/hull/hull_stream.h"
+#include "sift_hull/refine/free_space.h"
+#include "sift_hull/refine/surface_points.h"
+#include "sift_hull/settings.h"
+
+namespace sift_hull {
+
+/// Free-space carving of a streamed hull by the surface points of calibrated pairs that arrive
+/// one pair at a time (the hull node's `surface_points`).
+struct PointCarvingConfig {
+  /// Surface points kept; beyond, the oldest pairs' points are dropped (the newest pair is kept
+  /// whole, however large).
+  int max_surface_points = 200000;
+  /// max_reprojection_px: a pair's points with a larger error are left out on arrival.
+  /// (confirm_radius_voxels is unused: a pair's points carry no feature tracks.)
+  SurfacePointConfig surface_points;
+  FreeSpaceConfig free_space;
+};
+/// Its settings: names, units, ranges, help (sift_hull/settings.h); the nested structs without a
+/// prefix.
+template <>
+const SettingTable<PointCarvingConfig>& settingsOf<PointCarvingConfig>();
+
+/// Throws std::invalid_argument naming the first bad field.
+void validate(const PointCarvingConfig& config);
+
+/// A HullStream whose hull the kept surface points also carve (freeVoxels): the points wait until
+/// the first box exists, and carve the tree again whenever it starts anew (a first box, a refit),
+/// since the free voxels of the old tree are gone then.
+///
+/// Threads: addSurfacePoints may be called from any thread, also while another thread uses the
+/// rest; the other members need one caller at a time.
+class PointCarvedStream {
+ public:
+  /// Throws std::invalid_argument for a bad config (validate()).
+  PointCarvedStream(HullStreamConfig stream, PointCarvingConfig points);
+
+  /// HullStream::add.
+  HullStream::Outcome add(const std::string& name, const PinholeCamera& camera,
+                          const cv::Mat& mask);
+
+  /// One pair's points, world frame (their views are replaced by the pair's two cameras), stamped
+  /// `stamp_s`. Points over max_reprojection_px are left out; returns how many were kept.
+  size_t addSurfacePoints(const PinholeCamera& left, const PinholeCamera& right,
+                          std::vector<SurfacePoint> points, double stamp_s);
+
+  /// Whether refine() has work: a hull, and points that arrived since the last refine() or a tree
+  /// that started anew while points are kept.
+  bool refineDue();
+
+  struct Refinement {
+    size_t free_voxels = 0;       ///< the hull's free voxels afterwards
+    size_t points_used = 0;       ///< kept points inside the hull
+    double newest_stamp_s = 0.0;  ///< of the newest pair kept
+  };
+  /// Carves the hull with the free voxels of every point kept that lies inside it. Requires
+  /// stream().hasHull().
+  Refinement refine();
+
+  /// Back to no views, no hull and no points.
+  void reset();
+
+  const HullStream& stream() const { return stream_; }
+  /// HullStream::takeRefusals.
+  std::vector<std::string> takeRefusals() { return stream_.takeRefusals(); }
+  /// Surface points kept now.
+  size_t storedPoints() const;
+  /// The hull's free voxels after the last refine() (0 after reset()).
+  size_t freeVoxelCount() const { return free_voxels_; }
+
+ private:
+  struct PairPoints {
+    PinholeCamera left, right;
+    std::vector<SurfacePoint> points;
+    double stamp_s = 0.0;
+  };
+
+  const PointCarvingConfig config_;
+  HullStream stream_;
+  mutable std::mutex points_mutex_;  ///< guards pairs_, stored_points_ and points_new_
+  std::deque<PairPoints> pairs_;     ///< the kept points, oldest pair first
+  size_t stored_points_ = 0;
+  bool points_new_ = false;          ///< points arrived since the last refine()
+  uint64_t refined_generation_ = 0;  ///< the stream's hull generation last carved with points
+  size_t free_voxels_ = 0;
+};
+
+}  // namespace sift_hull
