@@ -21,13 +21,13 @@ struct HullConfig {
   /// of the pixel-sampled, interpolated transform.
   double distance_slack_px = 1.0;
   int padding_px = 16;  ///< around each distance map (see SignedDistanceMap)
-  /// Image pixels per side of one element of a view's distance map in buildHull: 0 chooses it
-  /// per view (distanceReduction(): a finest voxel covers about one element; 1 for views whose
+  /// Image pixels per side of one element of a view's distance map in buildHull and, once it has
+  /// its box, in HullStream: 0 chooses it per view (distanceReduction(): a finest voxel covers about one element; 1 for views whose
   /// voxels cover under two pixels and for images under 2 MP), 1 forces the full-resolution
   /// transform, 2 to 15 force that factor. A reduced map is exact at its samples near the
   /// contour and adds its error bound (at most the factor, in pixels;
-  /// reducedDistanceErrorBound_px) to distance_slack_px for that view. HullStream and
-  /// makeHullViews use full resolution.
+  /// reducedDistanceErrorBound_px) to distance_slack_px for that view. makeHullViews, and
+  /// HullStream's views waiting for a box, use full resolution.
   int distance_reduction = 0;
   int threads = 2;  ///< for carving and for the mesh's field samples
 };
