@@ -120,7 +120,7 @@ double share(size_t part, size_t whole) { return whole == 0 ? NAN : double(part)
 
 const std::vector<int> kSupports = {256, 512, 1024};
 
-/// gsc with max_support M against the exact gsc: time on all threads and the share of the same
+/// gsc with gsc_max_support M against the exact gsc: time on all threads and the share of the same
 /// decisions.
 nlohmann::json sampledGsc(const LabelledMatches& input) {
   FilterConfigs configs;
@@ -175,7 +175,7 @@ std::vector<std::pair<int, std::string>> supportsInOrder(const nlohmann::json& r
 
 /// What the targets of docs/BENCHMARKS.md are judged on, times on all threads: gsc's at N = 100
 /// and 10,000, MAGSAC's over gsc's at 2,000, best's over MAGSAC's from 1,000. (The target on gsc
-/// with a sampled support is judged on the max_support table.)
+/// with a sampled support is judged on the gsc_max_support table.)
 nlohmann::json measurements(const nlohmann::json& sweep) {
   nlohmann::json result = nlohmann::json::object();
   for (const auto& row : sweep) {
@@ -229,7 +229,7 @@ std::string sweepMarkdown(const nlohmann::json& sweep) {
 
 std::string sampledMarkdown(const nlohmann::json& sweep) {
   std::ostringstream md;
-  md << "| N | gsc max_support | all threads | same decisions as exact gsc |\n"
+  md << "| N | gsc_max_support | all threads | same decisions as exact gsc |\n"
         "| --- | --- | --- | --- |\n";
   for (const auto& row : sweep) {
     if (!row.contains("gsc_max_support")) continue;
@@ -255,7 +255,7 @@ std::string markdown(const nlohmann::json& result) {
        << tableOneMarkdown(result["table1"]);
   }
   md << "\n### Sweep: " << result["sweep_base"].get<std::string>() << "\n\n"
-     << sweepMarkdown(result["sweep"]) << "\n### gsc with a sampled support (max_support)\n\n"
+     << sweepMarkdown(result["sweep"]) << "\n### gsc with a sampled support (gsc_max_support)\n\n"
      << sampledMarkdown(result["sweep"]) << '\n'
      << measurementsMarkdown(result["measurements"]);
   return md.str();
