@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # Installs the built workspace (catkin_make install, into the workspace's install/) and checks it as
 # a user of the install space would, in an environment with nothing of the devel space: after
-# sourcing install/setup.bash, `sift_hull --help` and `sift_hull_ros --help` run from PATH and
-# through rosrun, roslaunch finds the launch files with their parameter files, and the nodelets
-# are registered. One JUnit case per check in RESULTS_DIR (install-*.xml).
+# sourcing install/setup.bash, `sift_hull --help`, `sift_hull_bench --help` and
+# `sift_hull_ros --help` run from PATH and through rosrun, roslaunch finds the launch files with
+# their parameter files, and the nodelets are registered. One JUnit case per check in RESULTS_DIR
+# (install-*.xml).
 #
 #   scripts/install_check.sh RESULTS_DIR
 set -euo pipefail
@@ -32,9 +33,9 @@ in_install() {  # COMMAND: run in a clean environment with only the install spac
     "source '$workspace/install/setup.bash' && $1"
 }
 record sift_hull_help "$workspace/install_help.log" in_install \
-  'sift_hull --help | grep -q "^usage: sift_hull <command>" && sift_hull_ros --help | grep -q "^usage: sift_hull_ros"'
+  'sift_hull --help | grep -q "^usage: sift_hull <command>" && sift_hull_bench --help | grep -q "^usage: sift_hull_bench <command>" && sift_hull_ros --help | grep -q "^usage: sift_hull_ros"'
 record rosrun "$workspace/install_rosrun.log" in_install \
-  'rosrun sift_hull sift_hull --help | grep -q "^usage: sift_hull" && [[ "$(rospack find sift_hull)" == */install/share/sift_hull ]]'
+  'rosrun sift_hull sift_hull --help | grep -q "^usage: sift_hull" && rosrun sift_hull sift_hull_bench --help | grep -q "^usage: sift_hull_bench" && [[ "$(rospack find sift_hull)" == */install/share/sift_hull ]]'
 record roslaunch "$workspace/install_roslaunch.log" in_install \
   'for f in hull matcher; do roslaunch --dump-params sift_hull $f.launch | grep -q "/queue_size"; done && roslaunch --files sift_hull demo.launch bag:=x.bag | grep -q install/share/sift_hull/launch/hull.launch && [[ -f "$(rospack find sift_hull)/config/sift_hull.rviz" ]]'
 record nodelets "$workspace/install_nodelets.log" in_install \

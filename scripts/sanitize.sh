@@ -18,7 +18,8 @@
 # Environment:
 #   SIFT_HULL_EXECUTABLE   the catkin-built sift_hull run by the command tests (default: the
 #                          workspace's devel/lib/sift_hull/sift_hull; scripts/build.sh builds it
-#                          when it is missing)
+#                          when it is missing); the tests of the benchmarks' commands run the
+#                          sift_hull_bench beside it
 #   SANITIZE_GTEST_FILTER  a gtest filter for every binary (default '*'); the cases excluded below
 #                          stay excluded
 #   SANITIZE_TIMEOUT       seconds one binary may run (default 1800)
@@ -50,7 +51,8 @@ fi
 
 echo "sanitize: building in $sanitize_build (log: $sanitize_build/build.log) ..."
 build_start=$(date +%s)
-if ! build_sanitized gtests "$sanitize_build/build.log" -DSIFT_HULL_EXECUTABLE="$executable"; then
+if ! build_sanitized gtests "$sanitize_build/build.log" -DSIFT_HULL_EXECUTABLE="$executable" \
+  -DSIFT_HULL_BENCH_EXECUTABLE="$(dirname "$executable")/sift_hull_bench"; then
   tail -n 60 "$sanitize_build/build.log" >&2
   "${junit[@]}" case "$results/sanitize_build.xml" sanitize build \
     --failure "the sanitizer build failed" --log "$sanitize_build/build.log" --tail 60

@@ -23,7 +23,14 @@ void printUsage(const Program& program, std::ostream& out) {
     out << "  " << command.name << std::string(width + 2 - std::strlen(command.name), ' ')
         << command.summary << '\n';
   }
-  out << "\n'" << program.name << " <command> --help' describes a command.\n";
+  out << "\n'" << program.name << " <command> --help' describes a command.\n\n"
+      << "The package's other programs:\n";
+  for (const ProgramEntry& other : otherPrograms(program.name)) {
+    out << "- " << other.name << ": " << other.summary << " (";
+    for (size_t i = 0; i < other.commands.size(); ++i)
+      out << (i == 0 ? "" : ", ") << other.commands[i];
+    out << ")\n";
+  }
 }
 
 const Command* findCommand(const Program& program, const std::string& name) {
@@ -33,7 +40,31 @@ const Command* findCommand(const Program& program, const std::string& name) {
   return nullptr;
 }
 
+/// The program of the package, other than `self`, that has the command `name`; null when none.
+const ProgramEntry* ownerOf(const std::vector<ProgramEntry>& others, const std::string& name) {
+  for (const ProgramEntry& other : others) {
+    const auto& commands = other.commands;
+    if (std::find(commands.begin(), commands.end(), name) != commands.end()) return &other;
+  }
+  return nullptr;
+}
+
 }  // namespace
+
+std::vector<ProgramEntry> otherPrograms(const std::string& self) {
+  static const std::vector<ProgramEntry> all = {
+      {"sift_hull", "the user's program", {"dataset-info", "scene", "match", "hull"}},
+      {"sift_hull_bench",
+       "benchmarks and evaluation, which write parts of docs/",
+       {"bench-filters", "bench-matching", "evaluate-filters", "bench-hull"}},
+      {"sift_hull_ros", "the tools that need ROS", {"bag", "bench-nodes", "settings"}},
+  };
+  std::vector<ProgramEntry> others;
+  for (const ProgramEntry& entry : all) {
+    if (self != entry.name) others.push_back(entry);
+  }
+  return others;
+}
 
 void printResult(bool as_json, const nlohmann::json& result, const std::string& text) {
   if (as_json) {
@@ -54,11 +85,11 @@ int runMain(const Program& program, int argc, char** argv) {
     return args.empty() ? 2 : 0;
   }
   const Command* command = findCommand(program, args[0]);
-  const auto& others = program.other_commands;
-  if (command == nullptr && std::find(others.begin(), others.end(), args[0]) != others.end()) {
-    std::cerr << program.name << ": '" << args[0] << "' is a command of " << program.other_name
-              << ", not of " << program.name << ": run '" << program.other_name << " " << args[0]
-              << "'\n";
+  const std::vector<ProgramEntry> others = otherPrograms(program.name);
+  const ProgramEntry* owner = command == nullptr ? ownerOf(others, args[0]) : nullptr;
+  if (owner != nullptr) {
+    std::cerr << program.name << ": '" << args[0] << "' is a command of " << owner->name
+              << ", not of " << program.name << ": run '" << owner->name << " " << args[0] << "'\n";
     return 2;
   }
   if (command == nullptr) {

@@ -117,6 +117,14 @@ class WrittenSceneSuite : public ::testing::Test {
 };
 #endif
 
+#ifdef SIFT_HULL_BENCH_EXECUTABLE
+/// Runs the benchmarks' program sift_hull_bench (bench-filters, bench-matching, evaluate-filters,
+/// bench-hull), as runCommand.
+inline int runBenchProgram(const std::string& arguments, std::string* out, std::string* err) {
+  return runCommand(std::string(SIFT_HULL_BENCH_EXECUTABLE) + " " + arguments, out, err);
+}
+#endif
+
 #ifdef SIFT_HULL_ROS_EXECUTABLE
 /// Runs the ROS tools' program sift_hull_ros (bag, bench-nodes), as runCommand.
 inline int runRosProgram(const std::string& arguments, std::string* out, std::string* err) {

@@ -1,5 +1,5 @@
-// What the offline program prints: the command list, the filters in the order given, and nothing
-// but the JSON with --json.
+// What the programs print: the command lists of sift_hull and sift_hull_bench, which name each
+// other's commands, the filters in the order given, and nothing but the JSON with --json.
 
 #include <gtest/gtest.h>
 
@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "common/test_data.h"
 
@@ -21,23 +22,59 @@ std::string fileText(const std::string& path) {
 
 using CommandOutput = test::WrittenSceneSuite;
 
-TEST(ProgramHelp, KeepsEveryCommandApartFromItsSummary) {
-  std::string out, err;
-  ASSERT_EQ(test::runProgram("--help", &out, &err), 0) << err;
-  std::istringstream lines(out);
+/// The commands a program's --help lists (lines of two spaces, a name and its summary), each
+/// summary checked to start in one column, at least two spaces after its name.
+std::vector<std::string> listedCommands(const std::string& help) {
+  std::istringstream lines(help);
   std::string line;
-  size_t listed = 0, summary_column = 0;
+  std::vector<std::string> names;
+  size_t summary_column = 0;
   while (std::getline(lines, line)) {
     if (line.rfind("  ", 0) != 0) continue;  // a command: two spaces, its name, its summary
     const size_t name_end = line.find(' ', 2);
     const size_t summary = line.find_first_not_of(' ', name_end);
-    ASSERT_NE(summary, std::string::npos) << line;
+    EXPECT_NE(summary, std::string::npos) << line;
+    if (summary == std::string::npos) continue;
     EXPECT_GE(summary - name_end, 2u) << "name and summary run together: " << line;
-    if (listed++ == 0) summary_column = summary;
+    if (names.empty()) summary_column = summary;
     EXPECT_EQ(summary, summary_column) << "summaries in one column: " << line;
+    names.push_back(line.substr(2, name_end - 2));
   }
-  EXPECT_GE(listed, 7u) << out;
+  return names;
+}
+
+/// The commands that `help` names for the program `other`: the list in parentheses of its line
+/// "- OTHER: summary (a, b, c)".
+std::vector<std::string> commandsNamedFor(const std::string& help, const std::string& other) {
+  const size_t line = help.find("\n- " + other + ": ");
+  if (line == std::string::npos) return {};
+  const size_t open = help.find('(', line), close = help.find(")\n", line);
+  std::vector<std::string> names;
+  std::istringstream list(help.substr(open + 1, close - open - 1));
+  for (std::string name; std::getline(list, name, ',');)
+    names.push_back(name.substr(name[0] == ' '));
+  return names;
+}
+
+TEST(ProgramHelp, KeepsEveryCommandApartFromItsSummary) {
+  std::string out, err;
+  ASSERT_EQ(test::runProgram("--help", &out, &err), 0) << err;
+  EXPECT_EQ(listedCommands(out),
+            (std::vector<std::string>{"dataset-info", "scene", "match", "hull"}))
+      << out;
+  ASSERT_EQ(test::runBenchProgram("--help", &out, &err), 0) << err;
+  EXPECT_EQ(listedCommands(out).size(), 4u) << out;
   EXPECT_NE(out.find("evaluate-filters  "), std::string::npos) << out;
+}
+
+TEST(ProgramHelp, NamesTheOtherProgramsWithTheCommandsTheyHave) {
+  std::string user, bench, err;
+  ASSERT_EQ(test::runProgram("--help", &user, &err), 0) << err;
+  ASSERT_EQ(test::runBenchProgram("--help", &bench, &err), 0) << err;
+  EXPECT_EQ(commandsNamedFor(user, "sift_hull_bench"), listedCommands(bench)) << user;
+  EXPECT_EQ(commandsNamedFor(bench, "sift_hull"), listedCommands(user)) << bench;
+  EXPECT_EQ(commandsNamedFor(user, "sift_hull_ros"), commandsNamedFor(bench, "sift_hull_ros"));
+  EXPECT_FALSE(commandsNamedFor(user, "sift_hull_ros").empty()) << user;
 }
 
 TEST_F(CommandOutput, ListsTheFiltersInTheOrderGiven) {
@@ -114,7 +151,7 @@ TEST_F(CommandOutput, PrintsOnlyJsonWithJson) {
             0)
       << err;
   EXPECT_EQ(err, "") << "stderr of a clean --json run";
-  EXPECT_NO_THROW(static_cast<void>(nlohmann::json::parse(out))) << out;
+  EXPECT_TRUE(nlohmann::json::accept(out)) << out;
 }
 
 TEST_F(CommandOutput, TakesTheResolutionInMetresInsteadOfTheDepth) {
@@ -126,7 +163,8 @@ TEST_F(CommandOutput, TakesTheResolutionInMetresInsteadOfTheDepth) {
   EXPECT_EQ(result["resolution_m"].get<double>(), 0.05);
   EXPECT_EQ(result["max_depth"].get<int>(), 6);  // a box of about 2 m: 2^6 - 3 cells of 5 cm
   EXPECT_EQ(test::runProgram(hull + "-1", &out, &err), 2);
-  EXPECT_NE(err.find("--resolution-m must be a finite number >= 0, not -1"), std::string::npos) << err;
+  EXPECT_NE(err.find("--resolution-m must be a finite number >= 0, not -1"), std::string::npos)
+      << err;
   EXPECT_EQ(test::runProgram(hull + "0.00001", &out, &err), 1);
   EXPECT_NE(err.find("raise resolution_m (at least"), std::string::npos) << err;
 }

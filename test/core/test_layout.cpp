@@ -1,6 +1,7 @@
-// The layout's rules (docs/ARCHITECTURE.md), checked on the source tree: each stage includes only
-// the stages below it, the core and the offline program include no ROS header, and no source file
-// grows past 450 lines.
+// The layout's rules (docs/ARCHITECTURE.md), checked on the source tree and the programs: each
+// stage includes only the stages below it, the core, the user's program sift_hull and the
+// benchmarks' sift_hull_bench include and link nothing of ROS, sift_hull includes nothing of
+// sift_hull_bench and sends its commands there, and no source file grows past 450 lines.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -72,12 +73,12 @@ std::string stageOf(const fs::path& file) {
 }
 
 /// A header of ROS, of a ROS package, of the package's generated messages (sift_hull/Foo.h), or
-/// of its ROS library (src/ros).
+/// of its ROS library, nodes or tools (src/ros).
 bool isRosHeader(const std::string& include) {
   static const std::regex ros(
       R"(^(ros|rosbag|sensor_msgs|std_msgs|geometry_msgs|visualization_msgs|tf2[a-z_]*|cv_bridge|)"
       R"(image_transport|nodelet|pluginlib|pcl_conversions|dynamic_reconfigure|message_filters|)"
-      R"(diagnostic_[a-z_]+|std_srvs|lib|nodes|nodelets)/|^sift_hull/[A-Z]\w*\.h$|\.\./ros/)");
+      R"(diagnostic_[a-z_]+|std_srvs|lib|nodes|nodelets|tools)/|^sift_hull/[A-Z]\w*\.h$|\.\./ros/)");
   return std::regex_search(include, ros);
 }
 
@@ -109,8 +110,9 @@ TEST(LayoutTest, EachStageIncludesOnlyTheStagesBelowIt) {
 }
 
 TEST(LayoutTest, RosHeadersAreRecognised) {
-  for (const char* include : {"ros/ros.h", "sensor_msgs/Image.h", "tf2_ros/buffer.h",
-                              "sift_hull/Octomap.h", "lib/conversions.h", "../ros/free_port.h"}) {
+  for (const char* include :
+       {"ros/ros.h", "sensor_msgs/Image.h", "tf2_ros/buffer.h", "sift_hull/Octomap.h",
+        "lib/conversions.h", "tools/free_port.h", "../ros/tools/free_port.h"}) {
     EXPECT_TRUE(isRosHeader(include)) << include;
   }
   for (const char* include : {"sift_hull/hull/octree.h", "sift_hull/limits.h", "opencv2/core.hpp",
@@ -119,9 +121,11 @@ TEST(LayoutTest, RosHeadersAreRecognised) {
   }
 }
 
-TEST(LayoutTest, TheCoreAndTheOfflineProgramIncludeNoRosHeader) {
+TEST(LayoutTest, TheCoreAndTheOfflineProgramsIncludeNoRosHeader) {
   std::vector<fs::path> files = coreFiles();
-  for (const fs::path& file : sourcesUnder(kRoot / "src" / "cli")) files.push_back(file);
+  for (const char* program : {"cli", "bench"}) {
+    for (const fs::path& file : sourcesUnder(kRoot / "src" / program)) files.push_back(file);
+  }
   ASSERT_GT(files.size(), 50u);
   for (const fs::path& file : files) {
     for (const std::string& include : includesOf(file)) {
@@ -130,13 +134,32 @@ TEST(LayoutTest, TheCoreAndTheOfflineProgramIncludeNoRosHeader) {
   }
 }
 
+TEST(LayoutTest, TheUserProgramIncludesNothingOfTheBenchmarks) {
+  std::set<std::string> bench_headers;
+  for (const fs::path& file : sourcesUnder(kRoot / "src" / "bench")) {
+    if (file.extension() == ".h") bench_headers.insert(file.filename().string());
+  }
+  ASSERT_TRUE(bench_headers.count("pair_data.h")) << "src/bench has moved";
+  const std::vector<fs::path> files = sourcesUnder(kRoot / "src" / "cli");
+  ASSERT_GT(files.size(), 20u);
+  for (const fs::path& file : files) {
+    for (const std::string& include : includesOf(file)) {
+      EXPECT_FALSE(bench_headers.count(fs::path(include).filename().string()) ||
+                   include.find("bench/") != std::string::npos)
+          << fs::relative(file, kRoot) << " includes " << include;
+    }
+  }
+}
+
 TEST(LayoutTest, TheOfflineProgramLinksNoRosLibrary) {
-  std::string out, err;
-  ASSERT_EQ(test::runCommand("ldd " + std::string(SIFT_HULL_EXECUTABLE), &out, &err), 0) << err;
-  ASSERT_NE(out.find("libsift_hull_core"), std::string::npos) << out;  // ldd read the program
-  for (const char* library : {"libroscpp", "librosbag", "libcv_bridge", "libtf2", "librostime"}) {
-    EXPECT_EQ(out.find(library), std::string::npos) << "sift_hull links " << library << ":\n"
-                                                    << out;
+  for (const char* program : {SIFT_HULL_EXECUTABLE, SIFT_HULL_BENCH_EXECUTABLE}) {
+    std::string out, err;
+    ASSERT_EQ(test::runCommand("ldd " + std::string(program), &out, &err), 0) << err;
+    ASSERT_NE(out.find("libsift_hull_core"), std::string::npos) << out;  // ldd read the program
+    for (const char* library : {"libroscpp", "librosbag", "libcv_bridge", "libtf2", "librostime"}) {
+      EXPECT_EQ(out.find(library), std::string::npos) << program << " links " << library << ":\n"
+                                                      << out;
+    }
   }
 }
 
@@ -146,7 +169,38 @@ TEST(LayoutTest, TheOfflineProgramNamesWhereTheRosCommandsWent) {
     EXPECT_EQ(test::runProgram(command, &out, &err), 2) << command;
     EXPECT_NE(err.find("run 'sift_hull_ros " + std::string(command) + "'"), std::string::npos)
         << err;
+    EXPECT_EQ(test::runBenchProgram(command, &out, &err), 2) << command;
+    EXPECT_NE(err.find("run 'sift_hull_ros " + std::string(command) + "'"), std::string::npos)
+        << err;
   }
+}
+
+TEST(LayoutTest, TheBenchmarksAreCommandsOfSiftHullBenchNotOfSiftHull) {
+  for (const char* command :
+       {"bench-filters", "bench-matching", "evaluate-filters", "bench-hull"}) {
+    std::string out, err;
+    EXPECT_EQ(test::runProgram(command, &out, &err), 2) << command;
+    EXPECT_NE(err.find("is a command of sift_hull_bench, not of sift_hull: run 'sift_hull_bench " +
+                       std::string(command) + "'"),
+              std::string::npos)
+        << err;
+    EXPECT_EQ(test::runBenchProgram(std::string(command) + " --help", &out, &err), 0) << err;
+    EXPECT_EQ(out.rfind("usage: sift_hull_bench " + std::string(command), 0), 0u) << out;
+    EXPECT_EQ(test::runBenchProgram(std::string(command) + " --no-such-option", &out, &err), 2);
+    EXPECT_NE(err.find("(see 'sift_hull_bench " + std::string(command) + " --help')"),
+              std::string::npos)
+        << err;
+  }
+  for (const char* command : {"dataset-info", "scene", "match", "hull"}) {
+    std::string out, err;
+    EXPECT_EQ(test::runBenchProgram(command, &out, &err), 2) << command;
+    EXPECT_NE(err.find("run 'sift_hull " + std::string(command) + "'"), std::string::npos) << err;
+  }
+  std::string out, err;
+  EXPECT_EQ(test::runBenchProgram("", &out, &err), 2);
+  EXPECT_EQ(err.rfind("usage: sift_hull_bench <command>", 0), 0u) << err;
+  EXPECT_EQ(test::runBenchProgram("no-such-command", &out, &err), 2);
+  EXPECT_NE(err.find("unknown command 'no-such-command'"), std::string::npos) << err;
 }
 
 TEST(LayoutTest, NoSourceFileExceeds450Lines) {

@@ -1,7 +1,7 @@
 // The voted LO-RANSAC filter (vote_ransac, today's best) on synthetic putatives with known
 // inliers (a 3D scene and a similarity, 30 % and 60 % outliers), rotation and zoom of the right
 // image, two motions, pure noise, tiny and degenerate inputs. Its models are tested in
-// test_two_view_models; its time is measured by `sift_hull bench-filters`, not here.
+// test_two_view_models; its time is measured by `sift_hull_bench bench-filters`, not here.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>

@@ -11,7 +11,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "common/test_data.h"
-#include "lib/free_port.h"
+#include "tools/free_port.h"
 #include "sift_hull/filters/filter.h"
 #include "sift_hull/hull/mesh.h"
 #include "sift_hull/io/ply.h"

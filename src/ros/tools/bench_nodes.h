@@ -22,7 +22,8 @@
 #include <thread>
 
 #include "args.h"
-#include "bench_timing.h"
+#include "bench_measure.h"
+#include "bench_report.h"
 #include "commands.h"
 #include "hull_options.h"
 #include "lib/conversions.h"

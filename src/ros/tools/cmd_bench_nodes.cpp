@@ -52,8 +52,11 @@ nlohmann::json hullJson(const HullRun& r) {
             {"rss_last_mib", r.rss_last_mib}}}};
 }
 
-nlohmann::json targetsJson(const std::vector<MatcherRun>& matcher,
-                           const std::vector<HullRun>& hulls) {
+/// What the targets of docs/BENCHMARKS.md are judged on: the matcher's best rate with its default
+/// workers and the pairs it lost at 10 Hz; the hull node's worst median latency, its largest
+/// relative difference of resolution from `sift_hull hull`'s and the views it dropped at 10 Hz.
+nlohmann::json measurementsJson(const std::vector<MatcherRun>& matcher,
+                                const std::vector<HullRun>& hulls) {
   double best_rate = 0.0, dropped_at_10_hz = 0.0;
   for (const MatcherRun& r : matcher) {
     if (r.workers != MatcherNodeConfig().workers) continue;
@@ -67,14 +70,11 @@ nlohmann::json targetsJson(const std::vector<MatcherRun>& matcher,
         std::max(worst_resolution, std::abs(r.resolution_m / r.cli_resolution_m - 1.0));
     dropped += r.rate_dropped;
   }
-  return {{"matcher_pairs_per_s>=25", {{"measured", best_rate}, {"met", best_rate >= 25.0}}},
-          {"matcher_pairs_dropped_at_10_hz==0",
-           {{"measured", dropped_at_10_hz}, {"met", dropped_at_10_hz == 0.0}}},
-          {"hull_view_to_octomap_depth8_median_ms<=50",
-           {{"measured_ms", worst_latency}, {"met", worst_latency <= 50.0}}},
-          {"hull_resolution_within_2%_of_cli",
-           {{"measured", worst_resolution}, {"met", worst_resolution <= 0.02}}},
-          {"hull_views_dropped_at_10_hz==0", {{"measured", dropped}, {"met", dropped == 0.0}}}};
+  return {{"matcher_pairs_per_s", best_rate},
+          {"matcher_pairs_dropped_at_10_hz", dropped_at_10_hz},
+          {"hull_view_to_octomap_depth8_median_ms", worst_latency},
+          {"hull_resolution_relative_difference_to_cli", worst_resolution},
+          {"hull_views_dropped_at_10_hz", dropped}};
 }
 
 nlohmann::json siftJson(const SiftCost& sift) {
@@ -103,7 +103,7 @@ std::string siftMarkdown(const nlohmann::json& sift) {
 }
 
 std::string markdownReport(const std::vector<MatcherRun>& matcher,
-                           const std::vector<HullRun>& hulls, const nlohmann::json& targets,
+                           const std::vector<HullRun>& hulls, const nlohmann::json& measurements,
                            const nlohmann::json& sift) {
   std::ostringstream out;
   out << "Written by `sift_hull_ros bench-nodes --write docs/BENCHMARKS.md` on " << todayUtc()
@@ -155,7 +155,7 @@ std::string markdownReport(const std::vector<MatcherRun>& matcher,
         << fixed(r.overload_redundant, 0) << " / " << fixed(r.overload_dropped, 0) << " | "
         << fixed(r.rss_first_mib, 0) << " / " << fixed(r.rss_last_mib, 0) << " |\n";
   }
-  out << '\n' << targetsMarkdown(targets);
+  out << '\n' << measurementsMarkdown(measurements);
   return out.str();
 }
 
@@ -205,10 +205,10 @@ int runBenchNodes(const std::vector<std::string>& args) {
                          {"sift", sift},
                          {"matcher", nlohmann::json::array()},
                          {"hull", nlohmann::json::array()},
-                         {"targets", targetsJson(matcher, hulls)}};
+                         {"measurements", measurementsJson(matcher, hulls)}};
   for (const MatcherRun& r : matcher) json["matcher"].push_back(matcherJson(r));
   for (const HullRun& r : hulls) json["hull"].push_back(hullJson(r));
-  const std::string report = markdownReport(matcher, hulls, json["targets"], json["sift"]);
+  const std::string report = markdownReport(matcher, hulls, json["measurements"], json["sift"]);
   if (parser.has("write")) replaceMarkedSection(parser.get("write"), "bench-nodes", report);
   printResult(parser.flag("json"), json, report);
   return 0;

@@ -1,5 +1,6 @@
 // sift_hull_ros: the tools that need ROS (bags, the nodes' benchmark, the files derived from
-// their settings), apart from the offline program sift_hull, which links no ROS library.
+// their settings), apart from the user's program sift_hull and the benchmarks' sift_hull_bench,
+// which link no ROS library.
 #include "commands.h"
 
 namespace sift_hull {
@@ -20,9 +21,6 @@ int main(int argc, char** argv) {
        {"bench-nodes", "time the matcher and hull nodes as processes on topic streams",
         runBenchNodes},
        {"settings", "write or check the parameter files and tables derived from the settings",
-        runSettings}},
-      "sift_hull",
-      {"dataset-info", "scene", "match", "bench-filters", "evaluate-filters", "hull",
-       "bench-hull"}};
+        runSettings}}};
   return runMain(program, argc, argv);
 }

@@ -17,7 +17,7 @@
 #include <stdexcept>
 #include <thread>
 
-#include "lib/free_port.h"
+#include "free_port.h"
 
 extern char** environ;
 

@@ -12,8 +12,10 @@
 #include <thread>
 
 #include "args.h"
+#include "bench_commands.h"
 #include "bench_hull_synthetic.h"
-#include "bench_timing.h"
+#include "bench_measure.h"
+#include "bench_report.h"
 #include "commands.h"
 #include "hull_options.h"
 #include "pair_data.h"
@@ -102,12 +104,22 @@ DatasetRuns benchDataset(const HullInput& input, const std::string& name) {
   return runs;
 }
 
+/// The user's program sift_hull, which is installed beside this one (devel/lib/sift_hull, the
+/// install space's bin and lib/sift_hull).
+std::string userProgram() {
+  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe");
+  const std::filesystem::path sibling = self.parent_path() / "sift_hull";
+  if (!std::filesystem::exists(sibling)) {
+    throw std::runtime_error("no sift_hull beside " + self.string() + " to run 'hull' with");
+  }
+  return sibling.string();
+}
+
 /// `sift_hull hull --json` on a data set as a child process (so that nothing else of this
 /// benchmark counts), with `extra` options; its JSON.
 nlohmann::json hullCommand(const std::string& directory, const HullDataset& dataset,
                            const std::string& extra) {
-  const std::string self = std::filesystem::read_symlink("/proc/self/exe").string();
-  std::string command = "'" + self + "' hull --json " + extra + " --threshold " +
+  std::string command = "'" + userProgram() + "' hull --json " + extra + " --threshold " +
                         std::to_string(dataset.threshold) + " --calib '" + directory + "/" +
                         dataset.calibration + "' --images '" + directory + "'";
   if (!dataset.view_list.empty())
@@ -185,7 +197,10 @@ std::string markdownTable(const std::vector<DatasetRuns>& all) {
   return out.str();
 }
 
-nlohmann::json targetsJson(const std::vector<DatasetRuns>& all) {
+/// What the targets of docs/BENCHMARKS.md are judged on, each the worse data set's: the total
+/// time at depth 8 and 9, dense carving's time over the octree's at depth 8, the peak memory
+/// through the hull at depth 9 and the mean reprojection IoU (the lowest of all depths).
+nlohmann::json measurementsJson(const std::vector<DatasetRuns>& all) {
   double worst_8 = 0.0, worst_9 = 0.0, least_speedup = 1e300, least_iou = 1.0, peak_mib = 0.0;
   for (const DatasetRuns& runs : all) {
     peak_mib = std::max(peak_mib, runs.peak_mib_depth9);
@@ -196,16 +211,17 @@ nlohmann::json targetsJson(const std::vector<DatasetRuns>& all) {
       least_iou = std::min(least_iou, r.iou.mean);
     }
   }
-  return {{"depth8_total_ms<=300", {{"measured_ms", worst_8}, {"met", worst_8 <= 300.0}}},
-          {"dense/octree_depth8>=10", {{"measured", least_speedup}, {"met", least_speedup >= 10}}},
-          {"depth9_total_ms<=2000", {{"measured_ms", worst_9}, {"met", worst_9 <= 2000.0}}},
-          {"depth9_peak_MiB<=300", {{"measured", peak_mib}, {"met", peak_mib <= 300.0}}},
-          {"mean_reprojection_iou>=0.98", {{"measured", least_iou}, {"met", least_iou >= 0.98}}}};
+  return {{"depth8_total_ms", worst_8},
+          {"dense_over_octree_depth8", least_speedup},
+          {"depth9_total_ms", worst_9},
+          {"depth9_peak_mib", peak_mib},
+          {"mean_reprojection_iou", least_iou}};
 }
 
-std::string markdownReport(const std::vector<DatasetRuns>& all, const nlohmann::json& targets) {
+std::string markdownReport(const std::vector<DatasetRuns>& all,
+                           const nlohmann::json& measurements) {
   std::ostringstream out;
-  out << "Written by `sift_hull bench-hull --write docs/BENCHMARKS.md` on " << todayUtc()
+  out << "Written by `sift_hull_bench bench-hull --write docs/BENCHMARKS.md` on " << todayUtc()
       << ", CPU " << cpuModel() << " (/proc/cpuinfo), " << std::thread::hardware_concurrency()
       << " hardware threads, 2 carving threads. Times are "
       << "medians of at least 3 runs (dense carving: at least 1, more within 3 s).\n\n"
@@ -217,7 +233,7 @@ std::string markdownReport(const std::vector<DatasetRuns>& all, const nlohmann::
         << fixed(runs.command_peak_mib_depth9, 0) << " MiB;";
   }
   out << "\n\n`sift_hull hull --max-depth 8 --refine-with-matches` (free-space carving from the "
-         "filtered matches of neighbouring views; README), median of 3 runs:\n\n"
+         "filtered matches of neighbouring views; docs/CLI.md), median of 3 runs:\n\n"
       << "| data | hull | matching | points | free voxels | carving | mesh | points kept | "
          "reproj. IoU min before / after |\n| --- | --- | --- | --- | --- | --- | --- | --- | "
          "--- |\n";
@@ -233,14 +249,15 @@ std::string markdownReport(const std::vector<DatasetRuns>& all, const nlohmann::
         << fixed(r.at("reprojection_iou_before").at("min").get<double>(), 4) << " / "
         << fixed(r.at("reprojection_iou_after").at("min").get<double>(), 4) << " |\n";
   }
-  out << "\n" << targetsMarkdown(targets);
+  out << "\n" << measurementsMarkdown(measurements);
   return out.str();
 }
 
 int reportBench(const ArgParser& parser, const std::vector<DatasetRuns>& all,
                 const std::optional<SyntheticHullBench>& synthetic) {
-  nlohmann::json json = {
-      {"datasets", nlohmann::json::array()}, {"targets", targetsJson(all)}, {"cpu", cpuModel()}};
+  nlohmann::json json = {{"datasets", nlohmann::json::array()},
+                         {"measurements", measurementsJson(all)},
+                         {"cpu", cpuModel()}};
   for (const DatasetRuns& runs : all) {
     nlohmann::json depths = nlohmann::json::array();
     for (const DepthRun& run : runs.depths) depths.push_back(depthJson(run));
@@ -251,7 +268,7 @@ int reportBench(const ArgParser& parser, const std::vector<DatasetRuns>& all,
                                 {"depth9_command_peak_mib", runs.command_peak_mib_depth9},
                                 {"refinement_depth8", runs.refinement}});
   }
-  std::string report = all.empty() ? "" : markdownReport(all, json["targets"]);
+  std::string report = all.empty() ? "" : markdownReport(all, json["measurements"]);
   if (parser.has("write") && !all.empty()) {
     replaceMarkedSection(parser.get("write"), "bench-hull", report);
   }
@@ -265,6 +282,23 @@ int reportBench(const ArgParser& parser, const std::vector<DatasetRuns>& all,
   }
   printResult(parser.flag("json"), json, report);
   return 0;
+}
+
+/// The synthetic case of --synthetic-views and --synthetic-size.
+SyntheticHullCase syntheticCase(const ArgParser& parser) {
+  SyntheticHullCase synthetic_case;
+  synthetic_case.views = parser.getInt("synthetic-views");
+  if (synthetic_case.views < 2) throw UsageError("--synthetic-views must be at least 2");
+  const std::string size = parser.get("synthetic-size");
+  const cv::Size parsed = parseSizeOption("--synthetic-size", size);
+  synthetic_case.width_px = parsed.width;
+  synthetic_case.height_px = parsed.height;
+  if (synthetic_case.width_px < 8 || synthetic_case.height_px < 8 ||
+      synthetic_case.width_px > 8192 || synthetic_case.height_px > 8192) {
+    throw UsageError("--synthetic-size expects WIDTHxHEIGHT, each side in [8, 8192], got '" + size +
+                     "'");
+  }
+  return synthetic_case;
 }
 
 }  // namespace
@@ -294,21 +328,7 @@ int runBenchHull(const std::vector<std::string>& args) {
 
   std::vector<DatasetRuns> all;
   std::optional<SyntheticHullBench> synthetic;
-  if (!parser.flag("skip-synthetic")) {
-    SyntheticHullCase synthetic_case;
-    synthetic_case.views = parser.getInt("synthetic-views");
-    if (synthetic_case.views < 2) throw UsageError("--synthetic-views must be at least 2");
-    const std::string size = parser.get("synthetic-size");
-    const cv::Size parsed = parseSizeOption("--synthetic-size", size);
-    synthetic_case.width_px = parsed.width;
-    synthetic_case.height_px = parsed.height;
-    if (synthetic_case.width_px < 8 || synthetic_case.height_px < 8 ||
-        synthetic_case.width_px > 8192 || synthetic_case.height_px > 8192) {
-      throw UsageError("--synthetic-size expects WIDTHxHEIGHT, each side in [8, 8192], got '" +
-                       size + "'");
-    }
-    synthetic = benchSyntheticHull(synthetic_case);
-  }
+  if (!parser.flag("skip-synthetic")) synthetic = benchSyntheticHull(syntheticCase(parser));
   for (const HullDataset& dataset : hullDatasets()) {
     if (parser.flag("synthetic-only")) break;
     const std::string directory = root + "/" + dataset.directory;

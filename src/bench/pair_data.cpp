@@ -3,9 +3,6 @@
 #include <sys/stat.h>
 
 #include <cstdlib>
-#include <ctime>
-#include <fstream>
-#include <sstream>
 
 #include "sift_hull/eval/match_evaluation.h"
 
@@ -53,31 +50,6 @@ std::optional<EvaluationPair> grafPair(const std::string& data_root, int n,
       "graf 1-" + index,
       matchPlanarPair(dir + "/img1.png", dir + "/img" + index + ".png", dir + "/H1to" + index + "p",
                       options.sift, options.matching)};
-}
-
-std::string todayUtc() {
-  const std::time_t now = std::time(nullptr);
-  char date[32];
-  std::strftime(date, sizeof date, "%Y-%m-%d", std::gmtime(&now));
-  return date;
-}
-
-void replaceMarkedSection(const std::string& path, const std::string& name,
-                          const std::string& content) {
-  std::ifstream in(path);
-  std::stringstream buffer;
-  buffer << in.rdbuf();
-  std::string text = buffer.str();
-  const std::string begin = "<!-- begin " + name + " -->\n", end = "<!-- end " + name + " -->\n";
-  const size_t first = text.find(begin), last = text.find(end);
-  const std::string section = begin + content + end;
-  if (first == std::string::npos || last == std::string::npos || last < first) {
-    text += (text.empty() || text.back() == '\n' ? "\n" : "\n\n") + section;
-  } else {
-    text.replace(first, last + end.size() - first, section);
-  }
-  std::ofstream out(path);
-  if (!(out << text)) throw std::runtime_error(path + ": cannot write");
 }
 
 }  // namespace cli

@@ -29,13 +29,5 @@ std::optional<EvaluationPair> teddyPair(const std::string& data_root, const Matc
 std::optional<EvaluationPair> grafPair(const std::string& data_root, int n,
                                        const MatchOptions& options, std::string* why_not);
 
-/// Today's date in UTC, YYYY-MM-DD, to stamp measurements written to docs.
-std::string todayUtc();
-
-/// Replaces the text between the lines "<!-- begin NAME -->" and "<!-- end NAME -->" of a
-/// Markdown file (appending the marked section when missing).
-void replaceMarkedSection(const std::string& path, const std::string& name,
-                          const std::string& content);
-
 }  // namespace cli
 }  // namespace sift_hull

@@ -12,6 +12,8 @@
 #include <sstream>
 #include <vector>
 
+#include "bench_measure.h"
+#include "bench_report.h"
 #include "bench_timing.h"
 #include "sift_hull/hull/reduced_distance_map.h"
 #include "sift_hull/synthetic/mask_render.h"
@@ -172,14 +174,11 @@ nlohmann::json syntheticJson(const SyntheticHullBench& bench) {
           {"peak_measured_per_setting", bench.peak_reset},
           {"reduced", runJson(bench.reduced)},
           {"full_resolution", runJson(bench.full)},
-          {"targets",
-           {{"hull_total_ms<=3000",
-             {{"measured_ms", bench.reduced.time.total_ms},
-              {"met", bench.reduced.time.total_ms <= 3000.0}}},
-            {"peak_MiB<=1536",
-             {{"measured", bench.reduced.peak_mib}, {"met", bench.reduced.peak_mib <= 1536.0}}},
-            {"|mean_iou - full_resolution|<=0.002",
-             {{"measured", iou_difference}, {"met", iou_difference <= 0.002}}}}}};
+          // What the targets of docs/BENCHMARKS.md are judged on, with the reduced maps.
+          {"measurements",
+           {{"hull_total_ms", bench.reduced.time.total_ms},
+            {"peak_mib", bench.reduced.peak_mib},
+            {"mean_iou_difference_to_full_resolution", iou_difference}}}};
 }
 
 std::string syntheticMarkdown(const SyntheticHullBench& bench) {
@@ -198,7 +197,7 @@ std::string syntheticMarkdown(const SyntheticHullBench& bench) {
       << "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n"
       << runRow("per view (`distance_reduction` 0)", bench.reduced)
       << runRow("full resolution (`distance_reduction` 1)", bench.full) << '\n'
-      << targetsMarkdown(syntheticJson(bench)["targets"]);
+      << measurementsMarkdown(syntheticJson(bench)["measurements"]);
   return out.str();
 }
 

@@ -9,7 +9,9 @@
 #include <thread>
 
 #include "args.h"
-#include "bench_timing.h"
+#include "bench_commands.h"
+#include "bench_measure.h"
+#include "bench_report.h"
 #include "commands.h"
 #include "pair_data.h"
 #include "sift_hull/features/nearest_neighbours.h"
@@ -100,7 +102,7 @@ nlohmann::json sizeRow(const BenchPair& pair, int keypoints) {
 
 std::string markdown(const nlohmann::json& result) {
   std::ostringstream md;
-  md << "Written by `sift_hull bench-matching --write docs/BENCHMARKS.md` on " << todayUtc()
+  md << "Written by `sift_hull_bench bench-matching --write docs/BENCHMARKS.md` on " << todayUtc()
      << ", CPU " << result["cpu"].get<std::string>() << " (/proc/cpuinfo), "
      << result["hardware_threads"] << " hardware threads, on " << result["pair"].get<std::string>()
      << ". Medians of repeated runs; every matcher finds the two nearest neighbours of each left "
@@ -115,12 +117,11 @@ std::string markdown(const nlohmann::json& result) {
     md << "| " << row["keypoints"][0] << ", " << row["keypoints"][1] << " | "
        << fixed(row["sift_ms_per_image"], 1) << " ms | " << fixed(row["opencv_bf_ms"], 1)
        << " ms | " << fixed(row["flann_ms"], 1) << " ms | " << fixed(row["blas_ms"], 1) << " ms | "
-       << fixed(row["blas_with_mutual_check_ms"], 1) << " ms | "
-       << fixed(row["blas_float32_ms"], 1) << " ms | " << fixed(row["speedup_vs_opencv_bf"], 1)
-       << "x | "
+       << fixed(row["blas_with_mutual_check_ms"], 1) << " ms | " << fixed(row["blas_float32_ms"], 1)
+       << " ms | " << fixed(row["speedup_vs_opencv_bf"], 1) << "x | "
        << fixed(100.0 * row["same_nearest_as_opencv_bf"].get<double>(), 2) << " % |\n";
   }
-  md << '\n' << targetsMarkdown(result["targets"]);
+  md << '\n' << measurementsMarkdown(result["measurements"]);
   return md.str();
 }
 
@@ -142,8 +143,8 @@ int runBenchMatching(const std::vector<std::string>& args) {
   for (int keypoints : {1000, 4000, 8000}) result["sizes"].push_back(sizeRow(pair, keypoints));
   const double speedup = result["sizes"].back()["speedup_vs_opencv_bf"];
   result["speedup_vs_opencv_bf"] = speedup;
-  result["targets"] = {
-      {"speedup_vs_opencv_bf_8000>=5", {{"measured", speedup}, {"met", speedup >= 5.0}}}};
+  // What the target of docs/BENCHMARKS.md is judged on.
+  result["measurements"] = {{"speedup_vs_opencv_bf_8000", speedup}};
   const std::string text = markdown(result);
   if (parser.has("write")) replaceMarkedSection(parser.get("write"), "bench-matching", text);
   printResult(parser.flag("json"), result, text);

@@ -9,7 +9,7 @@
 namespace sift_hull {
 
 /// A TCP port on the loopback interface that nothing listens on now (the kernel's choice), for a
-/// ROS master of its own.
+/// ROS master of its own: bench-nodes' harness (ros_harness.cpp) and test/ros/test_demo_launch.cpp.
 inline int freeTcpPort() {
   const int fd = socket(AF_INET, SOCK_STREAM, 0);
   sockaddr_in address{};

@@ -20,10 +20,10 @@ struct SyntheticHullCase {
 
 /// One setting of HullConfig::distance_reduction on the case.
 struct SyntheticHullRun {
-  int distance_reduction = 0;  ///< the setting (0: per view)
-  int reduction_min = 0, reduction_max = 0;  ///< the views' reductions
+  int distance_reduction = 0;                                  ///< the setting (0: per view)
+  int reduction_min = 0, reduction_max = 0;                    ///< the views' reductions
   double error_bound_mean_px = 0.0, error_bound_max_px = 0.0;  ///< the views' map error bounds
-  HullTimings time;                          ///< medians
+  HullTimings time;                                            ///< medians
   double peak_mib = 0.0;  ///< the process's peak resident memory during the runs (VmHWM)
   ReprojectionIoU iou;
   size_t surface_leaves = 0, mesh_faces = 0;
@@ -32,12 +32,12 @@ struct SyntheticHullRun {
 
 struct SyntheticHullBench {
   SyntheticHullCase config;
-  double render_ms = 0.0;        ///< rendering the masks (run-length encoded as they are made)
-  double masks_mib = 0.0;        ///< held by the run-length masks
-  double input_peak_mib = 0.0;   ///< peak resident memory after rendering
-  bool peak_reset = false;       ///< whether each run's peak could be measured alone
-  SyntheticHullRun reduced;      ///< distance_reduction 0
-  SyntheticHullRun full;         ///< distance_reduction 1, the baseline
+  double render_ms = 0.0;       ///< rendering the masks (run-length encoded as they are made)
+  double masks_mib = 0.0;       ///< held by the run-length masks
+  double input_peak_mib = 0.0;  ///< peak resident memory after rendering
+  bool peak_reset = false;      ///< whether each run's peak could be measured alone
+  SyntheticHullRun reduced;     ///< distance_reduction 0
+  SyntheticHullRun full;        ///< distance_reduction 1, the baseline
 };
 
 /// Renders the case's masks (renderMask, each on OpenCV's threads) and runs the hull with the
