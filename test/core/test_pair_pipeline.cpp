@@ -1,4 +1,4 @@
-// src/core/pipeline against the renderer's ground truth: a calibrated pair of the rendered cup
+// src/core/pipeline against the renderer's ground truth: a calibrated pair of rendered views
 // through runPair (kept matches judged by the depth maps, surface points on the true surface),
 // and the matches refinement of the scene's hull (points on the surface, nothing of the solid
 // carved).
@@ -34,26 +34,41 @@ double shareOnSurface(const std::vector<SurfacePoint>& points, const RenderedVie
   return points.empty() ? 0.0 : static_cast<double>(near) / points.size();
 }
 
+/// Relative depth error of a point "on the surface" in the refinement check.
+constexpr double kSurfaceTolerance = 0.02;
+
 class PairPipelineTest : public ::testing::Test {
  protected:
-  static void SetUpTestSuite() { scene_ = std::make_unique<ConcaveScene>("cup", 6); }
+  static void SetUpTestSuite() {
+    scene_ = std::make_unique<ConcaveScene>("cup", 6);
+    SceneConfig config;  // a ring of 24 views, 15 degrees apart: a pair of neighbours
+    config.views = 24;
+    pair_views_ = {renderSceneView(config, 0), renderSceneView(config, 1)};
+  }
   static void TearDownTestSuite() { scene_.reset(); }
 
-  /// Views 0 and its nearest neighbour, with their cameras.
+  /// Two neighbouring views of the default shape at 640x480, with their cameras.
   PairInput pairInput() const {
-    const auto pairs = refinementViewPairs(camerasOf(scene_->views), ViewPairing::kNeighbours);
-    const auto [a, b] = pairs.front();
     PairInput input;
-    input.left_image = scene_->views[a].image, input.right_image = scene_->views[b].image;
-    input.cameras = std::make_pair(scene_->views[a].view.camera, scene_->views[b].view.camera);
-    input.left_view = a, input.right_view = b;
+    input.left_image = pair_views_[0].image, input.right_image = pair_views_[1].image;
+    input.cameras = std::make_pair(pair_views_[0].view.camera, pair_views_[1].view.camera);
+    input.left_view = 3, input.right_view = 5;
     return input;
   }
 
-  static std::unique_ptr<ConcaveScene> scene_;
+  /// Guided matching along the epipolar lines (the refinement's).
+  static PairPipelineConfig guided() {
+    PairPipelineConfig config;
+    config.epipolar_search_px = 2.0;
+    return config;
+  }
+
+  static std::unique_ptr<ConcaveScene> scene_;  ///< the refinement's scene and hull
+  static std::vector<RenderedView> pair_views_;
 };
 
 std::unique_ptr<ConcaveScene> PairPipelineTest::scene_;
+std::vector<RenderedView> PairPipelineTest::pair_views_;
 
 TEST_F(PairPipelineTest, KeptMatchesAreCorrectAndTheirPointsLieOnTheSurface) {
   const PairInput input = pairInput();
@@ -71,8 +86,7 @@ TEST_F(PairPipelineTest, KeptMatchesAreCorrectAndTheirPointsLieOnTheSurface) {
   EXPECT_EQ(pair.kept.left_px.size(), kept.keptCount());
   EXPECT_EQ(pair.kept.left_keypoint.size(), pair.kept.left_px.size());
 
-  const RenderedView& left = scene_->views[input.left_view];
-  const RenderedView& right = scene_->views[input.right_view];
+  const RenderedView &left = pair_views_[0], &right = pair_views_[1];
   const std::vector<MatchTruth> truth = judgeBySceneDepth(
       pair.putative, {left.view.camera, left.depth}, {right.view.camera, right.depth});
   size_t correct = 0, wrong = 0;
@@ -98,11 +112,12 @@ TEST_F(PairPipelineTest, KeptMatchesAreCorrectAndTheirPointsLieOnTheSurface) {
 TEST_F(PairPipelineTest, TheCacheDescribesEachImageOnceAndChangesNothing) {
   const auto best = makeFilter("best", FilterConfigs());
   FeatureCache cache(4);
-  const PairResult first = runPair(pairInput(), PairPipelineConfig(), {best.get()}, &cache);
-  const PairResult again = runPair(pairInput(), PairPipelineConfig(), {best.get()}, &cache);
+  const PairResult first = runPair(pairInput(), guided(), {best.get()}, &cache);
+  const PairResult again = runPair(pairInput(), guided(), {best.get()}, &cache);
   EXPECT_EQ(cache.misses(), 2u);
   EXPECT_EQ(cache.hits(), 2u);
   EXPECT_EQ(first.verdicts[0].result.keep, again.verdicts[0].result.keep);
+  EXPECT_GT(first.surface_points.size(), 0u);
   EXPECT_EQ(first.surface_points.size(), again.surface_points.size());
 }
 
@@ -110,14 +125,15 @@ TEST_F(PairPipelineTest, WithoutCamerasNothingIsTriangulatedAndGuidedMatchingNee
   PairInput input = pairInput();
   input.cameras.reset();
   const auto best = makeFilter("best", FilterConfigs());
-  PairPipelineConfig guided;
-  guided.epipolar_search_px = 2.0;  // no cameras: every descriptor matched all the same
-  const PairResult pair = runPair(input, guided, {best.get()});
+  // No cameras: every descriptor matched, as without guided matching.
+  const PairResult pair = runPair(input, guided(), {best.get()});
   EXPECT_FALSE(pair.putative.F_right_left.has_value());
   EXPECT_TRUE(pair.surface_points.empty());
-  EXPECT_GT(pair.kept.left_px.size(), 0u);
+  EXPECT_GT(pair.putative.matches.size(), 0u);
   EXPECT_EQ(pair.putative.matches.size(),
             runPair(input, PairPipelineConfig(), {best.get()}).putative.matches.size());
+  input.F_right_left = Eigen::Matrix3d::Identity();
+  EXPECT_EQ(runPair(input, guided(), {best.get()}).putative.F_right_left, input.F_right_left);
 }
 
 TEST_F(PairPipelineTest, RefusesBadInput) {
@@ -146,7 +162,7 @@ TEST_F(PairPipelineTest, TheMatchesRefinementFindsTheSurfaceAndCarvesNothingOfTh
   ASSERT_GE(refined.points.size(), 100u);
   size_t near = 0;
   for (const SurfacePoint& point : refined.points) {
-    near += shareOnSurface({point}, scene_->views[point.views[0]], 0.01) > 0.0;
+    near += shareOnSurface({point}, scene_->views[point.views[0]], kSurfaceTolerance) > 0.0;
   }
   EXPECT_GE(static_cast<double>(near) / refined.points.size(), 0.95);
 
@@ -162,8 +178,9 @@ TEST_F(PairPipelineTest, TheMatchesRefinementFindsTheSurfaceAndCarvesNothingOfTh
   hull.hull.carveFree(refined.free_voxels);
   const double false_carved =
       falseCarvedFraction(before, sampleAgainstSolid(hull.hull, inside, 64));
-  std::cout << refined.points.size() << " points (" << near << " on the surface), "
-            << refined.free_voxels.size() << " free voxels, false carving " << false_carved << '\n';
+  std::cout << refined.points.size() << " points (" << near << " within " << 100 * kSurfaceTolerance
+            << " % of the rendered depth), " << refined.free_voxels.size()
+            << " free voxels, false carving " << false_carved << '\n';
   EXPECT_LE(false_carved, 0.005);
 }
 
