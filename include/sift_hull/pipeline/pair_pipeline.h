@@ -49,6 +49,9 @@ struct PairInput {
   /// rectifiedFundamentalMatrix()); nothing is triangulated then. Ignored when cameras are given.
   std::optional<Eigen::Matrix3d> F_right_left;
   uint32_t left_view = 0, right_view = 1;  ///< the view indices written into PairResult::kept
+  /// A pair with fewer keypoints in either image is not filtered (PairResult::why_not); 0 filters
+  /// every pair, however few its matches.
+  size_t min_keypoints = 2;
 };
 
 /// One filter's verdicts on the putative matches and its wall-clock time.
@@ -66,8 +69,8 @@ struct PairTimes {
 
 /// What runPair found.
 struct PairResult {
-  /// Set when the pair was not filtered: an image has fewer than two keypoints. `putative` is
-  /// then as matched, and verdicts, kept and surface_points are empty.
+  /// Set when the pair was not filtered: an image has fewer than PairInput::min_keypoints
+  /// keypoints. `putative` is then as matched, and verdicts, kept and surface_points are empty.
   std::string why_not;
   PutativeMatches putative;  ///< both keypoint sets, the matches, F and cameras when calibrated
   std::vector<FilterVerdicts> verdicts;  ///< one per filter, in the order given

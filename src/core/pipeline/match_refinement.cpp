@@ -63,11 +63,11 @@ void matchPairs(const RefineViews& views, const VisualHull& hull, const MatchFil
     input.left_image = store.image(a), input.right_image = store.image(b);
     input.cameras = std::make_pair(views.cameras[a], views.cameras[b]);
     input.left_view = a, input.right_view = b;
+    input.min_keypoints = 0;  // every pair filtered, however few its features
     // One SIFT at a time (the memory of one image's pyramid); runPair finds both in the cache.
     describeImage(input.left_image, config.pair.sift, cache);
     describeImage(input.right_image, config.pair.sift, cache);
     PairResult pair = runPair(input, config.pair, filters, cache);
-    if (!pair.why_not.empty()) pair.kept = PairMatches{a, b, {}, {}, {}, {}};
     result->sift_matches += pair.kept.left_px.size();
     result->pairs.push_back(std::move(pair.kept));
   }

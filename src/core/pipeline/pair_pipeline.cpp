@@ -4,6 +4,7 @@
 
 #include "sift_hull/pipeline/pair_pipeline.h"
 
+#include <algorithm>
 #include <chrono>
 #include <future>
 #include <stdexcept>
@@ -119,10 +120,13 @@ PairResult runPair(const PairInput& input, const PairPipelineConfig& config,
   Clock::time_point start = Clock::now();
   result.putative = matched(input, config, *left, *right_features);
   result.times.matching_ms = millisecondsSince(start);
-  if (result.putative.left_keypoints.size() < 2 || result.putative.right_keypoints.size() < 2) {
-    result.why_not = "fewer than two keypoints in an image (" +
-                     std::to_string(result.putative.left_keypoints.size()) + " and " +
-                     std::to_string(result.putative.right_keypoints.size()) + ")";
+  const size_t fewest =
+      std::min(result.putative.left_keypoints.size(), result.putative.right_keypoints.size());
+  if (fewest < input.min_keypoints) {
+    result.why_not =
+        "fewer than " + (input.min_keypoints == 2 ? "two" : std::to_string(input.min_keypoints)) +
+        " keypoints in an image (" + std::to_string(result.putative.left_keypoints.size()) +
+        " and " + std::to_string(result.putative.right_keypoints.size()) + ")";
     return result;
   }
   if (input.cameras) {
