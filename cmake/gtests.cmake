@@ -36,6 +36,7 @@ set(SIFT_HULL_CORE_GTESTS
   test_refine eval
   test_dense_matching eval
   test_refine_command eval
+  test_pair_pipeline eval
   test_reduced_distance eval
   test_hull_data eval
   test_hull_stream eval

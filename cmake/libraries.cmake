@@ -1,10 +1,12 @@
 # sift_hull_add_libraries(ROOT <package root> [SUFFIX <suffix>] [STATIC])
 #
-# The three ROS-free libraries of the package, by layer (docs/ARCHITECTURE.md), each linking only
+# The four ROS-free libraries of the package, by layer (docs/ARCHITECTURE.md), each linking only
 # the layers below it:
-#   sift_hull_core<suffix>   geometry, features, filters, hull
-#   sift_hull_io<suffix>     file formats; links sift_hull_core
-#   sift_hull_eval<suffix>   synthetic renderer and evaluation; links sift_hull_io
+#   sift_hull_core<suffix>      geometry, features, filters, hull, refine
+#   sift_hull_io<suffix>        file formats; links sift_hull_core
+#   sift_hull_pipeline<suffix>  pair pipeline, matches refinement, drawing; links sift_hull_core
+#   sift_hull_eval<suffix>      synthetic renderer and evaluation; links sift_hull_io and
+#                               sift_hull_pipeline
 # Used by the package's CMakeLists.txt and by the sanitizer build (test/sanitize), which makes static
 # variants with other compile flags. Expects OpenCV, Eigen3, octomap, VTK, GLPK (GLPK_INCLUDE_DIR,
 # GLPK_LIBRARY), OpenBLAS (OPENBLAS_INCLUDE_DIR, OPENBLAS_LIBRARY), nlohmann_json and Threads to be
@@ -17,7 +19,7 @@ function(sift_hull_add_libraries)
   if(ARG_STATIC)
     set(type STATIC)
   endif()
-  foreach(layer CORE IO EVAL EXACT_FLOAT)
+  foreach(layer CORE IO PIPELINE EVAL EXACT_FLOAT)
     set(${layer} ${SIFT_HULL_${layer}_SOURCES})
     list(TRANSFORM ${layer} PREPEND "${ARG_ROOT}/")
   endforeach()
@@ -37,8 +39,12 @@ function(sift_hull_add_libraries)
   add_library(${io} ${type} ${IO})
   target_link_libraries(${io} PUBLIC ${core})
 
+  set(pipeline sift_hull_pipeline${ARG_SUFFIX})
+  add_library(${pipeline} ${type} ${PIPELINE})
+  target_link_libraries(${pipeline} PUBLIC ${core})
+
   set(eval sift_hull_eval${ARG_SUFFIX})
   add_library(${eval} ${type} ${EVAL})
   target_include_directories(${eval} PRIVATE ${ARG_ROOT}/src/core)
-  target_link_libraries(${eval} PUBLIC ${io} PRIVATE nlohmann_json::nlohmann_json)
+  target_link_libraries(${eval} PUBLIC ${io} ${pipeline} PRIVATE nlohmann_json::nlohmann_json)
 endfunction()

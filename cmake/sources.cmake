@@ -1,6 +1,7 @@
 # The sources of the ROS-free libraries, relative to the package root, one list per layer:
 #   sift_hull_core   geometry, features, filters, hull: the method itself
 #   sift_hull_io     calibration files, images, PFM, PLY, view lists, ground-truth files
+#   sift_hull_pipeline  the pair pipeline and the matches refinement, the match drawings
 #   sift_hull_eval   the synthetic renderer and the evaluation against ground truth
 # Included by the package's CMakeLists.txt and by test/sanitize/CMakeLists.txt, so that both build
 # the libraries from the same lists (docs/ARCHITECTURE.md).
@@ -66,6 +67,11 @@ set(SIFT_HULL_IO_SOURCES
   src/core/io/view_list.cpp
   src/core/io/view_orientation.cpp
 )
+set(SIFT_HULL_PIPELINE_SOURCES
+  src/core/draw/match_drawing.cpp
+  src/core/pipeline/match_refinement.cpp
+  src/core/pipeline/pair_pipeline.cpp
+)
 set(SIFT_HULL_EVAL_SOURCES
   src/core/synthetic/mask_render.cpp
   src/core/synthetic/scene.cpp
@@ -74,7 +80,6 @@ set(SIFT_HULL_EVAL_SOURCES
   src/core/synthetic/texture.cpp
   src/core/synthetic/warped_pairs.cpp
   src/core/eval/hull_evaluation.cpp
-  src/core/eval/match_drawing.cpp
   src/core/eval/match_evaluation.cpp
   src/core/eval/mesh_render.cpp
 )

@@ -1,5 +1,5 @@
 #include <algorithm>
-#include <chrono>
+#include <memory>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
@@ -8,7 +8,7 @@
 #include "match_eval.h"
 #include "match_options.h"
 #include "match_table.h"
-#include "sift_hull/eval/match_drawing.h"
+#include "sift_hull/draw/match_drawing.h"
 #include "sift_hull/features/labelled_matches.h"
 #include "sift_hull/filters/filter.h"
 #include "sift_hull/filters/filter_result.h"
@@ -16,6 +16,7 @@
 #include "sift_hull/geometry/camera.h"
 #include "sift_hull/io/calibration.h"
 #include "sift_hull/io/images.h"
+#include "sift_hull/pipeline/pair_pipeline.h"
 #include "sift_hull/synthetic/scene.h"
 
 namespace sift_hull {
@@ -54,7 +55,7 @@ void addPairOptions(ArgParser* parser) {
 
 /// Calibrates the pair from --rectified, --calib or the scene's cameras, when any is given.
 void calibrate(const ArgParser& parser, const std::string& left, const std::string& right,
-               PutativeMatches* input) {
+               PairInput* input) {
   if (parser.flag("rectified")) {
     input->F_right_left = rectifiedFundamentalMatrix();
     return;
@@ -71,8 +72,8 @@ void calibrate(const ArgParser& parser, const std::string& left, const std::stri
   const std::string left_name = parser.has("left-view") ? parser.get("left-view") : baseName(left);
   const std::string right_name =
       parser.has("right-view") ? parser.get("right-view") : baseName(right);
-  calibratePair(input, views[viewIndex(views, left_name, calib)].camera,
-                views[viewIndex(views, right_name, calib)].camera);
+  input->cameras = std::make_pair(views[viewIndex(views, left_name, calib)].camera,
+                                  views[viewIndex(views, right_name, calib)].camera);
 }
 
 std::optional<PairTruth> pairTruth(const ArgParser& parser, const std::string& left,
@@ -173,43 +174,51 @@ void writeHistogramFigure(const std::string& path, const PutativeMatches& input,
   writeImage(path, figure);
 }
 
-/// Runs each chosen filter in the order given; fills result["filters"] and `order` (the filters'
-/// names as run) and returns the runs.
-std::vector<FilterRun> runFilters(const ArgParser& parser, const PutativeMatches& input,
-                                  const FilterConfigs& configs,
-                                  const std::vector<MatchTruth>* truth, nlohmann::json* result,
-                                  std::vector<std::string>* order) {
-  std::vector<FilterRun> runs;
-  for (const std::string& name : chosenFilters(parser, input.F_right_left.has_value())) {
-    FilterRun run = timedRun(*makeFilter(name, configs), input);
-    (*result)["filters"][run.name] = filterRunJson(run, truth);
-    if (std::find(order->begin(), order->end(), run.name) == order->end()) {
-      order->push_back(run.name);
-      runs.push_back(std::move(run));
-    }
+/// Each chosen filter once, in the order first given.
+std::vector<std::unique_ptr<MatchFilter>> chosenFilterObjects(const ArgParser& parser,
+                                                              const FilterConfigs& configs,
+                                                              bool calibrated) {
+  std::vector<std::unique_ptr<MatchFilter>> filters;
+  for (const std::string& name : chosenFilters(parser, calibrated)) {
+    std::unique_ptr<MatchFilter> filter = makeFilter(name, configs);
+    const bool seen = std::any_of(filters.begin(), filters.end(), [&](const auto& other) {
+      return other->name() == filter->name();
+    });
+    if (!seen) filters.push_back(std::move(filter));
   }
-  return runs;
+  return filters;
 }
 
-/// SIFT of both images (timed each) and the descriptor matching (timed): matchImages in steps.
-PutativeMatches timedMatch(const cv::Mat& left, const cv::Mat& right, const MatchOptions& options,
-                           nlohmann::json* time_ms) {
-  const auto start = std::chrono::steady_clock::now();
-  Features a = detectSift(left, options.sift);
-  const auto left_done = std::chrono::steady_clock::now();
-  Features b = detectSift(right, options.sift);
-  const auto right_done = std::chrono::steady_clock::now();
-  PutativeMatches input;
-  input.matches = matchDescriptors(a.descriptors, b.descriptors, options.matching);
-  const auto ms = [](auto from, auto to) {
-    return std::chrono::duration<double, std::milli>(to - from).count();
-  };
-  *time_ms = {{"sift_left", ms(start, left_done)},
-              {"sift_right", ms(left_done, right_done)},
-              {"matching", ms(right_done, std::chrono::steady_clock::now())}};
-  input.left_keypoints = std::move(a.keypoints), input.right_keypoints = std::move(b.keypoints);
-  input.left_image_size = left.size(), input.right_image_size = right.size();
-  return input;
+/// The pair through the core pipeline (runPair); fills result["filters"] and `order` (the
+/// filters' names as run) and returns the runs.
+std::vector<FilterRun> filterRuns(const PairResult& pair, const std::vector<MatchTruth>* truth,
+                                  nlohmann::json* result, std::vector<std::string>* order) {
+  for (const FilterVerdicts& run : pair.verdicts) {
+    (*result)["filters"][run.name] = filterRunJson(run, truth);
+    order->push_back(run.name);
+  }
+  return pair.verdicts;
+}
+
+nlohmann::json timesJson(const PairTimes& times) {
+  return {{"sift_left", times.sift_left_ms},
+          {"sift_right", times.sift_right_ms},
+          {"matching", times.matching_ms}};
+}
+
+/// LEFT and RIGHT through the core pipeline (runPair), calibrated as the options say, with each
+/// chosen filter.
+PairResult runPairOfFiles(const ArgParser& parser, const MatchOptions& options, const cv::Mat& left,
+                          const cv::Mat& right) {
+  const std::string left_path = parser.get("LEFT"), right_path = parser.get("RIGHT");
+  PairInput input;
+  input.left_image = left, input.right_image = right;
+  input.min_keypoints = 0;  // every pair filtered: an image without features keeps nothing
+  calibrate(parser, left_path, right_path, &input);
+  const bool calibrated = input.cameras || input.F_right_left;
+  const auto filters = chosenFilterObjects(parser, options.filters, calibrated);
+  const PairPipelineConfig pipeline{options.sift, options.matching, 0.0};
+  return runPair(input, pipeline, filterPointers(filters));
 }
 
 void addMatchCommandOptions(ArgParser* parser) {
@@ -242,9 +251,8 @@ int runMatch(const std::vector<std::string>& args) {
   const std::string left_path = parser.get("LEFT"), right_path = parser.get("RIGHT");
   const cv::Mat left = readImage(left_path), right = readImage(right_path);
 
-  nlohmann::json time_ms;
-  PutativeMatches input = timedMatch(left, right, options, &time_ms);
-  calibrate(parser, left_path, right_path, &input);
+  const PairResult pair = runPairOfFiles(parser, options, left, right);
+  const PutativeMatches& input = pair.putative;
   const std::optional<PairTruth> truth = pairTruth(parser, left_path, right_path);
   const std::vector<MatchTruth> judged = truth ? truth->judge(input) : std::vector<MatchTruth>();
   const std::vector<MatchTruth>* truth_or_null = truth ? &judged : nullptr;
@@ -252,12 +260,11 @@ int runMatch(const std::vector<std::string>& args) {
   nlohmann::json result = {{"putative", input.matches.size()},
                            {"left_keypoints", input.left_keypoints.size()},
                            {"right_keypoints", input.right_keypoints.size()},
-                           {"time_ms", time_ms},
+                           {"time_ms", timesJson(pair.times)},
                            {"filters", nlohmann::json::object()}};
   if (truth) result["ground_truth"] = truthJson(truth->kind, judged);
   std::vector<std::string> order;
-  const std::vector<FilterRun> runs =
-      runFilters(parser, input, options.filters, truth_or_null, &result, &order);
+  const std::vector<FilterRun> runs = filterRuns(pair, truth_or_null, &result, &order);
   if (parser.has("out-image") && !runs.empty()) {
     writeImage(parser.get("out-image"), drawMatchDecisions(left, right, input, runs[0].result));
   }

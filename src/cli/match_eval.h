@@ -10,6 +10,7 @@
 #include "sift_hull/features/labelled_matches.h"
 #include "sift_hull/filters/filter.h"
 #include "sift_hull/filters/filter_result.h"
+#include "sift_hull/pipeline/pair_pipeline.h"
 
 namespace sift_hull {
 namespace cli {
@@ -24,12 +25,8 @@ PairTruth disparityTruth(const std::string& path, double scale);
 PairTruth homographyTruth(const std::string& path);
 PairTruth sceneTruth(const DepthView& left, const DepthView& right);
 
-/// One filter applied once, with its wall-clock time.
-struct FilterRun {
-  std::string name;
-  FilterResult result;
-  double time_ms = 0.0;
-};
+/// One filter applied once, with its wall-clock time (what runPair returns per filter).
+using FilterRun = FilterVerdicts;
 
 FilterRun timedRun(const MatchFilter& filter, const PutativeMatches& input);
 

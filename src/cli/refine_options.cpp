@@ -1,25 +1,20 @@
 // hull --refine-with-matches: the filtered matches of calibrated pairs carve what silhouettes
-// cannot (src/core/refine), and with --gt-scene the result against the renderer's solid.
+// cannot (src/core/pipeline/match_refinement.cpp), and with --gt-scene the result against the
+// renderer's solid.
 
 #include "refine_options.h"
 
-#include <algorithm>
 #include <chrono>
-#include <iostream>
 #include <memory>
 #include <optional>
-#include <set>
-#include <sstream>
+#include <string>
 
 #include "bench_timing.h"
 #include "sift_hull/eval/hull_evaluation.h"
-#include "sift_hull/features/sift.h"
 #include "sift_hull/filters/filter.h"
 #include "sift_hull/io/images.h"
 #include "sift_hull/io/ply.h"
-#include "sift_hull/refine/dense_matching.h"
-#include "sift_hull/refine/free_space.h"
-#include "sift_hull/refine/surface_points.h"
+#include "sift_hull/pipeline/match_refinement.h"
 #include "sift_hull/synthetic/scene.h"
 #include "sift_hull/synthetic/shape.h"
 
@@ -31,30 +26,6 @@ namespace {
 constexpr int kSolidSamplesPerAxis = 160;
 /// SIFT's contrast threshold for refinement: lower than SiftConfig's 0.04, for denser points.
 constexpr double kRefineContrastThreshold = 0.04;
-/// How far from its epipolar line a match may lie in guided matching, pixels.
-constexpr double kGuidedEpipolarPx = 2.0;
-/// Views each view pairs with under --match-pairs neighbours: its nearest by camera centre.
-constexpr size_t kNeighbours = 2;
-
-/// (a, b) with a < b: each view with its kNeighbours nearest, or every pair.
-std::vector<std::pair<uint32_t, uint32_t>> viewPairs(const std::vector<PinholeCamera>& cameras,
-                                                     bool all) {
-  std::set<std::pair<uint32_t, uint32_t>> pairs;
-  const uint32_t n = static_cast<uint32_t>(cameras.size());
-  for (uint32_t a = 0; a < n; ++a) {
-    std::vector<uint32_t> others;
-    for (uint32_t b = 0; b < n; ++b) {
-      if (b != a) others.push_back(b);
-    }
-    const Eigen::Vector3d centre = cameras[a].centre();
-    std::sort(others.begin(), others.end(), [&](uint32_t x, uint32_t y) {
-      return (cameras[x].centre() - centre).norm() < (cameras[y].centre() - centre).norm();
-    });
-    if (!all && others.size() > kNeighbours) others.resize(kNeighbours);
-    for (const uint32_t b : others) pairs.insert({std::min(a, b), std::max(a, b)});
-  }
-  return {pairs.begin(), pairs.end()};
-}
 
 DenseMatchConfig denseMatchConfigFromArgs(const ArgParser& parser) {
   DenseMatchConfig config;
@@ -68,132 +39,23 @@ DenseMatchConfig denseMatchConfigFromArgs(const ArgParser& parser) {
   return config;
 }
 
-/// Each view's image, SIFT features and dense-matching image, read once when first needed.
-class ViewImages {
- public:
-  ViewImages(std::string folder, const HullInput& input, SiftConfig sift, int patch_radius_px)
-      : folder_(std::move(folder)),
-        input_(input),
-        sift_(sift),
-        patch_radius_px_(patch_radius_px),
-        views_(input.names.size()) {}
-
-  const Features& features(uint32_t view) {
-    View& v = load(view);
-    if (!v.features) v.features = detectSift(v.image, sift_);
-    return *v.features;
-  }
-  const DenseView& dense(uint32_t view) {
-    View& v = load(view);
-    if (v.dense.grey.empty()) {
-      const cv::Mat mask =
-          input_.masks.empty() ? input_.run_length_masks.at(view).decode() : input_.masks.at(view);
-      v.dense = denseMatchingView(v.image, mask, patch_radius_px_);
-    }
-    return v.dense;
-  }
-  cv::Size size(uint32_t view) { return load(view).image.size(); }
-
- private:
-  struct View {
-    cv::Mat image;
-    DenseView dense;
-    std::optional<Features> features;
-  };
-  View& load(uint32_t view) {
-    View& v = views_.at(view);
-    if (v.image.empty()) v.image = readImage(folder_ + "/" + input_.names[view]);
-    return v;
-  }
-  std::string folder_;
-  const HullInput& input_;
-  SiftConfig sift_;
-  int patch_radius_px_;
-  std::vector<View> views_;
-};
-
-/// The SIFT matches of a pair that its filter keeps, with their keypoint ids.
-PairMatches keptSiftMatches(ViewImages* images, const HullInput& input, uint32_t a, uint32_t b,
-                            const MatchConfig& matching, const MatchFilter& filter) {
-  const Features& left = images->features(a);
-  const Features& right = images->features(b);
-  PutativeMatches putative;
-  putative.matches = matchAlongEpipolarLines(left, right, input.cameras[a], input.cameras[b],
-                                             matching, kGuidedEpipolarPx);
-  putative.left_keypoints = left.keypoints;
-  putative.right_keypoints = right.keypoints;
-  putative.left_image_size = images->size(a);
-  putative.right_image_size = images->size(b);
-  calibratePair(&putative, input.cameras[a], input.cameras[b]);
-  const FilterResult kept = filter.apply(putative);
-  PairMatches pair;
-  pair.left_view = a, pair.right_view = b;
-  for (size_t m = 0; m < putative.matches.size(); ++m) {
-    if (!kept.keep[m]) continue;
-    pair.left_px.emplace_back(putative.left(m).pt.x, putative.left(m).pt.y);
-    pair.right_px.emplace_back(putative.right(m).pt.x, putative.right(m).pt.y);
-    pair.left_keypoint.push_back(putative.matches[m].queryIdx);
-    pair.right_keypoint.push_back(putative.matches[m].trainIdx);
-  }
-  return pair;
-}
-
-/// What matching the pairs found: each pair's kept SIFT matches (with keypoint ids), then each
-/// pair's dense matches (DenseMatchConfig, none when its grid_step_px is 0).
-struct MatchedPairs {
-  std::vector<PairMatches> pairs;
-  size_t view_pairs = 0, sift_matches = 0, dense_matches = 0;
-};
-
 /// How the pairs are chosen and matched (--match-pairs, --filter, --contrast-threshold, --ratio).
-struct MatchSettings {
-  bool all_pairs = false;
-  std::unique_ptr<MatchFilter> filter;
-  SiftConfig sift;
-  MatchConfig matching;
-};
-
-MatchSettings matchSettingsFromArgs(const ArgParser& parser) {
-  MatchSettings settings;
+void matchSettingsFromArgs(const ArgParser& parser, MatchRefineConfig* config,
+                           std::unique_ptr<MatchFilter>* filter) {
   const std::string match_pairs = parser.get("match-pairs");
   if (match_pairs != "neighbours" && match_pairs != "all") {
     throw UsageError("--match-pairs must be neighbours or all, not '" + match_pairs + "'");
   }
-  settings.all_pairs = match_pairs == "all";
-  const FilterConfigs filter_configs;
+  config->pairing = match_pairs == "all" ? ViewPairing::kAll : ViewPairing::kNeighbours;
   try {
-    settings.filter = makeFilter(parser.get("filter"), filter_configs);
+    *filter = makeFilter(parser.get("filter"), FilterConfigs());
   } catch (const std::invalid_argument& e) {
     throw UsageError(std::string("--filter: ") + e.what());
   }
-  settings.sift.contrast_threshold = parser.getDouble("contrast-threshold");
-  validateOptions(settings.sift);
-  settings.matching.ratio = parser.getDouble("ratio");
-  validateOptions(settings.matching);
-  return settings;
-}
-
-MatchedPairs matchedPairs(const ArgParser& parser, const HullInput& input, const VisualHull& hull) {
-  if (!parser.has("images")) throw UsageError("--refine-with-matches needs --images");
-  const MatchSettings settings = matchSettingsFromArgs(parser);
-  const DenseMatchConfig dense = denseMatchConfigFromArgs(parser);
-  ViewImages images(parser.get("images"), input, settings.sift, dense.patch_radius_px);
-  const auto view_pairs = viewPairs(input.cameras, settings.all_pairs);
-  MatchedPairs result;
-  result.view_pairs = view_pairs.size();
-  for (const auto& [a, b] : view_pairs) {
-    result.pairs.push_back(
-        keptSiftMatches(&images, input, a, b, settings.matching, *settings.filter));
-    result.sift_matches += result.pairs.back().left_px.size();
-  }
-  if (dense.grid_step_px == 0) return result;
-  for (const auto& [a, b] : view_pairs) {
-    result.pairs.push_back(denseMatches(images.dense(a), images.dense(b), input.cameras[a],
-                                        input.cameras[b], a, b, hull, dense,
-                                        hull.config().threads));
-    result.dense_matches += result.pairs.back().left_px.size();
-  }
-  return result;
+  config->pair.sift.contrast_threshold = parser.getDouble("contrast-threshold");
+  validateOptions(config->pair.sift);
+  config->pair.matching.ratio = parser.getDouble("ratio");
+  validateOptions(config->pair.matching);
 }
 
 SurfacePointConfig surfacePointConfigFromArgs(const ArgParser& parser) {
@@ -216,6 +78,29 @@ FreeSpaceConfig freeSpaceConfigFromArgs(const ArgParser& parser) {
   return config;
 }
 
+MatchRefineConfig refineConfigFromArgs(const ArgParser& parser,
+                                       std::unique_ptr<MatchFilter>* filter) {
+  MatchRefineConfig config;
+  matchSettingsFromArgs(parser, &config, filter);
+  config.dense = denseMatchConfigFromArgs(parser);
+  config.points = surfacePointConfigFromArgs(parser);
+  config.free_space = freeSpaceConfigFromArgs(parser);
+  return config;
+}
+
+/// The views as the refinement reads them: --images/<name>, the masks the hull was built from.
+RefineViews refineViews(const std::string& folder, const HullInput& input) {
+  RefineViews views;
+  views.cameras = input.cameras;
+  views.image = [folder, &input](uint32_t view) {
+    return readImage(folder + "/" + input.names.at(view));
+  };
+  views.mask = [&input](uint32_t view) {
+    return input.masks.empty() ? input.run_length_masks.at(view).decode() : input.masks.at(view);
+  };
+  return views;
+}
+
 nlohmann::json solidJson(const SolidComparison& c) {
   return {{"iou", c.iou},
           {"hull_m3", c.hull_m3},
@@ -231,10 +116,8 @@ nlohmann::json solidJson(const SolidComparison& c) {
 void checkRefineOptions(const ArgParser& parser) {
   if (!parser.flag("refine-with-matches")) return;
   if (!parser.has("images")) throw UsageError("--refine-with-matches needs --images");
-  static_cast<void>(matchSettingsFromArgs(parser));
-  static_cast<void>(denseMatchConfigFromArgs(parser));
-  static_cast<void>(surfacePointConfigFromArgs(parser));
-  static_cast<void>(freeSpaceConfigFromArgs(parser));
+  std::unique_ptr<MatchFilter> filter;
+  static_cast<void>(refineConfigFromArgs(parser, &filter));
 }
 
 void addRefineOptions(ArgParser* parser) {
@@ -312,10 +195,53 @@ void addRefineOptions(ArgParser* parser) {
                     "(volume IoU, and with --refine-with-matches before and after, false carving)");
 }
 
+namespace {
+
+/// The matches refinement of result->hull (sift_hull::refineWithMatches), carved and meshed
+/// again; its part of `hull --json`.
+nlohmann::json refine(const ArgParser& parser, const HullInput& input, HullResult* result) {
+  std::unique_ptr<MatchFilter> filter;
+  const MatchRefineConfig config = refineConfigFromArgs(parser, &filter);
+  nlohmann::json json = nlohmann::json::object();
+  const ReprojectionIoU iou_before = reprojectionIoU(result->mesh, result->hull.views());
+  json["reprojection_iou_before"] = {{"min", iou_before.min}, {"mean", iou_before.mean}};
+  const MatchRefineResult refined = sift_hull::refineWithMatches(
+      refineViews(parser.get("images"), input), result->hull, *filter, config);
+  if (parser.has("out-points")) {
+    TriangleMesh cloud;
+    for (const SurfacePoint& point : refined.points) {
+      cloud.vertices_W.push_back(point.X_W.cast<float>());
+    }
+    writePly(parser.get("out-points"), cloud);
+  }
+  const double before_m3 = result->hull.stats().occupied_volume_m3;
+  auto start = std::chrono::steady_clock::now();
+  result->hull.carveFree(refined.free_voxels);
+  const double carve_ms = millisecondsSince(start);
+  start = std::chrono::steady_clock::now();
+  result->mesh = result->hull.mesh();
+  result->mesh_check = checkMesh(result->mesh);
+  const SurfacePointCounts& counts = refined.counts;
+  json["refine_time_ms"] = {{"matching", refined.times_ms.matching},
+                            {"points", refined.times_ms.points},
+                            {"free_voxels", refined.times_ms.free_voxels},
+                            {"carving", carve_ms},
+                            {"mesh", millisecondsSince(start)}};
+  json["points"] = {
+      {"pairs", refined.view_pairs.size()},     {"matches_kept", refined.sift_matches},
+      {"dense_matches", refined.dense_matches}, {"triangulated", counts.triangulated},
+      {"reprojected", counts.reprojected},      {"inside_hull", counts.inside_hull},
+      {"confirmed", counts.confirmed},          {"kept", counts.kept}};
+  json["free_voxels"] = result->hull.freeVoxelCount();
+  json["carved_volume_m3"] = before_m3 - result->hull.stats().occupied_volume_m3;
+  return json;
+}
+
+}  // namespace
+
 nlohmann::json refineWithMatches(const ArgParser& parser, const HullInput& input,
                                  HullResult* result) {
   nlohmann::json json = nlohmann::json::object();
-  const bool refine = parser.flag("refine-with-matches");
   std::optional<Shape> solid;
   if (parser.has("gt-scene")) solid = Shape::byName(readScene(parser.get("gt-scene")).config.shape);
   const SolidPredicate inside = [&](const Eigen::Vector3d& X_W) { return solid->contains(X_W); };
@@ -326,53 +252,7 @@ nlohmann::json refineWithMatches(const ArgParser& parser, const HullInput& input
   };
   std::optional<SolidSamples> before;
   if (solid) before = sampleAgainstSolid(result->hull, inside, kSolidSamplesPerAxis, cavities);
-  if (refine) {
-    const SurfacePointConfig point_config = surfacePointConfigFromArgs(parser);
-    const FreeSpaceConfig free_config = freeSpaceConfigFromArgs(parser);
-    const ReprojectionIoU iou_before = reprojectionIoU(result->mesh, result->hull.views());
-    json["reprojection_iou_before"] = {{"min", iou_before.min}, {"mean", iou_before.mean}};
-    auto start = std::chrono::steady_clock::now();
-    const auto lapMs = [&start] {
-      const double ms = millisecondsSince(start);
-      start = std::chrono::steady_clock::now();
-      return ms;
-    };
-    const MatchedPairs matched = matchedPairs(parser, input, result->hull);
-    const std::vector<PairMatches>& pairs = matched.pairs;
-    const double matching_ms = lapMs();
-    SurfacePointCounts counts;
-    const std::vector<SurfacePoint> points =
-        surfacePoints(input.cameras, pairs, result->hull, point_config, &counts);
-    const double points_ms = lapMs();
-    if (parser.has("out-points")) {
-      TriangleMesh cloud;
-      for (const SurfacePoint& point : points) cloud.vertices_W.push_back(point.X_W.cast<float>());
-      writePly(parser.get("out-points"), cloud);
-    }
-    const double before_m3 = result->hull.stats().occupied_volume_m3;
-    const std::vector<Eigen::Vector3i> free =
-        freeVoxels(result->hull, input.cameras, points, free_config);
-    const double free_ms = lapMs();
-    result->hull.carveFree(free);
-    const double carve_ms = lapMs();
-    result->mesh = result->hull.mesh();
-    result->mesh_check = checkMesh(result->mesh);
-    json["refine_time_ms"] = {{"matching", matching_ms},
-                              {"points", points_ms},
-                              {"free_voxels", free_ms},
-                              {"carving", carve_ms},
-                              {"mesh", lapMs()}};
-    json["points"] = {{"pairs", matched.view_pairs},
-                      {"matches_kept", matched.sift_matches},
-                      {"dense_matches", matched.dense_matches},
-                      {"triangulated", counts.triangulated},
-                      {"reprojected", counts.reprojected},
-                      {"inside_hull", counts.inside_hull},
-                      {"confirmed", counts.confirmed},
-                      {"kept", counts.kept}};
-    json["free_voxels"] = result->hull.freeVoxelCount();
-    json["carved_volume_m3"] = before_m3 - result->hull.stats().occupied_volume_m3;
-  }
+  if (parser.flag("refine-with-matches")) json = refine(parser, input, result);
   if (solid) {
     const SolidSamples after =
         sampleAgainstSolid(result->hull, inside, kSolidSamplesPerAxis, cavities);

@@ -30,6 +30,8 @@ const std::map<std::string, std::set<std::string>>& allowedIncludes() {
       {"filters", {"geometry", "features"}},
       {"hull", {"geometry"}},
       {"refine", {"geometry", "hull"}},
+      {"draw", {"geometry", "features", "filters"}},
+      {"pipeline", {"geometry", "features", "filters", "hull", "refine"}},
       {"io", {"geometry", "features", "filters", "hull"}},
       {"synthetic", {"geometry", "features", "filters", "hull", "io"}},
       {"eval", {"geometry", "features", "filters", "hull", "refine", "io"}},

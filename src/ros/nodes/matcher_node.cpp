@@ -6,17 +6,17 @@
 
 #include <algorithm>
 #include <cmath>
-#include <future>
+#include <utility>
 
 #include "lib/conversions.h"
 #include "lib/node_diagnostics.h"
 #include "lib/reconfigure_settings.h"
 #include "lib/ros_params.h"
 #include "lib/wall_wait.h"
-#include "sift_hull/eval/match_drawing.h"
-#include "sift_hull/features/triangulation.h"
+#include "sift_hull/draw/match_drawing.h"
 #include "sift_hull/filters/filter.h"
 #include "sift_hull/filters/filter_result.h"
+#include "sift_hull/pipeline/pair_pipeline.h"
 
 namespace sift_hull {
 namespace {
@@ -40,6 +40,14 @@ std::string pairingHint(const MatcherNodeConfig& config) {
   if (config.approximate_sync) return "approximate sync found no two stamps near enough";
   return "the left and right images pair by equal stamps (~approximate_sync: true pairs the "
          "nearest ones)";
+}
+
+/// SIFT and matching as the settings say, every descriptor matched (no guided matching).
+PairPipelineConfig pairConfig(const MatcherSettings& settings) {
+  PairPipelineConfig config;
+  config.sift = settings.sift;
+  config.matching = settings.matching;
+  return config;
 }
 
 std::vector<std::unique_ptr<MatchFilter>> makeFilters(const MatcherSettings& settings) {
@@ -69,7 +77,7 @@ MatcherNode::MatcherNode(ros::NodeHandle nh, ros::NodeHandle private_nh, Matcher
       private_nh_(private_nh),
       settings_(std::move(settings)),
       pipeline_(std::make_shared<const Pipeline>(
-          Pipeline{settings_, makeFilters(settings_),
+          Pipeline{settings_, pairConfig(settings_), makeFilters(settings_),
                    ros_conversions::settingsJson(settings_.matching, settings_.filters)})),
       transport_(nh_),
       tf_listener_(tf_buffer_),
@@ -159,7 +167,7 @@ void MatcherNode::onReconfigure(sift_hull::MatcherConfig& config, uint32_t) {
     validate(changed.matching);
     validate(changed.filters);
     replacement = std::make_shared<const Pipeline>(
-        Pipeline{changed, makeFilters(changed),
+        Pipeline{changed, pairConfig(changed), makeFilters(changed),
                  ros_conversions::settingsJson(changed.matching, changed.filters)});
   } catch (const std::invalid_argument& e) {
     log_.error("matcher: reconfiguration refused: ", e.what());
@@ -347,65 +355,48 @@ void MatcherNode::matchPair(Pair& pair) {
   last_pair_ms_ = (ros::WallTime::now() - start).toSec() * 1e3;
 }
 
-PutativeMatches MatcherNode::matchDescribed(const Pipeline& pipeline, const cv::Mat& left,
-                                            const cv::Mat& right) {
-  const auto describe = [&](const cv::Mat& image) {
-    return features_.get(imageKey(image),
-                         [&] { return detectSift(image, pipeline.settings.sift); });
-  };
-  // The right image on a second thread; the future's destructor waits for it, also on a throw.
-  auto right_features = std::async(std::launch::async, describe, std::cref(right));
-  const std::shared_ptr<const Features> left_features = describe(left);
-  return matchFeatures(*left_features, *right_features.get(), left.size(), right.size(),
-                       pipeline.settings.matching);
-}
-
 void MatcherNode::process(const Pipeline& pipeline, const sensor_msgs::ImageConstPtr& left,
                           const sensor_msgs::ImageConstPtr& right, const StereoCameras* cameras) {
   std::string why_not;
-  const cv::Mat left_image = ros_conversions::eightBitImage(left, &why_not);
-  const cv::Mat right_image =
-      left_image.empty() ? cv::Mat() : ros_conversions::eightBitImage(right, &why_not);
-  if (left_image.empty() || right_image.empty()) {
+  PairInput input;
+  input.left_image = ros_conversions::eightBitImage(left, &why_not);
+  if (!input.left_image.empty())
+    input.right_image = ros_conversions::eightBitImage(right, &why_not);
+  if (input.left_image.empty() || input.right_image.empty()) {
     log_.error("matcher: pair ignored: ", why_not);
     return;
   }
-  PutativeMatches matches = matchDescribed(pipeline, left_image, right_image);
-  if (matches.left_keypoints.size() < 2 || matches.right_keypoints.size() < 2) {
-    log_.error("matcher: pair ignored: ", "fewer than two keypoints in an image (" +
-                                              std::to_string(matches.left_keypoints.size()) +
-                                              " and " +
-                                              std::to_string(matches.right_keypoints.size()) + ")");
+  if (cameras != nullptr) input.cameras = std::make_pair(cameras->left, cameras->right);
+  const PairResult pair =
+      runPair(input, pipeline.pair, filterPointers(pipeline.filters), &features_);
+  if (!pair.why_not.empty()) {
+    log_.error("matcher: pair ignored: ", pair.why_not);
     return;
   }
-  if (cameras != nullptr) calibratePair(&matches, cameras->left, cameras->right);
-  std::vector<FilterResult> results;
-  for (const auto& filter : pipeline.filters) results.push_back(filter->apply(matches));
   std::vector<std::string> names;
-  for (const auto& filter : pipeline.filters) names.push_back(filter->name());
+  std::vector<FilterResult> results;
+  for (const FilterVerdicts& verdicts : pair.verdicts) {
+    names.push_back(verdicts.name);
+    results.push_back(verdicts.result);
+  }
   correspondences_pub_.publish(ros_conversions::correspondencesMessage(
-      left->header, right->header, names, pipeline.settings_json, matches, results));
-  if (cameras != nullptr) publishPoints(left->header, *cameras, matches, results.front());
+      left->header, right->header, names, pipeline.settings_json, pair.putative, results));
+  if (cameras != nullptr) publishPoints(left->header, *cameras, pair.surface_points);
   if (matches_image_pub_.getNumSubscribers() > 0) {
-    const cv::Mat drawing = drawMatchDecisions(left_image, right_image, matches, results.front());
+    const cv::Mat drawing =
+        drawMatchDecisions(input.left_image, input.right_image, pair.putative, results.front());
     matches_image_pub_.publish(cv_bridge::CvImage(left->header, "bgr8", drawing).toImageMsg());
   }
 }
 
 void MatcherNode::publishPoints(const std_msgs::Header& header, const StereoCameras& cameras,
-                                const PutativeMatches& matches, const FilterResult& kept) {
-  points_pub_.publish(ros_conversions::pointCloudMessage(
-      triangulateMatches(cameras.left, cameras.right, matches, kept.keep), header));
+                                const std::vector<SurfacePoint>& points) {
+  std::vector<Eigen::Vector3d> points_L;
+  for (const SurfacePoint& point : points) points_L.push_back(point.X_W);
+  points_pub_.publish(ros_conversions::pointCloudMessage(points_L, header));
   if (surface_points_pub_.getNumSubscribers() == 0) return;
-  PairMatches pair;
-  pair.left_view = 0, pair.right_view = 1;
-  for (size_t m = 0; m < matches.matches.size(); ++m) {
-    if (!kept.keep[m]) continue;
-    pair.left_px.emplace_back(matches.left(m).pt.x, matches.left(m).pt.y);
-    pair.right_px.emplace_back(matches.right(m).pt.x, matches.right(m).pt.y);
-  }
-  surface_points_pub_.publish(ros_conversions::surfacePointsMessage(
-      header, cameras.left, cameras.right, triangulatePair(cameras.left, cameras.right, pair)));
+  surface_points_pub_.publish(
+      ros_conversions::surfacePointsMessage(header, cameras.left, cameras.right, points));
 }
 
 }  // namespace sift_hull

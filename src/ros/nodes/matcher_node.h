@@ -22,11 +22,11 @@
 #include <vector>
 
 #include "lib/image_input.h"
-#include "nodes/matcher_node_config.h"
 #include "lib/node_diagnostics.h"
 #include "lib/pairing_watch.h"
 #include "lib/throttled_log.h"
 #include "lib/work_queue.h"
+#include "nodes/matcher_node_config.h"
 #include "sift_hull/Correspondences.h"
 #include "sift_hull/MatcherConfig.h"
 #include "sift_hull/features/feature_cache.h"
@@ -35,10 +35,10 @@
 #include "sift_hull/filters/filter.h"
 #include "sift_hull/filters/filter_result.h"
 #include "sift_hull/geometry/camera.h"
+#include "sift_hull/pipeline/pair_pipeline.h"
+#include "sift_hull/refine/surface_points.h"
 
 namespace sift_hull {
-
-
 
 /// The matcher node: a left and a right image, paired by stamp, give SIFT matches and the
 /// verdicts of each filter on them (`correspondences`), and, when someone subscribes, a drawing of
@@ -70,6 +70,7 @@ class MatcherNode {
   /// with one consistent set of settings even while they change.
   struct Pipeline {
     MatcherSettings settings;
+    PairPipelineConfig pair;  ///< the settings' SIFT and matching, for runPair
     std::vector<std::unique_ptr<MatchFilter>> filters;
     std::string settings_json;
   };
@@ -103,9 +104,8 @@ class MatcherNode {
   void waitForTransform(const std::string& target, const std::string& source,
                         const ros::Time& stamp) const;
   void matchPair(Pair& pair);
-  /// SIFT of both images (through features_, the right one on a second thread), then matching.
-  PutativeMatches matchDescribed(const Pipeline& pipeline, const cv::Mat& left,
-                                 const cv::Mat& right);
+  /// The pair through the core pipeline (runPair: SIFT through features_, matching, the
+  /// filters, the first filter's kept matches triangulated), then published.
   void process(const Pipeline& pipeline, const sensor_msgs::ImageConstPtr& left,
                const sensor_msgs::ImageConstPtr& right, const StereoCameras* cameras);
   std::shared_ptr<const Pipeline> pipeline() const;
@@ -114,8 +114,10 @@ class MatcherNode {
                      const Info& right_info, StereoCameras* cameras);
   /// The right camera's pose in the left camera's frame from tf.
   bool rightPoseFromTf(const Image& left, const Image& right, Eigen::Isometry3d* T_L_R);
+  /// The first filter's kept matches triangulated (in the left camera's frame): `points`, and
+  /// `surface_points` when someone subscribes it.
   void publishPoints(const std_msgs::Header& header, const StereoCameras& cameras,
-                     const PutativeMatches& matches, const FilterResult& kept);
+                     const std::vector<SurfacePoint>& points);
 
   // Destroyed bottom up: subscriptions first, then the workers, then what they publish with.
   ros::NodeHandle nh_, private_nh_;

@@ -1,4 +1,4 @@
-#include "sift_hull/eval/match_drawing.h"
+#include "sift_hull/draw/match_drawing.h"
 
 #include <algorithm>
 #include <cstdio>
