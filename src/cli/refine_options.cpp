@@ -24,8 +24,6 @@ namespace {
 
 /// Samples per axis of the comparison with the true solid (--gt-scene).
 constexpr int kSolidSamplesPerAxis = 160;
-/// SIFT's contrast threshold for refinement: lower than SiftConfig's 0.04, for denser points.
-constexpr double kRefineContrastThreshold = 0.04;
 
 DenseMatchConfig denseMatchConfigFromArgs(const ArgParser& parser) {
   DenseMatchConfig config;
@@ -133,9 +131,9 @@ void addRefineOptions(ArgParser* parser) {
   parser->addOption("filter", "NAME", "match filter for --refine-with-matches (makeFilter names)",
                     kDefaultFilter);
   parser->addOption("contrast-threshold", "T",
-                    "SIFT's contrast threshold for --refine-with-matches (SiftConfig's default: "
-                    "0.04; lower finds more features)",
-                    numberText(kRefineContrastThreshold));
+                    "SIFT's contrast threshold for --refine-with-matches (lower finds more "
+                    "features)",
+                    numberText(SiftConfig{}.contrast_threshold));
   parser->addOption("ratio", "R",
                     "Lowe's ratio among a keypoint's candidates along its epipolar line "
                     "(--refine-with-matches)",
