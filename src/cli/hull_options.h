@@ -22,7 +22,7 @@ HullInput viewSetFromArgs(const ArgParser& parser);
 HullInput runLengthViewSetFromArgs(const ArgParser& parser);
 
 /// --max-depth, --carve-outside-image, --distance-slack-px, --distance-reduction, --threads, with
-/// HullConfig's defaults (deprecated: --depth, --slack).
+/// HullConfig's defaults.
 void addHullOptions(ArgParser* parser);
 HullConfig hullConfigFromArgs(const ArgParser& parser);
 

@@ -8,7 +8,7 @@ namespace sift_hull {
 namespace cli {
 
 /// --silhouettes DIR, or --threshold / --dilate-px / --erode-px for the Middlebury recipe, with
-/// the defaults of SilhouetteConfig (deprecated: --dilate, --erode).
+/// the defaults of SilhouetteConfig.
 void addSilhouetteOptions(ArgParser* parser);
 SilhouetteConfig silhouetteConfigFromArgs(const ArgParser& parser);
 

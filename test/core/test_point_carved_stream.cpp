@@ -60,13 +60,19 @@ TEST_F(CupStream, PointsWaitForTheBoxThenCarveTheCavityAndNothingOfTheSolid) {
   const PointCarvedStream::Refinement refinement = stream.refine();
   EXPECT_FALSE(stream.refineDue()) << "nothing new since";
   EXPECT_GT(refinement.free_voxels, 0u);
-  EXPECT_EQ(refinement.newest_stamp_s, scene.views.size() - 1.0);
+  EXPECT_EQ(refinement.newest_stamp_ns, static_cast<int64_t>(scene.views.size()) - 1);
   const SolidSamples after = samples(stream.stream().hull());
   const SolidComparison was = compareWithSolid(before), is = compareWithSolid(after);
   ASSERT_GT(was.cavity_filled_m3, 0.5 * was.cavity_m3);
   // As freeVoxels with the same points (test_refine): most of the pocket goes.
   EXPECT_LT(is.cavity_filled_m3, 0.3 * was.cavity_filled_m3);
   EXPECT_LE(falseCarvedFraction(before, after), 0.005);
+  stream.reset();
+  EXPECT_FALSE(stream.stream().hasHull());
+  EXPECT_EQ(stream.storedPoints(), 0u);
+  EXPECT_EQ(stream.freeVoxelCount(), 0u);
+  for (size_t v = 0; v < scene.views.size(); ++v) addView(&stream, v);
+  EXPECT_FALSE(stream.refineDue()) << "the points were forgotten by the reset";
 }
 
 TEST_F(CupStream, ATreeThatStartsAnewIsCarvedAgain) {
@@ -105,9 +111,6 @@ TEST(PointCarvedStream, KeepsAtMostTheSetNumberOfPointsAndOnlyWellReprojectedOne
   EXPECT_EQ(stream.storedPoints(), 8u) << "the oldest pair goes";
   EXPECT_EQ(stream.addSurfacePoints(camera, camera, std::vector<SurfacePoint>(30), 3.0), 30u);
   EXPECT_EQ(stream.storedPoints(), 30u) << "the newest pair stays whole";
-  stream.reset();
-  EXPECT_EQ(stream.storedPoints(), 0u);
-  EXPECT_FALSE(stream.refineDue());
   config.max_surface_points = 0;
   EXPECT_THROW(PointCarvedStream(streamConfig(5), config), std::invalid_argument);
 }

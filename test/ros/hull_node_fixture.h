@@ -6,6 +6,7 @@
 #include <geometry_msgs/TransformStamped.h>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
+#include <rosgraph_msgs/Log.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/PointCloud2.h>
@@ -14,6 +15,7 @@
 
 #include <cmath>
 #include <functional>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -64,6 +66,7 @@ class HullNodeTest : public ::testing::Test {
     info_pub_ = nh_.advertise<sensor_msgs::CameraInfo>("camera_info", 20);
     octomap_sub_ = nh_.subscribe("octomap_binary", 20, &HullNodeTest::onOctomap, this);
     cloud_sub_ = nh_.subscribe("occupied_cells", 20, &HullNodeTest::onCloud, this);
+    rosout_sub_ = nh_.subscribe("/rosout", 100, &HullNodeTest::onLog, this);
     ASSERT_TRUE(waitFor([&] {
       return silhouette_pub_.getNumSubscribers() > 0 && info_pub_.getNumSubscribers() > 0;
     })) << "the hull node did not subscribe";
@@ -108,13 +111,32 @@ class HullNodeTest : public ::testing::Test {
     return waitFor([&] { return last_octomap_ && last_octomap_->header.stamp >= stamp; });
   }
 
+  /// Whether the node logs an error containing every one of `parts` within the deadline.
+  bool loggedError(const std::vector<std::string>& parts) {
+    return waitFor([&] {
+      std::lock_guard<std::mutex> lock(errors_mutex_);
+      for (const std::string& error : errors_) {
+        bool all = true;
+        for (const std::string& part : parts) all = all && error.find(part) != std::string::npos;
+        if (all) return true;
+      }
+      return false;
+    });
+  }
+
+  void onLog(const rosgraph_msgs::LogConstPtr& log) {
+    std::lock_guard<std::mutex> lock(errors_mutex_);
+    if (log->level == rosgraph_msgs::Log::ERROR) errors_.push_back(log->msg);
+  }
   void onOctomap(const sift_hull::OctomapConstPtr& message) { last_octomap_ = message; }
   void onCloud(const sensor_msgs::PointCloud2ConstPtr& message) { last_cloud_ = message; }
 
   ros::NodeHandle nh_;
   tf2_ros::StaticTransformBroadcaster tf_;
   ros::Publisher silhouette_pub_, info_pub_;
-  ros::Subscriber octomap_sub_, cloud_sub_;
+  ros::Subscriber octomap_sub_, cloud_sub_, rosout_sub_;
+  std::mutex errors_mutex_;
+  std::vector<std::string> errors_;  ///< the errors on /rosout since SetUp
   std::vector<RenderedView> views_;
   sift_hull::OctomapConstPtr last_octomap_;
   sensor_msgs::PointCloud2ConstPtr last_cloud_;

@@ -117,13 +117,21 @@ TEST(SettingsFiles, TheDerivedFilesAreCurrent) {
 }
 
 TEST(SettingsFiles, TheNodeReferenceHasATableForEachNode) {
-  const std::string doc = settings_files::withParameterTables(
-      "<!-- BEGIN GENERATED PARAMETERS hull_node -->\nSTALE TEXT\n"
-      "<!-- END GENERATED PARAMETERS hull_node -->\n");
+  std::string stale;
+  for (const char* node : {"hull_node", "matcher_node", "save_results"}) {
+    stale += "<!-- BEGIN GENERATED PARAMETERS " + std::string(node) + " -->\nSTALE TEXT\n" +
+             "<!-- END GENERATED PARAMETERS " + node + " -->\n";
+  }
+  const std::string doc = settings_files::withParameterTables(stale);
   EXPECT_EQ(doc.find("STALE TEXT"), std::string::npos);
   EXPECT_NE(doc.find("| `~max_depth` | integer | `8` | levels | [2, 10] |"), std::string::npos)
       << doc;
   EXPECT_NE(doc.find("| `~box` |"), std::string::npos);
+  EXPECT_NE(doc.find("| `~gsc_max_histogram_distance` |"), std::string::npos) << doc;
+  // A node's table missing from the reference is an error, not a silent pass.
+  EXPECT_THROW(settings_files::withParameterTables("<!-- BEGIN GENERATED PARAMETERS hull_node -->\n"
+                                                   "<!-- END GENERATED PARAMETERS hull_node -->\n"),
+               std::runtime_error);
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <deque>
 #include <mutex>
 #include <string>
@@ -49,9 +50,10 @@ class PointCarvedStream {
                           const cv::Mat& mask);
 
   /// One pair's points, world frame (their views are replaced by the pair's two cameras), stamped
-  /// `stamp_s`. Points over max_reprojection_px are left out; returns how many were kept.
+  /// `stamp_ns` (nanoseconds, any epoch). Points over max_reprojection_px are left out; returns
+  /// how many were kept.
   size_t addSurfacePoints(const PinholeCamera& left, const PinholeCamera& right,
-                          std::vector<SurfacePoint> points, double stamp_s);
+                          std::vector<SurfacePoint> points, int64_t stamp_ns);
 
   /// Whether refine() has work: a hull, and points that arrived since the last refine() or a tree
   /// that started anew while points are kept.
@@ -60,7 +62,7 @@ class PointCarvedStream {
   struct Refinement {
     size_t free_voxels = 0;       ///< the hull's free voxels afterwards
     size_t points_used = 0;       ///< kept points inside the hull
-    double newest_stamp_s = 0.0;  ///< of the newest pair kept
+    int64_t newest_stamp_ns = 0;  ///< of the newest pair kept
   };
   /// Carves the hull with the free voxels of every point kept that lies inside it. Requires
   /// stream().hasHull().
@@ -81,7 +83,7 @@ class PointCarvedStream {
   struct PairPoints {
     PinholeCamera left, right;
     std::vector<SurfacePoint> points;
-    double stamp_s = 0.0;
+    int64_t stamp_ns = 0;
   };
 
   const PointCarvingConfig config_;

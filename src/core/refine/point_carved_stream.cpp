@@ -32,7 +32,7 @@ HullStream::Outcome PointCarvedStream::add(const std::string& name, const Pinhol
 }
 
 size_t PointCarvedStream::addSurfacePoints(const PinholeCamera& left, const PinholeCamera& right,
-                                           std::vector<SurfacePoint> points, double stamp_s) {
+                                           std::vector<SurfacePoint> points, int64_t stamp_ns) {
   const double max_px = config_.surface_points.max_reprojection_px;
   points.erase(
       std::remove_if(points.begin(), points.end(),
@@ -42,7 +42,7 @@ size_t PointCarvedStream::addSurfacePoints(const PinholeCamera& left, const Pinh
   if (kept == 0) return 0;
   std::lock_guard<std::mutex> lock(points_mutex_);
   stored_points_ += kept;
-  pairs_.push_back({left, right, std::move(points), stamp_s});
+  pairs_.push_back({left, right, std::move(points), stamp_ns});
   while (stored_points_ > static_cast<size_t>(config_.max_surface_points) && pairs_.size() > 1) {
     stored_points_ -= pairs_.front().points.size();
     pairs_.pop_front();
@@ -74,7 +74,7 @@ PointCarvedStream::Refinement PointCarvedStream::refine() {
         point.views = {first, first + 1};
         points.push_back(std::move(point));
       }
-      refinement.newest_stamp_s = std::max(refinement.newest_stamp_s, pair.stamp_s);
+      refinement.newest_stamp_ns = std::max(refinement.newest_stamp_ns, pair.stamp_ns);
     }
   }
   stream_.carveFree(sift_hull::freeVoxels(stream_.hull(), cameras, points, config_.free_space));

@@ -162,6 +162,10 @@ Box3d boxFromCorners(const geometry_msgs::Point& min, const geometry_msgs::Point
 visualization_msgs::MarkerArray freeCellsMarkers(const octomap::OcTree& tree,
                                                  const std_msgs::Header& header);
 
+/// One DELETEALL marker stamped `header`: rviz removes every marker of the topic (the hull node
+/// after ~reset).
+visualization_msgs::MarkerArray deleteAllMarkers(const std_msgs::Header& header);
+
 /// The mesh as a TRIANGLE_LIST marker in the header's frame, metres.
 visualization_msgs::Marker meshMarker(const TriangleMesh& mesh, const std_msgs::Header& header);
 

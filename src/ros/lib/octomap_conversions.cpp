@@ -157,6 +157,15 @@ visualization_msgs::MarkerArray freeCellsMarkers(const octomap::OcTree& tree,
   return cellsMarkers(tree, header, false, "free_cells");
 }
 
+visualization_msgs::MarkerArray deleteAllMarkers(const std_msgs::Header& header) {
+  visualization_msgs::Marker delete_all;
+  delete_all.header = header;
+  delete_all.action = visualization_msgs::Marker::DELETEALL;
+  visualization_msgs::MarkerArray markers;
+  markers.markers.push_back(delete_all);
+  return markers;
+}
+
 Box3d boxFromCorners(const geometry_msgs::Point& min, const geometry_msgs::Point& max) {
   return {Eigen::Vector3d(min.x, min.y, min.z), Eigen::Vector3d(max.x, max.y, max.z)};
 }

@@ -53,7 +53,7 @@ void PoseWait::add(const sensor_msgs::ImageConstPtr& image,
     std::lock_guard<std::mutex> lock(infos_mutex_);
     infos_[image.get()] = info;
   }
-  filter_.add(image);  // may call onPose or onFailure at once: no lock held here
+  filter_.add(image);  // no lock held: the filter may drop an older image (onFailure) here
 }
 
 sensor_msgs::CameraInfoConstPtr PoseWait::takeInfo(const sensor_msgs::Image* image) {
@@ -70,7 +70,8 @@ void PoseWait::onPose(const sensor_msgs::ImageConstPtr& image) {
   const std::string& frame = image->header.frame_id;
   if (!info) return;
   if (!waits_.posed(frame, image->header.stamp.toSec())) {
-    dropped_view_(frame, "its pose came after ~pose_timeout_s");  // counted when it expired
+    // Counted when it expired.
+    dropped_view_(frame, "the pose of '" + frame + "' came after ~pose_timeout_s");
     return;
   }
   Eigen::Isometry3d T_W_C;

@@ -63,9 +63,7 @@ std::string pythonString(const std::string& text) {
   return quoted + "\"";
 }
 
-std::string pythonBound(double bound) {
-  return std::isfinite(bound) ? yamlNumber(bound) : "None";
-}
+std::string pythonBound(double bound) { return std::isfinite(bound) ? yamlNumber(bound) : "None"; }
 
 std::string cfgLine(const Row& row) {
   const char* type = "double_t";
@@ -104,11 +102,13 @@ std::string readFile(const std::string& path) {
 }  // namespace
 
 std::string parameterYaml(const std::string& node) {
-  std::string text = "# " + node + "'s private parameters, every one it reads, with their defaults.\n";
+  std::string text =
+      "# " + node + "'s private parameters, every one it reads, with their defaults.\n";
   text += "# " + std::string(kDerivedNote) + "\n";
   text += "# Reference: docs/NODES.md.\n";
   for (const Row& row : nodeRows(node)) {
-    text += row.info.name + ": " + yamlValue(row.value) + "  # " + settingDescription(row.info) + "\n";
+    text +=
+        row.info.name + ": " + yamlValue(row.value) + "  # " + settingDescription(row.info) + "\n";
   }
   return text;
 }
@@ -129,10 +129,10 @@ std::string matcherReconfigureCfg() {
 }
 
 std::string parameterTable(const std::string& node) {
-  std::string text =
-      "<!-- " + std::string(kDerivedNote) + " -->\n\n"
-      "| Name | Type | Default | Unit | Range | Run time | Description |\n"
-      "| --- | --- | --- | --- | --- | --- | --- |\n";
+  std::string text = "<!-- " + std::string(kDerivedNote) +
+                     " -->\n\n"
+                     "| Name | Type | Default | Unit | Range | Run time | Description |\n"
+                     "| --- | --- | --- | --- | --- | --- | --- |\n";
   for (const Row& row : nodeRows(node)) {
     text += "| `~" + row.info.name + "` | " + settingTypeName(row.info.type) + " | `" +
             markdownCell(settingText(row.value)) + "` | " + row.info.unit + " | " +
@@ -148,7 +148,8 @@ std::string withParameterTables(const std::string& document) {
     const std::string begin = "<!-- BEGIN GENERATED PARAMETERS " + node + " -->\n";
     const std::string end = "<!-- END GENERATED PARAMETERS " + node + " -->";
     const size_t from = text.find(begin);
-    if (from == std::string::npos) continue;
+    // Every node's table must be there: a deleted marker would leave a node without reference.
+    if (from == std::string::npos) throw std::runtime_error("no begin marker for " + node);
     const size_t to = text.find(end, from);
     if (to == std::string::npos) throw std::runtime_error("no end marker for " + node);
     text.replace(from + begin.size(), to - from - begin.size(), parameterTable(node));

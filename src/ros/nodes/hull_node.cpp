@@ -3,6 +3,7 @@
 #include <image_transport/camera_common.h>
 #include <tf2_eigen/tf2_eigen.h>
 
+#include <algorithm>
 #include <sstream>
 
 #include "lib/conversions.h"
@@ -28,15 +29,6 @@ std::string pointText(const geometry_msgs::Point& point) {
   return out.str();
 }
 
-visualization_msgs::MarkerArray deleteAllMarkers(const std_msgs::Header& header) {
-  visualization_msgs::Marker delete_all;
-  delete_all.header = header;
-  delete_all.action = visualization_msgs::Marker::DELETEALL;
-  visualization_msgs::MarkerArray markers;
-  markers.markers.push_back(delete_all);
-  return markers;
-}
-
 }  // namespace
 
 HullNode::HullNode(ros::NodeHandle nh, ros::NodeHandle private_nh)
@@ -54,10 +46,6 @@ HullNode::HullNode(ros::NodeHandle nh, ros::NodeHandle private_nh, HullNodeConfi
                "a silhouette pairs with the camera_info of an equal stamp once tf has its "
                "camera's pose in ~world_frame (a node making masks must copy its image's header: "
                "stamp and frame_id)"),
-      diagnostics_(nh_, private_nh_, "hull", config_.diagnostic_period,
-                   [this](diagnostic_updater::DiagnosticStatusWrapper& status) {
-                     reportDiagnostics(status);
-                   }),
       tf_listener_(tf_buffer_),
       pose_wait_(
           nh_, &tf_buffer_, config_.world_frame, static_cast<uint32_t>(config_.queue_size),
@@ -66,8 +54,12 @@ HullNode::HullNode(ros::NodeHandle nh, ros::NodeHandle private_nh, HullNodeConfi
                  const sensor_msgs::CameraInfoConstPtr& info,
                  const Eigen::Isometry3d& T_W_C) { onPosed(silhouette, info, T_W_C); },
           [this](const std::string&, const std::string& why) {
-            log_.error("hull: dropped a silhouette: ", why);
+            log_.error("hull: dropped a silhouette: ", why);  // each reason names the frame
           }),
+      diagnostics_(nh_, private_nh_, "hull", config_.diagnostic_period,
+                   [this](diagnostic_updater::DiagnosticStatusWrapper& status) {
+                     reportDiagnostics(status);
+                   }),
       sync_(config_.queue_size) {
   advertiseOutputs();
   refine_timer_ = nh_.createWallTimer(ros::WallDuration(config_.refine_period_s),
@@ -77,7 +69,6 @@ HullNode::HullNode(ros::NodeHandle nh, ros::NodeHandle private_nh, HullNodeConfi
 }
 
 // --- Input -------------------------------------------------------------------------------------
-
 void HullNode::subscribe() {
   silhouette_sub_.registerCallback(&HullNode::onArrival, this);
   info_sub_.registerCallback(&HullNode::onInfoArrival, this);
@@ -155,11 +146,11 @@ void HullNode::onSurfacePoints(const sift_hull::SurfacePointsConstPtr& message) 
     log_.error("hull: surface points ignored: ", why_not);
     return;
   }
-  hull_.addSurfacePoints(left, right, std::move(points), message->header.stamp.toSec());
+  hull_.addSurfacePoints(left, right, std::move(points),
+                         static_cast<int64_t>(message->header.stamp.toNSec()));
 }
 
 // --- Work --------------------------------------------------------------------------------------
-
 void HullNode::integrate(View& view) {
   std::lock_guard<std::mutex> lock(hull_mutex_);
   if (view.generation != generation_) return;  // queued before a ~reset
@@ -216,14 +207,15 @@ void HullNode::refineIfDue() {
   try {
     const PointCarvedStream::Refinement refinement = hull_.refine();
     free_voxels_ = refinement.free_voxels;
-    publish(std::max(ros::Time(refinement.newest_stamp_s), header_.stamp));
+    ros::Time newest;
+    newest.fromNSec(static_cast<uint64_t>(refinement.newest_stamp_ns));
+    publish(std::max(newest, header_.stamp));
   } catch (const std::exception& e) {
     log_.error("hull: cannot carve with the surface points: ", e.what());
   }
 }
 
 // --- Output ------------------------------------------------------------------------------------
-
 template <typename Message>
 void HullNode::addOutput(const std::string& topic, bool lazy, std::function<Message()> hull,
                          std::function<Message()> empty) {
@@ -250,7 +242,9 @@ void HullNode::advertiseOutputs() {
   using ros_conversions::octomapMessage;
   using Cloud = sensor_msgs::PointCloud2;
   using Markers = visualization_msgs::MarkerArray;
-  outputs_.reserve(7);  // no reallocation while a subscriber's callback reads an entry
+  // No reallocation while a subscriber's connect callback reads an entry (nodelets spin while
+  // this runs); such a callback sends nothing anyway until a hull is published.
+  outputs_.reserve(7);
   const auto emptyTree = [this] { return octomap::OcTree(empty_resolution_m_); };
   const auto centres = [this] {
     return cleared_boxes_.empty() ? ros_conversions::pointCloudMessage(
@@ -263,7 +257,7 @@ void HullNode::advertiseOutputs() {
   addOutput<sift_hull::Octomap>(
       "octomap_binary", false,
       [this] {  // the compact map needs no OctoMap nodes, unless boxes were cleared
-        return cleared_boxes_.empty() ? octomapMessage(publishedCompact(false), header_)
+        return cleared_boxes_.empty() ? octomapMessage(publishedCompact(centres_wanted_), header_)
                                       : octomapMessage(publishedTree(), header_);
       },
       [this, emptyTree] { return octomapMessage(emptyTree(), header_); });
@@ -271,31 +265,41 @@ void HullNode::advertiseOutputs() {
       "octomap_full", true, [this] { return octomapFullMessage(publishedTree(), header_); },
       [this, emptyTree] { return octomapFullMessage(emptyTree(), header_); });
   addOutput<Cloud>("occupied_cells", true, centres, noCentres);
+  outputs_.back().centres = true;
   addOutput<Cloud>("octomap_point_cloud_centers", true, centres, noCentres);
+  outputs_.back().centres = true;
   addOutput<Markers>(
       "occupied_cells_vis_array", true,
       [this] { return ros_conversions::occupiedCellsMarkers(publishedTree(), header_); },
-      [this] { return deleteAllMarkers(header_); });
+      [this] { return ros_conversions::deleteAllMarkers(header_); });
   addOutput<Markers>(
       "free_cells_vis_array", true,
       [this] { return ros_conversions::freeCellsMarkers(publishedTree(), header_); },
-      [this] { return deleteAllMarkers(header_); });
+      [this] { return ros_conversions::deleteAllMarkers(header_); });
   addOutput<visualization_msgs::Marker>(
       "mesh", true, [this] { return ros_conversions::meshMarker(publishedMesh(), header_); },
-      [this] { return deleteAllMarkers(header_).markers.front(); });
+      [this] { return ros_conversions::deleteAllMarkers(header_).markers.front(); });
+  outputs_.back().map = false;
 }
 
-void HullNode::publish(const ros::Time& stamp, bool all) {
+void HullNode::publish(const ros::Time& stamp, bool hull_changed, bool all) {
   header_.stamp = stamp;
   header_.frame_id = config_.world_frame;
   last_publish_wall_ = ros::WallTime::now();
   unpublished_stamp_ = ros::Time();
-  tree_.reset();
-  compact_.reset();
-  mesh_.reset();
+  if (hull_changed) {
+    tree_.reset();
+    compact_.reset();
+    mesh_.reset();
+  }
   published_ = hull_.stream().hasHull();
+  const auto sent = [all](const Output& output) {
+    return all || !output.lazy || output.pub.getNumSubscribers() > 0;
+  };
+  centres_wanted_ = std::any_of(outputs_.begin(), outputs_.end(),
+                                [&](const Output& o) { return o.centres && sent(o); });
   for (const Output& output : outputs_) {
-    if (all || !output.lazy || output.pub.getNumSubscribers() > 0) output.send();
+    if (sent(output) && (hull_changed || output.map)) output.send();
   }
 }
 
@@ -342,7 +346,6 @@ const TriangleMesh& HullNode::publishedMesh() {
 }
 
 // --- Services and diagnostics ------------------------------------------------------------------
-
 void HullNode::advertiseServices() {
   reset_srv_ = private_nh_.advertiseService("reset", &HullNode::reset, this);
   save_srv_ = private_nh_.advertiseService("save", &HullNode::save, this);
@@ -365,7 +368,7 @@ bool HullNode::reset(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
   free_voxels_ = 0;
   refused_views_ = 0;
   cleared_boxes_.clear();
-  publish(ros::Time::now(), true);  // the empty map and no markers, on every output
+  publish(ros::Time::now(), true, true);  // the empty map and no markers, on every output
   ROS_INFO("hull: reset (%zu view(s) waiting to be carved discarded)", discarded);
   return true;
 }
@@ -419,7 +422,8 @@ bool HullNode::clearBbx(sift_hull::BoundingBoxQuery::Request& request,
     ROS_INFO("hull: ~clear_bbx: no map yet; the box will be cleared in the first one");
     return true;
   }
-  publish(ros::Time::now());  // the tree built anew with every cleared box
+  if (tree_) clearBox(box, tree_.get());  // else built with every cleared box when needed
+  publish(ros::Time::now(), false);       // the maps again; the mesh is unchanged
   ROS_INFO("hull: ~clear_bbx: cleared %s to %s", pointText(request.min).c_str(),
            pointText(request.max).c_str());
   return true;

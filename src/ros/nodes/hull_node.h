@@ -68,6 +68,8 @@ class HullNode {
   struct Output {
     ros::Publisher pub;
     bool lazy = true;
+    bool map = true;       ///< republished after ~clear_bbx (the mesh is not: boxes do not cut it)
+    bool centres = false;  ///< the occupied centres (the compact map is made with them then)
     std::function<void()> send;
   };
 
@@ -95,8 +97,9 @@ class HullNode {
   void addOutput(const std::string& topic, bool lazy, std::function<Message()> hull,
                  std::function<Message()> empty);
   void advertiseOutputs();
-  /// Every output, stamped `stamp` (all: the lazy ones too, subscribed or not).
-  void publish(const ros::Time& stamp, bool all = false);
+  /// The outputs, stamped `stamp`: the maps, and the rest when the hull changed (its cached tree,
+  /// compact map and mesh made anew); the lazy ones only while subscribed, unless `all`.
+  void publish(const ros::Time& stamp, bool hull_changed = true, bool all = false);
   /// publish(unpublished_stamp_) when views were carved since the last publication.
   void publishPending();
   void sendToNewSubscriber(size_t output);
@@ -140,11 +143,11 @@ class HullNode {
   std::atomic<size_t> redundant_views_{0}, refused_views_{0}, free_voxels_{0};
   WorkQueue<View> work_;
   PairingWatch pairing_;  ///< silhouettes and camera_infos that arrive but do not pair
-  NodeDiagnostics diagnostics_;
   ros::WallTimer refine_timer_;
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
   PoseWait pose_wait_;
+  NodeDiagnostics diagnostics_;  ///< after what it reports on (the pose wait's count)
   // Subscribed last, once every callback is in place.
   message_filters::Subscriber<sensor_msgs::Image> silhouette_sub_;
   message_filters::Subscriber<sensor_msgs::CameraInfo> info_sub_;

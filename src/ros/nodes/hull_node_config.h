@@ -14,15 +14,17 @@ namespace sift_hull {
 /// Node settings besides the hull's own (HullStreamConfig).
 struct HullNodeConfig {
   std::string world_frame = "world";
-  /// Silhouettes waiting for their camera_info or their pose; when more wait, the oldest is
-  /// dropped with an error (a pose that never arrives). Also the views waiting to be carved:
-  /// when more come, the oldest is dropped and counted in /diagnostics.
+  /// Silhouettes waiting for their camera_info (when more wait, the oldest is dropped, and
+  /// /diagnostics warns of inputs that do not pair), paired ones waiting for their pose (the oldest
+  /// dropped with an error, counted as without pose), and views waiting to be carved (the oldest
+  /// dropped and counted in /diagnostics).
   int queue_size = 10;
-  /// A silhouette whose pose is not in tf this long after it arrived is reported and, should the
-  /// pose come later still, not carved. <= 0: wait as long as the queue allows.
+  /// A silhouette whose pose is not in tf this long after it paired with its camera_info is
+  /// reported and, should the pose come later still, not carved. <= 0: wait as long as the queue
+  /// allows.
   double pose_timeout_s = 5.0;
   /// Subscribe `image` (8-bit colour or mono) instead of `silhouette`, and extract each
-  /// silhouette by `recipe` (the Middlebury threshold, dilation and erosion).
+  /// silhouette by `recipe` (SilhouetteConfig: its method, threshold, dilation and erosion).
   bool from_image = false;
   /// The silhouettes are of rectified images (image_proc's image_rect, whose camera_info is the
   /// raw image's): cameras from P and R, whatever D says. False: raw, K and D, unless D is zero

@@ -18,7 +18,8 @@ const SettingTable<HullNodeConfig>& settingsOf<HullNodeConfig>() {
           "carved; one more drops the oldest")
         .atLeast(1);
     t.add("pose_timeout_s", &HullNodeConfig::pose_timeout_s, "s",
-          "a silhouette whose pose is not in tf by then is dropped; <= 0: no limit");
+          "a silhouette paired with its camera_info whose pose is not in tf by then is dropped; "
+          "<= 0: no limit");
     t.add("from_image", &HullNodeConfig::from_image, "",
           "subscribe `image` and take each silhouette by the recipe (silhouette_method)");
     t.add("rectified", &HullNodeConfig::rectified, "",
