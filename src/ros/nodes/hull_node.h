@@ -130,6 +130,7 @@ class HullNode {
   std::unique_ptr<octomap::OcTree> tree_;    ///< publishedTree()
   std::unique_ptr<CompactOctomap> compact_;  ///< publishedCompact()
   bool compact_centres_ = false;             ///< compact_ has the centres
+  bool centres_wanted_ = false;              ///< a subscriber of this publication wants them
   std::unique_ptr<TriangleMesh> mesh_;       ///< publishedMesh()
   double empty_resolution_m_ = 0.1;          ///< of the empty map published after ~reset
   std_msgs::Header header_;                  ///< of the last publication
