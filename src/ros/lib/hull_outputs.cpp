@@ -78,7 +78,7 @@ void HullOutputs::advertise() {
   for (Output& output : outputs_) output.pub = output.advertise();
 }
 
-void HullOutputs::publish(const ros::Time& stamp, bool all) {
+void HullOutputs::publish(ros::Time stamp, bool all) {
   header_.stamp = stamp;
   tree_.reset();
   compact_.reset();

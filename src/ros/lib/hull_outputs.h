@@ -41,7 +41,7 @@ class HullOutputs {
   /// Every output (the lazy ones only while subscribed, unless `all`) stamped `stamp`, from the
   /// hull as it is (the empty map when it has none), the cached tree, compact map and mesh made
   /// anew, and the snapshot. Throws what the conversions throw (a hull beyond OctoMap's keys).
-  void publish(const ros::Time& stamp, bool all = false);
+  void publish(ros::Time stamp, bool all = false);
   /// Keeps the full map (octomap_full) in every snapshot from the next publication on.
   void keepFullMap() { keep_full_ = true; }
   bool keepsFullMap() const { return keep_full_; }

@@ -302,7 +302,7 @@ void HullNode::publishPending() {
   if (!unpublished_stamp_.isZero()) publish(unpublished_stamp_);
 }
 
-void HullNode::publish(const ros::Time& stamp, bool all) {
+void HullNode::publish(ros::Time stamp, bool all) {
   last_publish_wall_ = ros::WallTime::now();
   unpublished_stamp_ = ros::Time();
   try {

@@ -115,7 +115,7 @@ class HullNode {
   /// outputs_.publish(unpublished_stamp_) when views were carved since the last publication.
   void publishPending();
   /// outputs_.publish, its failure logged.
-  void publish(const ros::Time& stamp, bool all = false);
+  void publish(ros::Time stamp, bool all = false);  // by value: callers pass members it resets
   // Services and diagnostics.
   void advertiseServices();
   bool reset(std_srvs::Empty::Request& request, std_srvs::Empty::Response& response);
