@@ -83,21 +83,9 @@ void HullNode::subscribe() {
   info_sub_.registerCallback(&HullNode::onInfoArrival, this);
   sync_.connectInput(silhouette_sub_, info_sub_);
   sync_.registerCallback(&HullNode::onPair, this);
-  points_filter_ = std::make_unique<tf2_ros::MessageFilter<sift_hull::SurfacePoints>>(
-      points_sub_, tf_buffer_, config_.world_frame, static_cast<uint32_t>(config_.queue_size),
-      nh_);
-  points_filter_->setTolerance(ros::Duration(0.0));
-  points_filter_->registerCallback(&HullNode::onSurfacePoints, this);
-  points_filter_->registerFailureCallback(
-      [this](const sift_hull::SurfacePointsConstPtr& message,
-             tf2_ros::filter_failure_reasons::FilterFailureReason) {
-        ++counts_.pairs_no_pose;
-        problem("hull: surface points ignored: ", "no pose of '" + message->header.frame_id +
-                                                      "' in '" + config_.world_frame +
-                                                      "' at their stamp");
-      });
-  points_sub_.registerCallback(boost::function<void(const sift_hull::SurfacePointsConstPtr&)>(
-      [this](const sift_hull::SurfacePointsConstPtr&) { ++counts_.pairs; }));
+  // Surface points are looked up in tf as they come (a matcher publishes them after it has
+  // looked up the same poses): one without a pose is counted at once, not kept waiting.
+  points_sub_.registerCallback(&HullNode::onSurfacePoints, this);
   points_sub_.subscribe(nh_, "surface_points", static_cast<uint32_t>(config_.queue_size));
   // camera_info beside the image, wherever remapping put it (image_transport's convention);
   // the image through the transport ~image_transport names (raw, compressed, ...).
@@ -132,8 +120,9 @@ void HullNode::onPosed(const sensor_msgs::ImageConstPtr& silhouette,
 }
 
 void HullNode::onSurfacePoints(const sift_hull::SurfacePointsConstPtr& message) {
+  ++counts_.pairs;
   PosedPoints posed{message, Eigen::Isometry3d::Identity()};
-  try {  // the filter has seen it in tf: no wait
+  try {
     posed.T_W_F = tf2::transformToEigen(tf_buffer_.lookupTransform(
         config_.world_frame, message->header.frame_id, message->header.stamp));
   } catch (const tf2::TransformException& e) {

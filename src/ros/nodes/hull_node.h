@@ -161,7 +161,6 @@ class HullNode {
   message_filters::Subscriber<sensor_msgs::CameraInfo> info_sub_;
   Sync sync_;
   message_filters::Subscriber<sift_hull::SurfacePoints> points_sub_;
-  std::unique_ptr<tf2_ros::MessageFilter<sift_hull::SurfacePoints>> points_filter_;
   ros::ServiceServer reset_srv_, save_srv_, binary_srv_, full_srv_, clear_bbx_srv_;
 };
 
