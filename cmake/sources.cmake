@@ -58,6 +58,7 @@ set(SIFT_HULL_CORE_SOURCES
 set(SIFT_HULL_IO_SOURCES
   src/core/io/calibration.cpp
   src/core/io/colmap.cpp
+  src/core/io/colmap_text.cpp
   src/core/io/colmap_writer.cpp
   src/core/io/ground_truth_files.cpp
   src/core/io/images.cpp
