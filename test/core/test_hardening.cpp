@@ -278,6 +278,17 @@ TEST_F(HostileCommandLine, HugeCoordinatesEndInAClearError) {
   EXPECT_EQ(hull("--box 0,0,0,1e-300,1e-300,1e-300", &err), 1);
 }
 
+TEST_F(HostileCommandLine, AFarTranslationIsBlamedOnItsOwnView) {
+  // Before, the box LP, framed by the far camera, said that the point where the optical axes meet
+  // is behind five other views.
+  std::string err;
+  EXPECT_EQ(hull("", &err, parWithCameraAt(1e30, true)), 1);
+  EXPECT_TRUE(contains(err, "view 'view_0001.png': its camera lies 1e+30 from the cameras' median "
+                            "centre, more than 1e+06 times their median distance from it ("))
+      << err;
+  EXPECT_TRUE(contains(err, "): check its translation")) << err;
+}
+
 TEST_F(HostileCommandLine, OutOfRangeSettingsAreUsageErrors) {
   std::string err, out;
   EXPECT_EQ(hull("--max-depth 12", &err), 2);
