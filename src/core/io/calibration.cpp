@@ -89,7 +89,11 @@ template <typename MakeCamera>
 CalibratedView makeView(const std::string& name, const Line& line, const std::string& path,
                         MakeCamera make_camera) {
   try {
-    return CalibratedView{name, make_camera(), location(path, line.number), {}};
+    CalibratedView view;
+    view.name = name;
+    view.camera = make_camera();
+    view.source = location(path, line.number);
+    return view;
   } catch (const std::invalid_argument& e) {
     throw ParseError(path, line.number, e.what());
   }

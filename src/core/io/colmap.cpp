@@ -12,7 +12,7 @@
 #include <set>
 #include <sstream>
 
-#include "io/colmap_internal.h"
+#include "colmap_internal.h"
 #include "sift_hull/limits.h"
 
 namespace sift_hull {

@@ -8,7 +8,7 @@
 #include <cstdlib>
 #include <fstream>
 
-#include "io/colmap_internal.h"
+#include "colmap_internal.h"
 #include "sift_hull/limits.h"
 
 namespace sift_hull {
