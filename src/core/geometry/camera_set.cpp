@@ -101,7 +101,7 @@ void requireNoStrayCamera(const std::vector<PinholeCamera>& cameras,
   }
   std::vector<double> distances;
   for (const PinholeCamera& camera : cameras) {
-    distances.push_back((camera.centre() - centre).norm());
+    distances.push_back((camera.centre() - centre).stableNorm());  // no overflow near 1e308
   }
   const double typical = median(distances);
   if (!(typical > 0.0) || !std::isfinite(typical)) return;
