@@ -88,9 +88,10 @@ void calibrate(const ArgParser& parser, const std::string& left, const std::stri
   const std::string left_name = parser.has("left-view") ? parser.get("left-view") : baseName(left);
   const std::string right_name =
       parser.has("right-view") ? parser.get("right-view") : baseName(right);
-  input->cameras =
-      std::make_pair(checkedCamera(views, left_name, calib, input->left_image, left),
-                     checkedCamera(views, right_name, calib, input->right_image, right));
+  // Left first: the order of a call's arguments is unspecified.
+  const PinholeCamera left_camera = checkedCamera(views, left_name, calib, input->left_image, left);
+  input->cameras = std::make_pair(
+      left_camera, checkedCamera(views, right_name, calib, input->right_image, right));
 }
 
 /// Refuses a --gt-scene that is not the scene of the pair: each image must have the scene's size

@@ -238,17 +238,19 @@ void expectSameViews(const std::vector<CalibratedView>& a, const std::vector<Cal
 }
 
 TEST_F(CalibrationFormats, ThreeRowAndCommaProjectionsEqualTheOneLineForm) {
-  const auto one_line = readProjectionList(write("one.txt", std::string(kOneLine) + kOneLine));
+  // Two views, a.png and b.png, of the same camera: each image is listed once.
+  const auto one_line = readProjectionList(
+      write("one.txt", std::string(kOneLine) + "b" + std::string(kOneLine).substr(1)));
   ASSERT_EQ(one_line.size(), 2u);
   EXPECT_EQ(one_line[0].camera_model, "projection");
   expectSameViews(one_line, readProjectionList(
                                 write("rows.txt",
                                       "# name on its own line\na.png\n500 0 320 10\n0 500 240 20\n"
-                                      "0 0 1 2\n\na.png 500 0 320 10\n0 500 240 20\n0 0 1 2\n")));
+                                      "0 0 1 2\n\nb.png 500 0 320 10\n0 500 240 20\n0 0 1 2\n")));
   expectSameViews(one_line,
                   readCalibration(write("commas.txt",
                                         "a.png, 500, 0, 320, 10, 0, 500, 240, 20, 0, 0, 1, 2\n"
-                                        "a.png\n500,0,320,10,0,500,240,20,0,0,1,2\n")));
+                                        "b.png\n500,0,320,10,0,500,240,20,0,0,1,2\n")));
   const auto unnamed =
       readProjectionList(write("unnamed.txt", "500 0 320 10\n0 500 240 20\n0 0 1 2\n"));
   ASSERT_EQ(unnamed.size(), 1u);
