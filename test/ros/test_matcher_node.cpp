@@ -3,6 +3,7 @@
 // good pairs still count. Every wait has a deadline.
 
 #include <dynamic_reconfigure/Reconfigure.h>
+#include <dynamic_reconfigure/client.h>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <sensor_msgs/CompressedImage.h>
@@ -12,6 +13,7 @@
 #include <tf2_ros/static_transform_broadcaster.h>
 
 #include <functional>
+#include <limits>
 #include <mutex>
 #include <opencv2/imgcodecs.hpp>
 #include <set>
@@ -21,6 +23,7 @@
 #include "lib/conversions.h"
 #include "ros_wait.h"
 #include "sift_hull/Correspondences.h"
+#include "sift_hull/MatcherConfig.h"
 #include "sift_hull/eval/match_evaluation.h"
 #include "sift_hull/features/labelled_matches.h"
 #include "sift_hull/synthetic/scene.h"
@@ -186,6 +189,42 @@ TEST_F(MatcherNodeTest, ThresholdsChangeAtRunTime) {
   ASSERT_TRUE(answeredAtLeast(stamp));
   EXPECT_LT(keptByGsc(), 3u);  // histograms equal to the last bin: hardly any
   EXPECT_NE(last_->filter_settings.find("\"gsc_max_histogram_distance\":0.0"), std::string::npos)
+      << last_->filter_settings;
+}
+
+/// `name`'s value in a published reconfigure config (NaN when absent).
+double publishedValue(const dynamic_reconfigure::Config& config, const std::string& name) {
+  for (const auto& p : config.doubles) {
+    if (p.name == name) return p.value;
+  }
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
+TEST_F(MatcherNodeTest, ARefusedValueLeavesTheServerOnTheLastAcceptedOne) {
+  std::vector<dynamic_reconfigure::Config> published;  // ~parameter_updates, latched
+  ros::Subscriber updates = nh_.subscribe<dynamic_reconfigure::Config>(
+      "/matcher/parameter_updates", 5,
+      [&](const dynamic_reconfigure::ConfigConstPtr& m) { published.push_back(*m); });
+  ASSERT_TRUE(waitFor([&] { return !published.empty(); })) << "no ~parameter_updates";
+  sift_hull::MatcherConfig config = sift_hull::MatcherConfig::__getDefault__();
+  ASSERT_TRUE(config.__fromMessage__(published.back()));
+  dynamic_reconfigure::Client<sift_hull::MatcherConfig> client("/matcher");
+  config.max_descriptor_distance = 400.0;
+  ASSERT_TRUE(client.setConfiguration(config));
+  ASSERT_TRUE(waitFor([&] {
+    return !published.empty() &&
+           publishedValue(published.back(), "max_descriptor_distance") == 400.0;
+  }));
+  const size_t accepted = published.size();
+  config.max_descriptor_distance = std::numeric_limits<double>::quiet_NaN();
+  ASSERT_TRUE(client.setConfiguration(config));  // answered with the config in force
+  EXPECT_EQ(config.max_descriptor_distance, 400.0);
+  ASSERT_TRUE(waitFor([&] { return published.size() > accepted; })) << "no update for the refusal";
+  EXPECT_EQ(publishedValue(published.back(), "max_descriptor_distance"), 400.0);
+  const ros::Time stamp = publishPair(left_.image, right_.image);
+  ASSERT_TRUE(answeredAtLeast(stamp)) << "no correspondences after the refused value";
+  EXPECT_GE(last_->matches.size(), 20u);
+  EXPECT_NE(last_->filter_settings.find("\"max_descriptor_distance\":400.0"), std::string::npos)
       << last_->filter_settings;
 }
 
