@@ -323,18 +323,20 @@ class CalibratedMatcherTest : public MatcherNodeTest {
     }));
   }
 
-  ros::Time publishCalibratedPair() {
+  /// The pair with its camera_infos, the right camera's stamped `right_delay` after the left's.
+  ros::Time publishCalibratedPair(const ros::Duration& right_delay = ros::Duration(0)) {
     const ros::Time stamp = ros::Time::now();
     std_msgs::Header header;
     header.stamp = stamp;
     header.frame_id = "left";
     left_info_pub_.publish(
         ros_conversions::cameraInfoMessage(left_.view.camera, left_.image.size(), header));
+    header.stamp = stamp + right_delay;
     header.frame_id = "right";
     right_info_pub_.publish(
         ros_conversions::cameraInfoMessage(right_.view.camera, right_.image.size(), header));
     left_pub_.publish(bgrImage(left_.image, stamp, "left"));
-    right_pub_.publish(bgrImage(right_.image, stamp, "right"));
+    right_pub_.publish(bgrImage(right_.image, header.stamp, "right"));
     return stamp;
   }
 
@@ -381,6 +383,24 @@ TEST_F(CalibratedMatcherTest, FiltersByEpipolarLinesAndTriangulatesOntoTheScene)
   size_t small_error = 0;
   for (const SurfacePoint& p : surface_points) small_error += p.reprojection_px < 1.0 ? 1 : 0;
   EXPECT_GE(small_error, 0.9 * surface_points.size());
+}
+
+/// ~approximate_sync with ~calibrated: the images and camera_infos pair by the nearest stamps.
+class CalibratedApproximateMatcherTest : public CalibratedMatcherTest {};
+
+TEST_F(CalibratedApproximateMatcherTest, PairsAStereoPairWhoseStampsDiffer) {
+  // Each set is paired once a later one shows that no nearer stamps will come.
+  std::set<ros::Time> sent;
+  ASSERT_TRUE(waitFor([&] {
+    if (last_) return true;
+    sent.insert(publishCalibratedPair(ros::Duration(0.004)));
+    ros::WallDuration(0.2).sleep();
+    return false;
+  })) << "no correspondences for stereo pairs 4 ms apart";
+  EXPECT_EQ(sent.count(last_->header.stamp), 1u);
+  EXPECT_EQ(last_->right_header.stamp, last_->header.stamp + ros::Duration(0.004));
+  ASSERT_EQ(last_->filters, (std::vector<std::string>{"epipolar", "gsc"}));
+  EXPECT_GE(last_->matches.size(), 50u);
 }
 
 /// image_pipeline's lazy subscription: the images are subscribed only while someone listens to
