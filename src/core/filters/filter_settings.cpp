@@ -162,8 +162,10 @@ const SettingTable<VoteRansacConfig>& settingsOf<VoteRansacConfig>() {
     SettingTable<VoteRansacConfig> t;
     t.add("max_angle_deg", &VoteRansacConfig::max_angle_deg, "deg",
           "vote_ransac (best): half width of the rotation vote's window, which chooses where "
-          "samples are drawn")
-        .above(0.0, 180.0)
+          "samples are drawn; at most 60: a further motion is looked for only where the window "
+          "holds twice the share of evenly spread rotations, which a wider one cannot once half "
+          "the matches left are mismatches")
+        .above(0.0, 60.0)
         .tunedAtRunTime();
     t.add("max_scale_ratio", &VoteRansacConfig::max_scale_ratio, "",
           "vote_ransac (best): half width of the scale vote's window, as a factor")
