@@ -30,18 +30,18 @@ struct Sweep {
 
 const std::vector<Sweep>& sweeps() {
   static const std::vector<Sweep> all = {
-      {"epipolar_max_distance_px", {"epipolar"}, {0.1, 0.5, 2, 10, 50, 200, 1000}},
+      {"epipolar_max_distance_px", {"epipolar"}, {0.1, 0.5, 2, 10, 50, 100}},
       {"gsc_max_histogram_distance", {"gsc"}, {0.1, 0.2, 0.5, 1, 1.5}},
-      {"ransac_max_epipolar_px", {"ransac"}, {0.1, 0.5, 1, 5, 20, 100, 1000}},
+      {"ransac_max_epipolar_px", {"ransac"}, {0.1, 0.5, 1, 5, 20, 100}},
       {"magsac_max_epipolar_px",
        {"magsac", "guided", "vote_ransac"},
-       {0.1, 0.5, 1, 5, 20, 42, 100, 1000}},
-      {"gms_threshold_factor", {"gms"}, {0.1, 1, 3, 6, 12, 20}},
-      {"lsc_max_relative_error", {"lsc", "guided"}, {0, 0.1, 0.35, 0.7, 1, 1.5, 2}},
-      {"lsc_min_support", {"lsc", "guided"}, {0, 0.1, 0.25, 0.5, 0.75, 0.9, 1}},
-      {"local_gsc_max_histogram_distance", {"local_gsc"}, {0.1, 0.2, 0.35, 0.7, 1, 1.5}},
-      {"guided_max_transfer_px", {"guided", "vote_ransac"}, {0.1, 0.5, 3, 10, 30, 100, 1000}},
-      {"guided_min_support", {"guided"}, {0, 0.1, 0.25, 0.5, 0.75, 1}},
+       {0.1, 0.5, 1, 5, 20, 42, 100}},
+      {"gms_threshold_factor", {"gms"}, {0.1, 1, 3, 6, 12}},
+      {"lsc_max_relative_error", {"lsc", "guided"}, {0.2, 0.35, 0.7, 1, 1.5, 2}},
+      {"lsc_min_support", {"lsc", "guided"}, {0, 0.1, 0.2, 0.25, 0.3}},
+      {"local_gsc_max_histogram_distance", {"local_gsc"}, {0.2, 0.35, 0.7, 1, 1.5}},
+      {"guided_max_transfer_px", {"guided", "vote_ransac"}, {0.1, 0.5, 3, 10, 30, 100}},
+      {"guided_min_support", {"guided"}, {0, 0.1, 0.2, 0.25, 0.3}},
       {"vote_ransac_max_angle_deg", {"vote_ransac"}, {0.5, 5, 15, 30, 45, 60}},
       {"vote_ransac_max_scale_ratio", {"vote_ransac"}, {1.01, 1.1, 1.5, 2, 4, 16, 1000}},
   };
