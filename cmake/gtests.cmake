@@ -22,6 +22,7 @@ set(SIFT_HULL_CORE_GTESTS
   test_local_filters eval
   test_two_view_models eval
   test_vote_ransac eval
+  test_filter_ranges eval
   test_densest_window core
   test_evaluation eval
   test_evaluation_commands eval

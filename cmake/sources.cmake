@@ -58,6 +58,7 @@ set(SIFT_HULL_CORE_SOURCES
 set(SIFT_HULL_IO_SOURCES
   src/core/io/calibration.cpp
   src/core/io/colmap.cpp
+  src/core/io/colmap_text.cpp
   src/core/io/colmap_writer.cpp
   src/core/io/ground_truth_files.cpp
   src/core/io/images.cpp
@@ -75,6 +76,7 @@ set(SIFT_HULL_PIPELINE_SOURCES
 set(SIFT_HULL_EVAL_SOURCES
   src/core/synthetic/mask_render.cpp
   src/core/synthetic/scene.cpp
+  src/core/synthetic/scene_match.cpp
   src/core/synthetic/shape.cpp
   src/core/synthetic/synthetic_matches.cpp
   src/core/synthetic/texture.cpp

@@ -53,6 +53,22 @@ void addPairOptions(ArgParser* parser) {
   parser->addOption("gt-scene", "DIR", "ground truth: a scene directory (sift_hull scene)");
 }
 
+/// The camera of the view named `name` in `calib`, checked against its image: the size the
+/// calibration gives (COLMAP's WIDTH x HEIGHT) and a lens distortion that does not fold over
+/// within it, as the hull checks its views.
+PinholeCamera checkedCamera(const std::vector<CalibratedView>& views, const std::string& name,
+                            const std::string& calib, const cv::Mat& image,
+                            const std::string& image_path) {
+  const CalibratedView& view = views[viewIndex(views, name, calib)];
+  checkImageSize(view, image.size(), image_path);
+  try {
+    requireUnfoldedDistortion(name, view.camera, image.cols, image.rows);
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(calib + ": " + e.what());
+  }
+  return view.camera;
+}
+
 /// Calibrates the pair from --rectified, --calib or the scene's cameras, when any is given.
 void calibrate(const ArgParser& parser, const std::string& left, const std::string& right,
                PairInput* input) {
@@ -72,12 +88,42 @@ void calibrate(const ArgParser& parser, const std::string& left, const std::stri
   const std::string left_name = parser.has("left-view") ? parser.get("left-view") : baseName(left);
   const std::string right_name =
       parser.has("right-view") ? parser.get("right-view") : baseName(right);
-  input->cameras = std::make_pair(views[viewIndex(views, left_name, calib)].camera,
-                                  views[viewIndex(views, right_name, calib)].camera);
+  // Left first: the order of a call's arguments is unspecified.
+  const PinholeCamera left_camera = checkedCamera(views, left_name, calib, input->left_image, left);
+  input->cameras = std::make_pair(
+      left_camera, checkedCamera(views, right_name, calib, input->right_image, right));
+}
+
+/// Refuses a --gt-scene that is not the scene of the pair: each image must have the scene's size
+/// and, with --calib, the calibration's cameras must be the scene's (requireViewsOfScene).
+void checkSceneOfPair(const ArgParser& parser, const SceneData& scene,
+                      const std::vector<std::string>& paths, const std::vector<cv::Mat>& images) {
+  const std::string directory = parser.get("gt-scene");
+  for (size_t i = 0; i < paths.size(); ++i) {
+    if (images[i].cols != scene.config.width_px || images[i].rows != scene.config.height_px) {
+      throw std::runtime_error("--gt-scene " + directory + " is not the scene of " + paths[i] +
+                               ": its views are " + std::to_string(scene.config.width_px) + "x" +
+                               std::to_string(scene.config.height_px) + ", the image is " +
+                               std::to_string(images[i].cols) + "x" +
+                               std::to_string(images[i].rows));
+    }
+  }
+  if (!parser.has("calib")) return;
+  const std::string calib = parser.get("calib");
+  const std::vector<CalibratedView> views =
+      readCalibrationWithImages(calib, parentDirectory(paths[0]));
+  HullInput pair;  // names and cameras only
+  pair.names = {parser.has("left-view") ? parser.get("left-view") : baseName(paths[0]),
+                parser.has("right-view") ? parser.get("right-view") : baseName(paths[1])};
+  for (const std::string& name : pair.names) {
+    pair.cameras.push_back(views[viewIndex(views, name, calib)].camera);
+  }
+  requireViewsOfScene(scene, directory, pair, calib);
 }
 
 std::optional<PairTruth> pairTruth(const ArgParser& parser, const std::string& left,
-                                   const std::string& right) {
+                                   const std::string& right, const cv::Mat& left_image,
+                                   const cv::Mat& right_image) {
   const int given =
       parser.has("gt-disparity") + parser.has("gt-homography") + parser.has("gt-scene");
   if (given > 1)
@@ -92,6 +138,7 @@ std::optional<PairTruth> pairTruth(const ArgParser& parser, const std::string& l
   const SceneData scene = readScene(parser.get("gt-scene"));
   const size_t a = viewIndex(scene.views, baseName(left), parser.get("gt-scene"));
   const size_t b = viewIndex(scene.views, baseName(right), parser.get("gt-scene"));
+  checkSceneOfPair(parser, scene, {left, right}, {left_image, right_image});
   return sceneTruth({scene.views[a].camera, scene.depths[a]},
                     {scene.views[b].camera, scene.depths[b]});
 }
@@ -251,9 +298,9 @@ int runMatch(const std::vector<std::string>& args) {
   const std::string left_path = parser.get("LEFT"), right_path = parser.get("RIGHT");
   const cv::Mat left = readImage(left_path), right = readImage(right_path);
 
+  const std::optional<PairTruth> truth = pairTruth(parser, left_path, right_path, left, right);
   const PairResult pair = runPairOfFiles(parser, options, left, right);
   const PutativeMatches& input = pair.putative;
-  const std::optional<PairTruth> truth = pairTruth(parser, left_path, right_path);
   const std::vector<MatchTruth> judged = truth ? truth->judge(input) : std::vector<MatchTruth>();
   const std::vector<MatchTruth>* truth_or_null = truth ? &judged : nullptr;
 

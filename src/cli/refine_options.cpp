@@ -241,7 +241,11 @@ nlohmann::json refineWithMatches(const ArgParser& parser, const HullInput& input
                                  HullResult* result) {
   nlohmann::json json = nlohmann::json::object();
   std::optional<Shape> solid;
-  if (parser.has("gt-scene")) solid = Shape::byName(readScene(parser.get("gt-scene")).config.shape);
+  if (parser.has("gt-scene")) {
+    const SceneData scene = readScene(parser.get("gt-scene"));
+    requireViewsOfScene(scene, parser.get("gt-scene"), input, parser.get("calib"));
+    solid = Shape::byName(scene.config.shape);
+  }
   const SolidPredicate inside = [&](const Eigen::Vector3d& X_W) { return solid->contains(X_W); };
   std::optional<Shape> filled;
   if (solid) filled = solid->withoutCuts();

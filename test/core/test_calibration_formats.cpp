@@ -155,10 +155,29 @@ TEST_F(CalibrationFormats, LlffDownscaledImagesScaleTheIntrinsics) {
     readLlffPoses(npy, {"a.png", "b.png"}, 200, 100);
     FAIL() << "no error";
   } catch (const ParseError& e) {
-    EXPECT_NE(std::string(e.what()).find("the images are 200x100 but the poses' [height, width] "
-                                         "is 378x504"),
-              std::string::npos)
-        << e.what();
+    EXPECT_EQ(std::string(e.what()), npy +
+                                         ": row 0 (a.png): the images are 200x100 (width x "
+                                         "height) but the poses' [height, width] is 378x504, "
+                                         "not a downscaled copy of one factor");
+  }
+}
+
+TEST_F(CalibrationFormats, LlffSwappedHeightAndWidthAreNamed) {
+  const std::string npy = write("poses_bounds.npy", npyBytes(dictFor(2), llffRows(knownViews())));
+  // The poses say 378 high and 504 wide; portrait images 378 wide and 504 high (or their
+  // quarter-size copies) have the two sides the other way round.
+  for (const auto& [width, height] : {std::pair<int, int>(378, 504), {95, 126}}) {
+    try {
+      readLlffPoses(npy, {"a.png", "b.png"}, width, height);
+      FAIL() << "no error";
+    } catch (const ParseError& e) {
+      const std::string size = std::to_string(width) + "x" + std::to_string(height);
+      EXPECT_EQ(std::string(e.what()),
+                npy + ": row 0 (a.png): the images are " + size +
+                    " (width x height) but the poses' [height, width] is 378x504: height and "
+                    "width are swapped (the poses give height 378 and width 504; the images are " +
+                    std::to_string(height) + " high and " + std::to_string(width) + " wide)");
+    }
   }
 }
 
@@ -219,17 +238,19 @@ void expectSameViews(const std::vector<CalibratedView>& a, const std::vector<Cal
 }
 
 TEST_F(CalibrationFormats, ThreeRowAndCommaProjectionsEqualTheOneLineForm) {
-  const auto one_line = readProjectionList(write("one.txt", std::string(kOneLine) + kOneLine));
+  // Two views, a.png and b.png, of the same camera: each image is listed once.
+  const auto one_line = readProjectionList(
+      write("one.txt", std::string(kOneLine) + "b" + std::string(kOneLine).substr(1)));
   ASSERT_EQ(one_line.size(), 2u);
   EXPECT_EQ(one_line[0].camera_model, "projection");
   expectSameViews(one_line, readProjectionList(
                                 write("rows.txt",
                                       "# name on its own line\na.png\n500 0 320 10\n0 500 240 20\n"
-                                      "0 0 1 2\n\na.png 500 0 320 10\n0 500 240 20\n0 0 1 2\n")));
+                                      "0 0 1 2\n\nb.png 500 0 320 10\n0 500 240 20\n0 0 1 2\n")));
   expectSameViews(one_line,
                   readCalibration(write("commas.txt",
                                         "a.png, 500, 0, 320, 10, 0, 500, 240, 20, 0, 0, 1, 2\n"
-                                        "a.png\n500,0,320,10,0,500,240,20,0,0,1,2\n")));
+                                        "b.png\n500,0,320,10,0,500,240,20,0,0,1,2\n")));
   const auto unnamed =
       readProjectionList(write("unnamed.txt", "500 0 320 10\n0 500 240 20\n0 0 1 2\n"));
   ASSERT_EQ(unnamed.size(), 1u);

@@ -1,15 +1,22 @@
 #include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <unistd.h>
 
 #include <Eigen/Geometry>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <functional>
+#include <iterator>
+#include <opencv2/imgcodecs.hpp>
+#include <optional>
 #include <sstream>
 
 #include "common/test_data.h"
 #include "sift_hull/io/calibration.h"
 #include "sift_hull/io/colmap.h"
+#include "sift_hull/io/images.h"
 #include "sift_hull/io/view_list.h"
 
 namespace sift_hull {
@@ -166,7 +173,7 @@ TEST_F(ColmapModel, EmptyPointLinesAndEveryModelRead) {
             "5 OPENCV_FISHEYE 640 480 500 500 320 240 0.05 -0.01 0.002 -0.0004\n");
   writeFile("images.txt",
             "1 1 0 0 0 0 0 2 1 w.png\n\n2 1 0 0 0 0 0 2 2 x.png\n\n3 1 0 0 0 0 0 2 3 y.png\n\n"
-            "4 2 0 0 0 0 0 2 4 z.png\n\n5 5 0 0 0 0 0 2 5 zz.png\n");
+            "4 1.005 0 0 0 0 0 2 4 z.png\n\n5 1 0 0 0 0 0 2 5 zz.png\n");
   const auto views = readColmapModel(dir_);
   ASSERT_EQ(views.size(), 5u);
   EXPECT_EQ(views[4].name, "zz.png");                 // views come sorted by name
@@ -180,6 +187,9 @@ TEST_F(ColmapModel, EmptyPointLinesAndEveryModelRead) {
   EXPECT_DOUBLE_EQ(views[3].camera.distortion().k6, 0.08);
   EXPECT_DOUBLE_EQ(views[3].camera.K()(1, 1), 501.0);
   EXPECT_TRUE(views[3].camera.R().isApprox(Eigen::Matrix3d::Identity()));  // q normalised
+  EXPECT_EQ(views[3].width_px, 640u);  // the camera's WIDTH x HEIGHT and where it is written
+  EXPECT_EQ(views[3].height_px, 480u);
+  EXPECT_EQ(views[3].size_source, dir_ + "/cameras.txt:4");
 }
 
 TEST_F(ColmapModel, TextErrorsNameFileAndLine) {
@@ -207,7 +217,9 @@ TEST_F(ColmapModel, TextErrorsNameFileAndLine) {
                            "not hold");
   writeText();
   writeFile("images.txt", "1 0 0 0 0 0 0 2 1 a.png\n");
-  EXPECT_EQ(errorOf(), images + ":1: the quaternion is zero");
+  EXPECT_EQ(errorOf(), images +
+                           ":1: the quaternion (0, 0, 0, 0) is not of unit length: its norm is 0 "
+                           "(1 to within 0.01 is normalised)");
   writeFile("images.txt", "1 1 0 0 0 0 0 2 1\n");
   EXPECT_EQ(errorOf(),
             images + ":1: expected IMAGE_ID QW QX QY QZ TX TY TZ CAMERA_ID NAME, found 9 fields");
@@ -280,6 +292,138 @@ TEST_F(ColmapModel, CamerasProjectThroughTheirDistortion) {
       (camera.K() * distortNormalised(camera.distortion(), normalised).homogeneous()).hnormalized();
   EXPECT_LT((camera.project(X_W) - expected).norm(), 1e-9);
   EXPECT_LT((camera.project(X_W) - Eigen::Vector2d(10.0, 20.0)).norm(), 1e-8);
+}
+
+/// images.txt of eight unit-quaternion images on camera 1, each image line followed by
+/// `points_line(i)` (nothing when it returns std::nullopt: the POINTS2D line left out).
+std::string eightImages(const std::function<std::optional<std::string>(int)>& points_line) {
+  std::string text = "# IMAGE_ID, QW, QX, QY, QZ, TX, TY, TZ, CAMERA_ID, NAME\n";
+  for (int i = 0; i < 8; ++i) {
+    text += std::to_string(i + 1) + " 1 0 0 0 0.1 0 " + std::to_string(2 + i) + " 1 v" +
+            std::to_string(i) + ".png\n";
+    const std::optional<std::string> points = points_line(i);
+    if (points) text += *points + "\n";
+  }
+  return text;
+}
+
+TEST_F(ColmapModel, EveryImageIsKeptWithOrWithoutItsPointsLine) {
+  writeFile("cameras.txt", kCamerasText);
+  const std::vector<std::function<std::optional<std::string>(int)>> forms = {
+      [](int) { return std::string(); },                         // COLMAP: empty lines
+      [](int) { return std::nullopt; },                          // lines left out
+      [](int) { return std::string("10.5 20.5 -1 30 40 17"); },  // points
+      [](int i) {                                                // the three mixed
+        return i % 3 == 0 ? std::optional<std::string>() : std::string(i % 3 == 1 ? "" : "1 2 -1");
+      }};
+  for (size_t form = 0; form < forms.size(); ++form) {
+    writeFile("images.txt", eightImages(forms[form]));
+    const std::vector<CalibratedView> views = readColmapModel(dir_);
+    ASSERT_EQ(views.size(), 8u) << "form " << form;
+    for (int i = 0; i < 8; ++i) {
+      EXPECT_EQ(views[i].name, "v" + std::to_string(i) + ".png");
+      EXPECT_DOUBLE_EQ(views[i].camera.t().z(), 2.0 + i);
+    }
+  }
+}
+
+TEST_F(ColmapModel, APointsLineThatIsNoneIsRefusedNamingItsLine) {
+  writeFile("cameras.txt", kCamerasText);
+  const std::string images = dir_ + "/images.txt";
+  writeFile("images.txt", "1 1 0 0 0 0 0 2 1 a.png\n1 2 -1 3 4\n");
+  EXPECT_EQ(errorOf(), images +
+                           ":2: expected the POINTS2D line of the image above (X Y POINT3D_ID per "
+                           "point: two numbers and an integer) or the next IMAGE_ID QW QX QY QZ "
+                           "TX TY TZ CAMERA_ID NAME; found 5 fields");
+  writeFile("images.txt", "1 1 0 0 0 0 0 2 1 a.png\n1 2 0.5\n");  // POINT3D_ID not an integer
+  EXPECT_EQ(errorOf().find(images + ":2: expected the POINTS2D line"), 0u) << errorOf();
+  writeFile("images.txt", "1 1 0 0 0 0 0 2 1 a.png\n1 2 -1\n3 4 -1\n");  // two points lines
+  EXPECT_EQ(errorOf(),
+            images + ":3: expected IMAGE_ID QW QX QY QZ TX TY TZ CAMERA_ID NAME, found 3 fields");
+}
+
+/// The peak resident memory of the process so far, in kB.
+long peakResidentKb() {
+  struct rusage usage;
+  getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_maxrss;
+}
+
+TEST_F(ColmapModel, PointsLinesAreReadWithoutKeepingThem) {
+  writeFile("cameras.txt", kCamerasText);
+  {
+    std::ofstream out(dir_ + "/images.txt");
+    for (int image = 0; image < 2; ++image) {  // 2 x 1.2 million points, about 40 MB
+      out << image + 1 << " 1 0 0 0 0 0 2 1 p" << image << ".png\n";
+      for (int p = 0; p < 1200000; ++p) out << 1000.25 + p % 997 << " 500.125 " << p << ' ';
+      out << "\n";
+    }
+  }
+  const long before_kb = peakResidentKb();
+  const std::vector<CalibratedView> views = readColmapModel(dir_);
+  ASSERT_EQ(views.size(), 2u);
+  EXPECT_EQ(views[1].name, "p1.png");
+  // Keeping the words would take well over 100 MB; a line at a time takes nothing of the kind.
+  EXPECT_LT(peakResidentKb() - before_kb, 8 * 1024);
+}
+
+TEST_F(ColmapModel, AQuaternionNotOfUnitLengthIsRefusedWithItsNorm) {
+  writeFile("cameras.txt", kCamerasText);
+  const std::string images = dir_ + "/images.txt";
+  writeFile("images.txt", "1 2 0 0 0 0 0 2 1 a.png\n");
+  EXPECT_EQ(errorOf(), images +
+                           ":1: the quaternion (2, 0, 0, 0) is not of unit length: its norm is 2 "
+                           "(1 to within 0.01 is normalised)");
+  writeFile("images.txt", "1 1e-07 0 0 0 0 0 2 1 a.png\n");
+  EXPECT_EQ(errorOf(), images +
+                           ":1: the quaternion (1e-07, 0, 0, 0) is not of unit length: its norm "
+                           "is 1e-07 (1 to within 0.01 is normalised)");
+  // Rounded to four digits, as some exporters write them: normalised.
+  writeFile("images.txt", "1 0.7071 0.7071 0 0 0 0 2 1 a.png\n");
+  const std::vector<CalibratedView> views = readColmapModel(dir_);
+  const Eigen::Matrix3d expected =
+      Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  EXPECT_TRUE(views[0].camera.R().isApprox(expected, 1e-12)) << views[0].camera.R();
+}
+
+TEST_F(ColmapModel, AByteOrderMarkIsSkipped) {
+  writeText();
+  const std::vector<CalibratedView> plain = readColmapModel(dir_);
+  writeFile("cameras.txt", "\xEF\xBB\xBF" + kCamerasText);
+  std::ifstream images_in(dir_ + "/images.txt");
+  const std::string images((std::istreambuf_iterator<char>(images_in)),
+                           std::istreambuf_iterator<char>());
+  writeFile("images.txt", "\xEF\xBB\xBF" + images);
+  const std::vector<CalibratedView> marked = readColmapModel(dir_);
+  ASSERT_EQ(marked.size(), plain.size());
+  for (size_t i = 0; i < plain.size(); ++i) {
+    EXPECT_EQ(marked[i].name, plain[i].name);
+    EXPECT_TRUE(marked[i].camera.projectionMatrix().isApprox(plain[i].camera.projectionMatrix()));
+  }
+}
+
+TEST_F(ColmapModel, TheCameraSizeIsCheckedAgainstTheImage) {
+  writeText();
+  const std::vector<CalibratedView> views = readColmapModel(dir_);  // b.png: camera 1, 640x480
+  ASSERT_EQ(views[1].name, "b.png");
+  EXPECT_EQ(views[1].size_source, dir_ + "/cameras.txt:2");
+  ASSERT_TRUE(cv::imwrite(dir_ + "/b.png", cv::Mat(480, 640, CV_8UC3, cv::Scalar::all(9))));
+  EXPECT_EQ(loadViewImage(dir_, views[1]).size(), cv::Size(640, 480));
+  ASSERT_TRUE(cv::imwrite(dir_ + "/b.png", cv::Mat(240, 320, CV_8UC3, cv::Scalar::all(9))));
+  try {
+    loadViewImage(dir_, views[1]);
+    FAIL() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), dir_ +
+                                         "/cameras.txt:2: the camera of view 'b.png' is 640x480 "
+                                         "(WIDTH x HEIGHT) but the image " +
+                                         dir_ + "/b.png is 320x240");
+  }
+  // The binary model names the camera by id and byte.
+  writeFile("cameras.bin", camerasBin());
+  writeFile("images.bin", imagesBin());
+  ::unlink((dir_ + "/cameras.txt").c_str());
+  EXPECT_EQ(readColmapModel(dir_)[1].size_source, dir_ + "/cameras.bin (camera 1 at byte 8)");
 }
 
 }  // namespace

@@ -44,9 +44,11 @@ class MalformedFile : public ::testing::Test {
 };
 
 TEST_F(MalformedFile, WellFormedParFileLoads) {
+  const std::string second = std::string(kGoodLine).replace(0, 4, "next");
   const auto views =
-      readMiddleburyPar(write(std::string("2\n") + kGoodLine + "\n" + kGoodLine + "\n"));
+      readMiddleburyPar(write(std::string("2\n") + kGoodLine + "\n" + second + "\n"));
   ASSERT_EQ(views.size(), 2u);
+  EXPECT_EQ(views[1].name, "next.png");
   EXPECT_EQ(views[0].name, "view.png");
   EXPECT_NEAR(views[1].camera.project(Eigen::Vector3d(0, 0, 0)).x(), 320.0, 1e-12);
 }
@@ -115,6 +117,32 @@ TEST_F(MalformedFile, ProjectionListErrorsNameFileAndLine) {
             path + ":1: the left 3x3 block of P is singular");
   EXPECT_EQ(errorOf("a.png 1 0 0 0  0 1 0 0  0 0 1 inf\n", readProjectionList),
             path + ":1: 'inf' is not finite");
+}
+
+TEST_F(MalformedFile, AViewListedTwiceIsRefusedNamingBothLines) {
+  const std::string path = dir_ + "/calib.txt";
+  const std::string good = kGoodLine;
+  const std::string other = std::string(kGoodLine).replace(0, 4, "next");
+  EXPECT_EQ(errorOf("3\n" + good + "\n" + other + "\n" + good + "\n", readMiddleburyPar),
+            path +
+                ":4: image 'view.png' is given twice, on lines 2 and 4: each view must be "
+                "listed once");
+  const std::string P = "500 0 320 0  0 500 240 1000  0 0 1 2";
+  EXPECT_EQ(
+      errorOf("# list\na.png " + P + "\nb.png " + P + "\na.png\n" + P + "\n", readProjectionList),
+      path +
+          ":4: image 'a.png' is given twice, on lines 2 and 4: each view must be listed "
+          "once");
+}
+
+TEST_F(MalformedFile, AByteOrderMarkBeforeTheCountLineIsSkipped) {
+  const std::string text = std::string("1\n") + kGoodLine + "\n";
+  const PinholeCamera plain = readCalibration(write(text))[0].camera;
+  EXPECT_EQ(calibrationFormat(write("\xEF\xBB\xBF" + text)), "Middlebury par");
+  const std::vector<CalibratedView> marked = readCalibration(write("\xEF\xBB\xBF" + text));
+  ASSERT_EQ(marked.size(), 1u);
+  EXPECT_EQ(marked[0].name, "view.png");
+  EXPECT_TRUE(marked[0].camera.projectionMatrix().isApprox(plain.projectionMatrix(), 1e-15));
 }
 
 TEST_F(MalformedFile, ProjectionListMatchesParFile) {

@@ -216,6 +216,38 @@ TEST(DistortedScene, SceneCommandWritesAColmapModelAndTheHullReadsIt) {
   EXPECT_NE(out.find("OPENCV, k1=-0.3"), std::string::npos) << out;
 }
 
+TEST(DistortedScene, TheMatchCommandRefusesAFoldingDistortionAsTheHullDoes) {
+  const std::string dir = test::temporaryDirectory();
+  std::string out, err;
+  ASSERT_EQ(test::runProgram("scene --out " + dir + " --views 4 --size 320x240", &out, &err), 0)
+      << err;
+  std::vector<CalibratedView> views = readCalibration(dir + "/scene_par.txt");
+  for (CalibratedView& view : views) {
+    view.camera = view.camera.withDistortion({-1.5, 0.0, 0.0, 0.0, 0.0});
+  }
+  writeColmapText(dir + "/folded", views, 320, 240);
+  const std::string folds =
+      "its lens distortion folds over within its 320x240 image (no one-to-one undistortion)";
+  EXPECT_EQ(test::runProgram("match " + dir + "/view_0000.png " + dir + "/view_0001.png --calib " +
+                                 dir + "/folded --filter epipolar",
+                             &out, &err),
+            1);
+  EXPECT_NE(err.find(dir + "/folded: view 'view_0000.png': " + folds), std::string::npos) << err;
+  EXPECT_EQ(test::runProgram("hull --calib " + dir + "/folded --images " + dir + " --silhouettes " +
+                                 dir + "/masks --max-depth 5",
+                             &out, &err),
+            1);
+  EXPECT_NE(err.find(folds), std::string::npos) << err;
+  // A lens that does not fold within its image is matched as before.
+  for (CalibratedView& view : views) view.camera = view.camera.withDistortion(kBarrel);
+  writeColmapText(dir + "/barrel", views, 320, 240);
+  EXPECT_EQ(test::runProgram("match " + dir + "/view_0000.png " + dir + "/view_0001.png --calib " +
+                                 dir + "/barrel --filter epipolar",
+                             &out, &err),
+            0)
+      << err;
+}
+
 TEST(DistortedScene, BadDistortionOptionsAreUsageErrors) {
   const std::string dir = test::temporaryDirectory();
   std::string out, err;

@@ -354,16 +354,16 @@ TEST(MatchCommand, FilterFlagsAreTheSettingNamesAndOldNamesAreRefused) {
                             " --gt-scene " + scene +
                             " --json --filter gsc --filter ransac --filter magsac --filter gms ";
   std::string out, err;
-  ASSERT_EQ(test::runProgram(match +
-                                 "--gsc-max-histogram-distance 0 --ransac-max-epipolar-px 3 "
-                                 "--magsac-max-epipolar-px 3 --gms-grid-cells 10 "
-                                 "--gms-with-rotation --gms-with-scale --backend flann "
-                                 "--max-descriptor-distance 300 --sigma-px 1.5",
+  ASSERT_EQ(test::runProgram(match + "--gsc-max-histogram-distance 1.5 --ransac-max-epipolar-px 3 "
+                                     "--magsac-max-epipolar-px 3 --gms-grid-cells 10 "
+                                     "--gms-with-rotation --gms-with-scale --backend flann "
+                                     "--max-descriptor-distance 300 --sigma-px 1.5",
                              &out, &err),
             0)
       << err;
   const nlohmann::json result = nlohmann::json::parse(out);  // stdout holds it alone
-  EXPECT_LT(result["filters"]["gsc"]["kept"].get<int>(), 3);  // histograms equal to the last bin
+  // Histograms are at most sqrt(2) apart: 1.5 keeps every putative.
+  EXPECT_EQ(result["filters"]["gsc"]["kept"], result["putative"]);
   EXPECT_GT(result["filters"]["magsac"]["kept"].get<int>(), 20);
   for (const char* old : {"--gsc-max-distance 0", "--ransac-px 3", "--gms-cells 10", "--sigma 1.5",
                           "--max-histogram-distance 0", "--grid-cells 10"}) {

@@ -119,12 +119,11 @@ TEST(Readers, NumbersWithTrailingBytesAreRefused) {
   EXPECT_THROW(readHomography(dir + "/H"), std::exception);
   writeText(dir + "/H10", "1 0 0 0 1 0 0 0 1 1\n");
   EXPECT_THROW(readHomography(dir + "/H10"), std::exception);
-  const std::vector<CalibratedView> views = {
-      {"a.png",
-       PinholeCamera(Eigen::Matrix3d::Identity(), Eigen::Matrix3d::Identity(),
-                     Eigen::Vector3d(0, 0, 1)),
-       "", ""}};
-  writeMiddleburyPar(dir + "/good.txt", views);
+  CalibratedView view;
+  view.name = "a.png";
+  view.camera = PinholeCamera(Eigen::Matrix3d::Identity(), Eigen::Matrix3d::Identity(),
+                              Eigen::Vector3d(0, 0, 1));
+  writeMiddleburyPar(dir + "/good.txt", {view});
   std::ifstream in(dir + "/good.txt");
   std::string text((std::istreambuf_iterator<char>(in)), {});
   const size_t last_digit = text.find_last_of("0123456789");
@@ -278,6 +277,18 @@ TEST_F(HostileCommandLine, HugeCoordinatesEndInAClearError) {
   EXPECT_EQ(hull("--box 0,0,0,1e-300,1e-300,1e-300", &err), 1);
 }
 
+TEST_F(HostileCommandLine, AFarTranslationIsBlamedOnItsOwnView) {
+  // Before, the box LP, framed by the far camera, said that the point where the optical axes meet
+  // is behind five other views.
+  std::string err;
+  EXPECT_EQ(hull("", &err, parWithCameraAt(1e30, true)), 1);
+  EXPECT_TRUE(contains(err,
+                       "view 'view_0001.png': its camera lies 1e+30 from the cameras' median "
+                       "centre, more than 1e+06 times their median distance from it ("))
+      << err;
+  EXPECT_TRUE(contains(err, "): check its translation")) << err;
+}
+
 TEST_F(HostileCommandLine, OutOfRangeSettingsAreUsageErrors) {
   std::string err, out;
   EXPECT_EQ(hull("--max-depth 12", &err), 2);
@@ -285,9 +296,10 @@ TEST_F(HostileCommandLine, OutOfRangeSettingsAreUsageErrors) {
   EXPECT_EQ(hull("--threads 100000", &err), 2);
   EXPECT_EQ(hull("--views ,", &err), 2);
   const std::string left = *scene_ + "/view_0000.png", right = *scene_ + "/view_0001.png";
-  EXPECT_EQ(test::runProgram("match " + left + " " + right + " --filter gms --gms-grid-cells 100000",
-                             &out, &err),
-            2);
+  EXPECT_EQ(
+      test::runProgram("match " + left + " " + right + " --filter gms --gms-grid-cells 100000",
+                       &out, &err),
+      2);
   EXPECT_EQ(test::runProgram("match " + left + " " + right + " --filter +gsc", &out, &err), 2);
   EXPECT_EQ(test::runProgram("match " + left + " " + right + " --filter epipolar", &out, &err), 2);
   EXPECT_EQ(test::runProgram("bag --calib " + *scene_ + "/scene_par.txt --images " + *scene_ +

@@ -1,7 +1,8 @@
 // The layout's rules (docs/ARCHITECTURE.md), checked on the source tree and the programs: each
 // stage includes only the stages below it, the core, the user's program sift_hull and the
 // benchmarks' sift_hull_bench include and link nothing of ROS, sift_hull includes nothing of
-// sift_hull_bench and sends its commands there, and no source file grows past 450 lines.
+// sift_hull_bench and sends its commands there, no source file grows past 450 lines, and the
+// catkin package lints clean.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -217,6 +218,17 @@ TEST(LayoutTest, NoSourceFileExceeds450Lines) {
     for (std::string line; std::getline(in, line);) ++lines;
     EXPECT_LE(lines, 450u) << fs::relative(file, kRoot);
   }
+}
+
+/// catkin_lint (scripts/apt-packages.txt) finds no problem in the package, warnings included;
+/// what it cannot see is explained where CMakeLists.txt tells it to ignore it.
+TEST(LayoutTest, TheCatkinPackageLintsClean) {
+  std::string out, err;
+  if (test::runCommand("command -v catkin_lint", &out, &err) != 0) {
+    GTEST_SKIP() << "catkin_lint is not installed";
+  }
+  EXPECT_EQ(test::runCommand("catkin_lint --strict " + kRoot.string(), &out, &err), 0)
+      << out << err;
 }
 
 }  // namespace

@@ -98,21 +98,91 @@ TEST_F(CupStream, ATreeThatStartsAnewIsCarvedAgain) {
 TEST(PointCarvedStream, KeepsAtMostTheSetNumberOfPointsAndOnlyWellReprojectedOnes) {
   PointCarvingConfig config;
   config.max_surface_points = 10;
+  config.max_points_per_pair = 20;
   config.surface_points.max_reprojection_px = 1.0;
   PointCarvedStream stream(streamConfig(5), config);
   const PinholeCamera camera;
   std::vector<SurfacePoint> points(6);
   points[0].reprojection_px = 2.0;
   points[1].reprojection_px = std::numeric_limits<double>::quiet_NaN();
-  EXPECT_EQ(stream.addSurfacePoints(camera, camera, points, 0.0), 4u);
-  EXPECT_EQ(stream.addSurfacePoints(camera, camera, points, 1.0), 4u);
+  const PointCarvedStream::AddedPoints first = stream.addSurfacePoints(camera, camera, points, 0);
+  EXPECT_EQ(first.kept, 4u);
+  EXPECT_EQ(first.over_reprojection, 2u);
+  EXPECT_EQ(stream.addSurfacePoints(camera, camera, points, 1).kept, 4u);
   EXPECT_EQ(stream.storedPoints(), 8u);
-  EXPECT_EQ(stream.addSurfacePoints(camera, camera, points, 2.0), 4u);
+  EXPECT_EQ(stream.addSurfacePoints(camera, camera, points, 2).kept, 4u);
   EXPECT_EQ(stream.storedPoints(), 8u) << "the oldest pair goes";
-  EXPECT_EQ(stream.addSurfacePoints(camera, camera, std::vector<SurfacePoint>(30), 3.0), 30u);
-  EXPECT_EQ(stream.storedPoints(), 30u) << "the newest pair stays whole";
+  const PointCarvedStream::AddedPoints large =
+      stream.addSurfacePoints(camera, camera, std::vector<SurfacePoint>(30), 3);
+  EXPECT_EQ(large.kept, 20u) << "subsampled to max_points_per_pair";
+  EXPECT_EQ(large.subsampled, 10u);
+  EXPECT_EQ(stream.storedPoints(), 20u) << "the newest pair stays whole";
   config.max_surface_points = 0;
   EXPECT_THROW(PointCarvedStream(streamConfig(5), config), std::invalid_argument);
+}
+
+TEST(PointCarvedStream, SubsamplesALargePairEvenlyInItsOrder) {
+  PointCarvingConfig config;
+  config.max_points_per_pair = 4;
+  PointCarvedStream stream(streamConfig(5), config);
+  std::vector<SurfacePoint> points(100);
+  for (size_t i = 0; i < points.size(); ++i) points[i].X_W.x() = static_cast<double>(i);
+  const PinholeCamera camera;
+  EXPECT_EQ(stream.addSurfacePoints(camera, camera, points, 0).kept, 4u);
+  EXPECT_EQ(stream.storedPoints(), 4u);
+}
+
+TEST_F(CupStream, AFarCameraOrPointIsRefusedAndTheCarvingGoesOn) {
+  PointCarvedStream stream(streamConfig(6), {});
+  for (size_t v = 0; v < scene.views.size(); ++v) addView(&stream, v);
+  ASSERT_TRUE(stream.stream().hasHull());
+  const PinholeCamera& near = scene.views[0].view.camera;
+  const PinholeCamera far = PinholeCamera::fromCentre(near.K(), near.R(),
+                                                      Eigen::Vector3d(1e300, 0.0, 0.0));
+  std::vector<SurfacePoint> points = pointsOfView(scene.views, 0);
+  const PointCarvedStream::AddedPoints refused = stream.addSurfacePoints(near, far, points, 0);
+  EXPECT_EQ(refused.kept, 0u);
+  EXPECT_NE(refused.refused.find("max_distance_cube_edges"), std::string::npos) << refused.refused;
+  EXPECT_FALSE(stream.refineDue()) << "nothing of the refused pair stays";
+  SurfacePoint lost = points.front();
+  lost.X_W = Eigen::Vector3d(0.0, 0.0, 1e30);
+  points.push_back(lost);
+  const PointCarvedStream::AddedPoints added = stream.addSurfacePoints(near, near, points, 1);
+  EXPECT_EQ(added.outside, 1u);
+  EXPECT_EQ(added.kept, points.size() - 1);
+  ASSERT_TRUE(stream.refineDue());
+  EXPECT_GT(stream.refine().free_voxels, 0u) << "the good pair still carves";
+}
+
+TEST_F(CupStream, ClearingABoxFreesItsOccupiedVoxelsInTheHullAndTheMesh) {
+  PointCarvedStream stream(streamConfig(6), {});
+  for (size_t v = 0; v < scene.views.size(); ++v) addView(&stream, v);
+  ASSERT_TRUE(stream.stream().hasHull());
+  const VisualHull& hull = stream.stream().hull();
+  const Box3d box = stream.stream().box();
+  // The cube above the middle of the box.
+  Box3d top = hull.cube().box();
+  top.min_W.z() = box.centre().z();
+  const size_t cleared = stream.clearBox(top);
+  EXPECT_GT(cleared, 0u);
+  EXPECT_EQ(stream.freeVoxelCount(), hull.freeVoxelCount());
+  const double edge = hull.cube().resolution_m;
+  size_t occupied_above = 0, occupied_below = 0;
+  hull.forEachLeaf([&](const HullCell& cell) {
+    if (cell.state == CellState::kOut) return;
+    const double cell_edge = hull.cube().edge_m() / (1 << cell.depth);
+    const double z_min = hull.cube().origin_W().z() + cell.index.z() * cell_edge;
+    (z_min >= top.min_W.z() + edge ? occupied_above : occupied_below) += 1;
+  });
+  EXPECT_EQ(occupied_above, 0u) << "no occupied cell wholly inside the cleared box";
+  EXPECT_GT(occupied_below, 0u) << "the rest stays";
+  for (const Eigen::Vector3f& vertex : hull.mesh().vertices_W) {
+    EXPECT_LE(vertex.z(), top.min_W.z() + edge) << "the mesh is cut at the box";
+  }
+  EXPECT_EQ(stream.clearBox(top), 0u) << "a cleared box has nothing more to clear";
+  Box3d inverted = box;
+  std::swap(inverted.min_W, inverted.max_W);
+  EXPECT_THROW(stream.clearBox(inverted), std::invalid_argument);
 }
 
 }  // namespace

@@ -130,8 +130,8 @@ TEST(SurfacePoints, KeepsConsistentPointsWithTheViewsOfEveryPairThatSawThem) {
   EXPECT_EQ(counts.confirmed, 2u);
   EXPECT_EQ(counts.kept, 3u);
   for (const SurfacePoint& p : points) {
-    if ((p.X_W - X[0]).norm() < 1e-6) EXPECT_EQ(p.views, std::vector<uint32_t>({0, 1, 2}));
-    if ((p.X_W - X[1]).norm() < 1e-6) EXPECT_EQ(p.views, std::vector<uint32_t>({1, 2}));
+    if ((p.X_W - X[0]).norm() < 1e-6) { EXPECT_EQ(p.views, std::vector<uint32_t>({0, 1, 2})); }
+    if ((p.X_W - X[1]).norm() < 1e-6) { EXPECT_EQ(p.views, std::vector<uint32_t>({1, 2})); }
     EXPECT_GT((p.X_W - X[2]).norm(), 1e-3);
     EXPECT_LT(p.reprojection_px, 1e-6);
     EXPECT_GT(p.depth_sigma_m, 0.0);

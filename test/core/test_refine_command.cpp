@@ -77,5 +77,41 @@ TEST(RefineCommand, RefusesBadSettingsByName) {
   refused("--min-views 0", "min_views");
 }
 
+TEST(RefineCommand, AGroundTruthOfAnotherSceneIsRefusedNamingBoth) {
+  const std::string& cup = cupScene();
+  const std::string other = test::temporaryDirectory() + "/box";
+  std::string out, err;
+  ASSERT_EQ(
+      test::runProgram("scene --shape box --layout sphere --views 20 --size 320x240 --out " + other,
+                       &out, &err),
+      0)
+      << err;
+  const std::string hull = "hull --calib " + cup + "/scene_par.txt --images " + cup +
+                           " --silhouettes " + cup + "/masks --max-depth 5 --json --gt-scene ";
+  EXPECT_EQ(test::runProgram(hull + other, &out, &err), 1) << out;
+  EXPECT_NE(err.find("--gt-scene " + other + " is not the scene of the views of " + cup +
+                     "/scene_par.txt: view 'view_0000.png'"),
+            std::string::npos)
+      << err;
+  ASSERT_EQ(test::runProgram(hull + cup, &out, &err), 0) << err;
+  EXPECT_GT(nlohmann::json::parse(out)["volume_iou_vs_truth"]["after"].get<double>(), 0.5) << out;
+  // The match command: the calibration's cameras against the scene's, and the images' size.
+  const std::string pair = "match " + cup + "/view_0000.png " + cup + "/view_0001.png --gt-scene ";
+  EXPECT_EQ(test::runProgram(pair + other + " --calib " + cup + "/scene_par.txt", &out, &err), 1);
+  EXPECT_NE(err.find("--gt-scene " + other + " is not the scene of the views of " + cup +
+                     "/scene_par.txt: view 'view_0000.png'"),
+            std::string::npos)
+      << err;
+  const std::string small = test::temporaryDirectory() + "/small";
+  ASSERT_EQ(
+      test::runProgram("scene --shape cup --views 2 --size 160x120 --out " + small, &out, &err), 0)
+      << err;
+  EXPECT_EQ(test::runProgram(pair + small, &out, &err), 1);
+  EXPECT_NE(err.find("--gt-scene " + small + " is not the scene of " + cup +
+                     "/view_0000.png: its views are 160x120, the image is 320x240"),
+            std::string::npos)
+      << err;
+}
+
 }  // namespace
 }  // namespace sift_hull

@@ -64,7 +64,8 @@ HullData& hullData() {
     const cv::Size size = views[0].mask.size();  // sphereViews: 320x240, the default seed
     for (double degrees : {20.0, 45.0}) {
       for (int v = 0; v < kViews; ++v) {
-        CalibratedView view{"", turnedCamera(views[v].view.camera, degrees), "", ""};
+        CalibratedView view;
+        view.camera = turnedCamera(views[v].view.camera, degrees);
         const RenderedView rendered = renderView(shape, view, size, SceneConfig().seed);
         d.fresh.push_back({"fresh_" + std::to_string(d.fresh.size()), view.camera, rendered.mask});
       }

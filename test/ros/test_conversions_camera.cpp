@@ -174,6 +174,25 @@ TEST(CameraInfoGeometry, RefusesAnInconsistentPOrR) {
   EXPECT_EQ(refusal(bad), "");
 }
 
+TEST(CameraInfoGeometry, RefusesADistortionThatFoldsOverWithinTheImage) {
+  // k1 = -3 folds the model over at r^2 = 1/9, inside this 320x240 image's corners (r^2 = 0.16);
+  // the camera is refused as the hull refuses such a view (requireUnfoldedDistortion).
+  sensor_msgs::CameraInfo folded =
+      info(kK, {-3.0, 0, 0, 0, 0}, Eigen::Matrix3d::Zero(), Matrix34d::Zero());
+  folded.header.frame_id = "left";
+  EXPECT_EQ(refusal(folded),
+            "camera: view 'left': its lens distortion folds over within its 320x240 image (no "
+            "one-to-one undistortion): check the coefficients and the image size");
+  PinholeCamera left, right;
+  std::string why_not;
+  EXPECT_FALSE(rc::sharedFrameStereo(folded, folded, {320, 240}, {320, 240}, false, &left, &right,
+                                     &why_not));
+  EXPECT_NE(why_not.find("folds over within its 320x240 image"), std::string::npos) << why_not;
+  sensor_msgs::CameraInfo mild = folded;
+  mild.D = {-0.1, 0.01, 0, 0, 0};
+  EXPECT_EQ(refusal(mild), "");
+}
+
 TEST(SharedFrameStereo, TheRightCameraSitsAtTheBaselineOfItsP) {
   const double baseline_m = 0.12, fx = kKRect(0, 0);
   const sensor_msgs::CameraInfo left = info(kK, {}, kRect, projection(kKRect, {0, 0, 0}));

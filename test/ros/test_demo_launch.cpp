@@ -67,6 +67,9 @@ TEST_P(DemoLaunch, PlaysTheBagThroughBothNodesAndSavesTheResults) {
   const std::string out = dir_ + (GetParam() ? "/nodelets" : "/nodes");
   std::string log;
   ASSERT_EQ(runDemoLaunch(out, GetParam(), &log), 0) << log;
+  // A complete save ends the launch as Ctrl-C does, not by a required node's death.
+  EXPECT_EQ(log.find("REQUIRED process"), std::string::npos) << log;
+  EXPECT_NE(log.find("ending the launch"), std::string::npos) << log;
   std::ifstream summary_file(out + "/summary.json");
   ASSERT_TRUE(summary_file) << "no summary.json; roslaunch said:\n" << log;
   const nlohmann::json summary = nlohmann::json::parse(summary_file);

@@ -111,9 +111,15 @@ TEST(HullRefineTest, SurfacePointsCarveTheCupsPocketFromTheOctomapAndNothingOfTh
   sift_hull::OctomapConstPtr last;
   ros::Subscriber sub = nh.subscribe<sift_hull::Octomap>(
       "octomap_binary", 5, [&](const sift_hull::OctomapConstPtr& m) { last = m; });
+  // The node's errors, from the start: connected before any message is sent.
+  std::vector<std::string> errors;
+  ros::Subscriber rosout =
+      nh.subscribe<rosgraph_msgs::Log>("/rosout", 50, [&](const rosgraph_msgs::LogConstPtr& log) {
+        if (log->level == rosgraph_msgs::Log::ERROR) errors.push_back(log->msg);
+      });
   ASSERT_TRUE(waitFor([&] {
     return silhouette_pub.getNumSubscribers() > 0 && info_pub.getNumSubscribers() > 0 &&
-           points_pub.getNumSubscribers() > 0;
+           points_pub.getNumSubscribers() > 0 && rosout.getNumPublishers() > 0;
   })) << "the hull node did not subscribe";
   ros::Time stamp;
   for (int v = 0; v < kCupViews; ++v) {
@@ -140,11 +146,6 @@ TEST(HullRefineTest, SurfacePointsCarveTheCupsPocketFromTheOctomapAndNothingOfTh
   EXPECT_GT(solid_before, 0.98);
 
   // Bad messages first: each refused with its reason on /rosout, and the node carries on.
-  std::vector<std::string> errors;
-  ros::Subscriber rosout =
-      nh.subscribe<rosgraph_msgs::Log>("/rosout", 50, [&](const rosgraph_msgs::LogConstPtr& log) {
-        if (log->level == rosgraph_msgs::Log::ERROR) errors.push_back(log->msg);
-      });
   sift_hull::SurfacePoints unknown_frame = exactPairPoints(views[0], views[1], 16);
   unknown_frame.header.frame_id = "nowhere";
   sift_hull::SurfacePoints short_errors = exactPairPoints(views[0], views[1], 16);

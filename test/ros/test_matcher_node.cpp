@@ -3,6 +3,7 @@
 // good pairs still count. Every wait has a deadline.
 
 #include <dynamic_reconfigure/Reconfigure.h>
+#include <dynamic_reconfigure/client.h>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 #include <sensor_msgs/CompressedImage.h>
@@ -12,6 +13,7 @@
 #include <tf2_ros/static_transform_broadcaster.h>
 
 #include <functional>
+#include <limits>
 #include <mutex>
 #include <opencv2/imgcodecs.hpp>
 #include <set>
@@ -21,6 +23,7 @@
 #include "lib/conversions.h"
 #include "ros_wait.h"
 #include "sift_hull/Correspondences.h"
+#include "sift_hull/MatcherConfig.h"
 #include "sift_hull/eval/match_evaluation.h"
 #include "sift_hull/features/labelled_matches.h"
 #include "sift_hull/synthetic/scene.h"
@@ -174,18 +177,55 @@ TEST_F(MatcherNodeTest, ThresholdsChangeAtRunTime) {
   };
   ros::Time stamp = publishPair(left_.image, right_.image);
   ASSERT_TRUE(answeredAtLeast(stamp));
-  ASSERT_GT(keptByGsc(), 20u);
+  const size_t kept_by_default = keptByGsc();
+  ASSERT_GT(kept_by_default, 20u);
   dynamic_reconfigure::Reconfigure change;
   dynamic_reconfigure::DoubleParameter threshold;
   threshold.name = "gsc_max_histogram_distance";
-  threshold.value = 0.0;
+  threshold.value = 0.1;  // the strictest the setting takes (its default: 0.2)
   change.request.config.doubles.push_back(threshold);
   ASSERT_TRUE(ros::service::waitForService("/matcher/set_parameters", ros::Duration(kDeadline_s)));
   ASSERT_TRUE(ros::service::call("/matcher/set_parameters", change));
   stamp = publishPair(left_.image, right_.image);
   ASSERT_TRUE(answeredAtLeast(stamp));
-  EXPECT_LT(keptByGsc(), 3u);  // histograms equal to the last bin: hardly any
-  EXPECT_NE(last_->filter_settings.find("\"gsc_max_histogram_distance\":0.0"), std::string::npos)
+  EXPECT_LT(keptByGsc(), kept_by_default);
+  EXPECT_NE(last_->filter_settings.find("\"gsc_max_histogram_distance\":0.1"), std::string::npos)
+      << last_->filter_settings;
+}
+
+/// `name`'s value in a published reconfigure config (NaN when absent).
+double publishedValue(const dynamic_reconfigure::Config& config, const std::string& name) {
+  for (const auto& p : config.doubles) {
+    if (p.name == name) return p.value;
+  }
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
+TEST_F(MatcherNodeTest, ARefusedValueLeavesTheServerOnTheLastAcceptedOne) {
+  std::vector<dynamic_reconfigure::Config> published;  // ~parameter_updates, latched
+  ros::Subscriber updates = nh_.subscribe<dynamic_reconfigure::Config>(
+      "/matcher/parameter_updates", 5,
+      [&](const dynamic_reconfigure::ConfigConstPtr& m) { published.push_back(*m); });
+  ASSERT_TRUE(waitFor([&] { return !published.empty(); })) << "no ~parameter_updates";
+  sift_hull::MatcherConfig config = sift_hull::MatcherConfig::__getDefault__();
+  ASSERT_TRUE(config.__fromMessage__(published.back()));
+  dynamic_reconfigure::Client<sift_hull::MatcherConfig> client("/matcher");
+  config.max_descriptor_distance = 400.0;
+  ASSERT_TRUE(client.setConfiguration(config));
+  ASSERT_TRUE(waitFor([&] {
+    return !published.empty() &&
+           publishedValue(published.back(), "max_descriptor_distance") == 400.0;
+  }));
+  const size_t accepted = published.size();
+  config.max_descriptor_distance = std::numeric_limits<double>::quiet_NaN();
+  ASSERT_TRUE(client.setConfiguration(config));  // answered with the config in force
+  EXPECT_EQ(config.max_descriptor_distance, 400.0);
+  ASSERT_TRUE(waitFor([&] { return published.size() > accepted; })) << "no update for the refusal";
+  EXPECT_EQ(publishedValue(published.back(), "max_descriptor_distance"), 400.0);
+  const ros::Time stamp = publishPair(left_.image, right_.image);
+  ASSERT_TRUE(answeredAtLeast(stamp)) << "no correspondences after the refused value";
+  EXPECT_GE(last_->matches.size(), 20u);
+  EXPECT_NE(last_->filter_settings.find("\"max_descriptor_distance\":400.0"), std::string::npos)
       << last_->filter_settings;
 }
 
@@ -284,18 +324,20 @@ class CalibratedMatcherTest : public MatcherNodeTest {
     }));
   }
 
-  ros::Time publishCalibratedPair() {
+  /// The pair with its camera_infos, the right camera's stamped `right_delay` after the left's.
+  ros::Time publishCalibratedPair(const ros::Duration& right_delay = ros::Duration(0)) {
     const ros::Time stamp = ros::Time::now();
     std_msgs::Header header;
     header.stamp = stamp;
     header.frame_id = "left";
     left_info_pub_.publish(
         ros_conversions::cameraInfoMessage(left_.view.camera, left_.image.size(), header));
+    header.stamp = stamp + right_delay;
     header.frame_id = "right";
     right_info_pub_.publish(
         ros_conversions::cameraInfoMessage(right_.view.camera, right_.image.size(), header));
     left_pub_.publish(bgrImage(left_.image, stamp, "left"));
-    right_pub_.publish(bgrImage(right_.image, stamp, "right"));
+    right_pub_.publish(bgrImage(right_.image, header.stamp, "right"));
     return stamp;
   }
 
@@ -342,6 +384,24 @@ TEST_F(CalibratedMatcherTest, FiltersByEpipolarLinesAndTriangulatesOntoTheScene)
   size_t small_error = 0;
   for (const SurfacePoint& p : surface_points) small_error += p.reprojection_px < 1.0 ? 1 : 0;
   EXPECT_GE(small_error, 0.9 * surface_points.size());
+}
+
+/// ~approximate_sync with ~calibrated: the images and camera_infos pair by the nearest stamps.
+class CalibratedApproximateMatcherTest : public CalibratedMatcherTest {};
+
+TEST_F(CalibratedApproximateMatcherTest, PairsAStereoPairWhoseStampsDiffer) {
+  // Each set is paired once a later one shows that no nearer stamps will come.
+  std::set<ros::Time> sent;
+  ASSERT_TRUE(waitFor([&] {
+    if (last_) return true;
+    sent.insert(publishCalibratedPair(ros::Duration(0.004)));
+    ros::WallDuration(0.2).sleep();
+    return false;
+  })) << "no correspondences for stereo pairs 4 ms apart";
+  EXPECT_EQ(sent.count(last_->header.stamp), 1u);
+  EXPECT_EQ(last_->right_header.stamp, last_->header.stamp + ros::Duration(0.004));
+  ASSERT_EQ(last_->filters, (std::vector<std::string>{"epipolar", "gsc"}));
+  EXPECT_GE(last_->matches.size(), 50u);
 }
 
 /// image_pipeline's lazy subscription: the images are subscribed only while someone listens to

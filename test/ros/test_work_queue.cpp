@@ -3,11 +3,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <future>
 #include <set>
 #include <stdexcept>
+#include <string>
 
 #include "lib/work_queue.h"
 
@@ -103,6 +105,52 @@ TEST(WorkQueue, CountsAThrowingItemAsFailedAndGoesOn) {
   EXPECT_EQ(processed, (std::vector<int>{0, 2}));
   EXPECT_EQ(queue.counts().failed, 1u);
   EXPECT_EQ(queue.counts().done, 3u);
+}
+
+TEST(WorkQueue, RunsCommandsBeforeWaitingItemsAndCallWaitsForItsCommand) {
+  std::promise<void> release;
+  std::shared_future<void> released = release.get_future().share();
+  std::promise<void> first_taken;
+  std::vector<std::string> order;  // written by the worker only
+  WorkQueue<int> queue(5, 1, [&](int& item) {
+    if (item == 0) {
+      first_taken.set_value();
+      released.wait();
+    }
+    order.push_back("item " + std::to_string(item));
+  });
+  queue.push(0);
+  first_taken.get_future().wait();
+  queue.push(1);
+  EXPECT_TRUE(queue.post([&] { order.push_back("command"); }));
+  EXPECT_FALSE(queue.call([] {}, 0.05)) << "the worker is busy with item 0: the deadline passes";
+  release.set_value();
+  EXPECT_TRUE(queue.call([&] { order.push_back("called"); }, 5.0));
+  queue.waitIdle();
+  // The command (posted while item 1 waited) ran before item 1; each call ran once.
+  ASSERT_GE(order.size(), 4u);
+  EXPECT_EQ(order[0], "item 0");
+  EXPECT_EQ(order[1], "command");
+  EXPECT_EQ(std::count(order.begin(), order.end(), "called"), 1);
+  EXPECT_EQ(std::count(order.begin(), order.end(), "item 1"), 1);
+}
+
+TEST(WorkQueue, RefusesCommandsBeyondItsBoundAndAfterStop) {
+  std::promise<void> release;
+  std::shared_future<void> released = release.get_future().share();
+  std::promise<void> first_taken;
+  WorkQueue<int> queue(1, 1, [&](int&) {
+    first_taken.set_value();
+    released.wait();
+  });
+  queue.push(0);
+  first_taken.get_future().wait();
+  for (size_t i = 0; i < WorkQueue<int>::kMaxCommands; ++i) EXPECT_TRUE(queue.post([] {}));
+  EXPECT_FALSE(queue.post([] {})) << "commands are bounded";
+  release.set_value();
+  queue.stop();
+  EXPECT_FALSE(queue.post([] {}));
+  EXPECT_FALSE(queue.call([] {}, 0.1));
 }
 
 TEST(WorkQueue, StopsAfterTheItemInHandAndDiscardsTheWaitingOnes) {

@@ -25,7 +25,11 @@ namespace sift_hull {
 /// 4. Again on what the motions found so far leave unexplained, up to guided_max_models motions,
 ///    each with at least guided_min_model_inliers inliers and 4 times as many as it explains when
 ///    each left point is paired with the right point of another match (the right points shifted
-///    by half the set: a model that only fits noise does not). A further motion is looked for
+///    by half the set: a model that only fits noise does not). Where chance alone explains more
+///    than 1/16 of the set within the threshold (a wide threshold: no motion with mismatches
+///    could explain 4 times that), the two are compared within the narrower residual where chance
+///    explains 1/16, since a motion's matches lie near it and chance's spread over the band.
+///    A further motion is looked for
 ///    only while the rotations left over still cluster (their strongest window holds at least
 ///    twice its share of evenly spread rotations, and at least 2 guided_min_model_inliers); it
 ///    is sampled locally, searched for as long as a motion explaining two thirds of its vote

@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <optional>
+#include <string>
 #include <utility>
 
 #include "sift_hull/geometry/distortion.h"
@@ -106,6 +107,13 @@ class PinholeCamera {
   Eigen::Matrix3d K_inv_ = Eigen::Matrix3d::Identity();
   LensDistortion distortion_;
 };
+
+/// Throws std::invalid_argument "view 'NAME': its lens distortion folds over within its WxH image
+/// ..." when the camera's distortion is not one-to-one (distortionInvertibleOver) over its
+/// width_px x height_px image widened by `padding_px` on each side. The hull's views (with their
+/// distance maps' padding), the match command and the matcher node check their cameras with it.
+void requireUnfoldedDistortion(const std::string& name, const PinholeCamera& camera, int width_px,
+                               int height_px, int padding_px = 0);
 
 /// Cross-product matrix [v]x, so that [v]x w = v x w.
 Eigen::Matrix3d skew(const Eigen::Vector3d& v);

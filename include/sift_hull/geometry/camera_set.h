@@ -46,4 +46,15 @@ CameraOrientation orientCameras(std::vector<PinholeCamera>* cameras,
 /// 0 for fewer than two cameras.
 double camerasMutualDistance(const std::vector<PinholeCamera>& cameras);
 
+/// How far one camera may stray from the others: a centre more than this many times the cameras'
+/// median distance from their median centre (per axis) is a translation off by orders of
+/// magnitude, and would set the scale of everything computed from the cameras together.
+constexpr double kMaxCameraSpread = 1e6;
+
+/// Throws std::invalid_argument naming the view (`names`, optional) whose camera centre lies more
+/// than kMaxCameraSpread times the cameras' median distance from their median centre, or at a
+/// distance that is not finite. Needs three cameras or more (with two, neither is the odd one).
+void requireNoStrayCamera(const std::vector<PinholeCamera>& cameras,
+                          const std::vector<std::string>& names = {});
+
 }  // namespace sift_hull

@@ -150,4 +150,10 @@ struct VoxelBlock {
 };
 std::vector<VoxelBlock> occupiedBlocks(const VisualHull& hull);
 
+/// The finest voxels (indices in the cube, as carveFree takes them) of the in and surface leaves
+/// that a world box touches. Throws std::invalid_argument, before listing them, when there are
+/// more than max_voxels.
+std::vector<Eigen::Vector3i> occupiedVoxelsIn(const VisualHull& hull, const Box3d& box_W,
+                                              size_t max_voxels);
+
 }  // namespace sift_hull

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -29,6 +30,12 @@ struct CalibratedView {
   /// Camera model of the calibration: a COLMAP model name ("PINHOLE", "OPENCV", ...), "LLFF",
   /// "par" or "projection"; empty when made in code.
   std::string camera_model;
+  /// Image size the calibration gives for the view (a COLMAP camera's WIDTH and HEIGHT); 0 when
+  /// it gives none. checkImageSize compares it with the image.
+  uint64_t width_px = 0;
+  uint64_t height_px = 0;
+  /// Where that size is written ("FILE:LINE" of the camera); empty when no size is given.
+  std::string size_source;
 };
 
 /// Reads a Middlebury `*_par.txt`: a count line, then one line per view

@@ -19,14 +19,20 @@ struct ColmapCamera {
   uint64_t height_px = 0;
   Eigen::Matrix3d K = Eigen::Matrix3d::Identity();
   LensDistortion distortion;
+  /// Where the camera is written: "cameras.txt:LINE", or "cameras.bin (camera ID at byte N)".
+  std::string source;
 };
 
 /// Reads a COLMAP sparse model directory: the text model (cameras.txt, images.txt) when both exist,
 /// else the binary model (cameras.bin, images.bin). Each image becomes a view with the camera
-/// K [R | t], R from the quaternion (qw, qx, qy, qz, normalised) and t as written (world to
-/// camera). Models SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL, OPENCV and FULL_OPENCV (with
-/// k4 = k5 = k6 = 0) are read; others are refused by name. Views are sorted by image name. Throws
-/// ParseError naming the file (and the line for text files).
+/// K [R | t], R from the quaternion (qw, qx, qy, qz; normalised when its norm is within 0.01 of 1,
+/// refused naming its norm otherwise) and t as written (world to camera). In images.txt each
+/// image line may be followed by its POINTS2D line (empty or not) or not: the points are checked
+/// as read and not kept. Each view carries its camera's WIDTH x HEIGHT (CalibratedView::width_px,
+/// height_px), which loadViewImage checks against the image. Models SIMPLE_PINHOLE, PINHOLE,
+/// SIMPLE_RADIAL, RADIAL, OPENCV and FULL_OPENCV (with k4 = k5 = k6 = 0) are read; others are
+/// refused by name. Views are sorted by image name. Throws ParseError naming the file (and the line
+/// for text files).
 std::vector<CalibratedView> readColmapModel(const std::string& directory);
 
 /// True when `directory` holds cameras.txt and images.txt, or cameras.bin and images.bin.

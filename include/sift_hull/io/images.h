@@ -13,9 +13,15 @@ namespace sift_hull {
 /// Reads a colour image; throws std::runtime_error "PATH: image missing or unreadable".
 cv::Mat readImage(const std::string& path);
 
+/// Throws std::runtime_error naming the camera line (view.size_source) with its size and the image
+/// `image_path` with its own when the view's calibration gives an image size (width_px x
+/// height_px) other than `image_size`.
+void checkImageSize(const CalibratedView& view, cv::Size image_size, const std::string& image_path);
+
 /// Reads the image a view names, from `directory`. Throws std::runtime_error naming the image and
 /// the calibration line that names it when the view has no image name or the image is missing or
-/// cannot be decoded. Colour images come back as BGR, 8 bits per channel.
+/// cannot be decoded, and as checkImageSize when its size is not the calibration's. Colour images
+/// come back as BGR, 8 bits per channel.
 cv::Mat loadViewImage(const std::string& directory, const CalibratedView& view);
 
 /// Reads a mask file: any non-zero pixel is inside. Returns CV_8UC1 with 255 inside.

@@ -18,9 +18,16 @@ namespace sift_hull {
 /// Free-space carving of a streamed hull by the surface points of calibrated pairs that arrive
 /// one pair at a time (the hull node's `surface_points`).
 struct PointCarvingConfig {
-  /// Surface points kept; beyond, the oldest pairs' points are dropped (the newest pair is kept
-  /// whole, however large).
-  int max_surface_points = 200000;
+  /// Surface points kept in all; beyond, the oldest pairs' points are dropped. A refinement
+  /// carves with all of them at once (about 40 us a point at depth 8): this bounds its time.
+  int max_surface_points = 50000;
+  /// Points kept of one pair; a larger pair is subsampled evenly (in the message's order) to this
+  /// many, and the rest counted.
+  int max_points_per_pair = 20000;
+  /// A pair's camera farther than this many edges of the hull's cube from its centre, or a point
+  /// outside the cube grown by this many edges on each side, is refused: it carves nothing a
+  /// camera near the object would not, and far enough it breaks the arithmetic.
+  double max_distance_cube_edges = 1000.0;
   /// max_reprojection_px: a pair's points with a larger error are left out on arrival.
   /// (confirm_radius_voxels is unused: a pair's points carry no feature tracks.)
   SurfacePointConfig surface_points;
@@ -49,11 +56,29 @@ class PointCarvedStream {
   HullStream::Outcome add(const std::string& name, const PinholeCamera& camera,
                           const cv::Mat& mask);
 
+  /// What became of one pair's points.
+  struct AddedPoints {
+    size_t kept = 0;
+    size_t over_reprojection = 0;  ///< over max_reprojection_px (or NaN)
+    size_t subsampled = 0;         ///< left out to keep max_points_per_pair
+    size_t outside = 0;            ///< outside the cube's margin (max_distance_cube_edges)
+    std::string refused;           ///< why the whole pair was refused (empty: it was not)
+  };
   /// One pair's points, world frame (their views are replaced by the pair's two cameras), stamped
-  /// `stamp_ns` (nanoseconds, any epoch). Points over max_reprojection_px are left out; returns
-  /// how many were kept.
-  size_t addSurfacePoints(const PinholeCamera& left, const PinholeCamera& right,
-                          std::vector<SurfacePoint> points, int64_t stamp_ns);
+  /// `stamp_ns` (nanoseconds, any epoch). Points over max_reprojection_px are left out, the rest
+  /// subsampled to max_points_per_pair. Once there is a hull, a pair whose camera lies beyond
+  /// max_distance_cube_edges is refused and points beyond it are left out; pairs that came before
+  /// the hull are checked so when it starts (refine() drops them, counted in Refinement).
+  AddedPoints addSurfacePoints(const PinholeCamera& left, const PinholeCamera& right,
+                               std::vector<SurfacePoint> points, int64_t stamp_ns);
+
+  /// ~clear_bbx: the occupied finest voxels the box touches become free (VisualHull::carveFree:
+  /// the maps and the mesh lose them), at once; returns how many. Requires stream().hasHull().
+  /// When the tree starts anew (a refit of the box, only while views shrink it without a given
+  /// box), the boxes cleared before are gone. Throws std::invalid_argument for a box that is not
+  /// finite with min <= max, or that touches more than kMaxClearedVoxels occupied voxels.
+  size_t clearBox(const Box3d& box_W);
+  static constexpr size_t kMaxClearedVoxels = size_t{1} << 20;
 
   /// Whether refine() has work: a hull, and points that arrived since the last refine() or a tree
   /// that started anew while points are kept.
@@ -63,6 +88,7 @@ class PointCarvedStream {
     size_t free_voxels = 0;       ///< the hull's free voxels afterwards
     size_t points_used = 0;       ///< kept points inside the hull
     int64_t newest_stamp_ns = 0;  ///< of the newest pair kept
+    size_t pairs_refused = 0;     ///< waiting pairs whose camera lies beyond the cube's margin
   };
   /// Carves the hull with the free voxels of every point kept that lies inside it. Requires
   /// stream().hasHull().
@@ -80,6 +106,11 @@ class PointCarvedStream {
   size_t freeVoxelCount() const { return free_voxels_; }
 
  private:
+  /// Why a camera is beyond the cube's margin (empty: it is not). Requires a hull.
+  std::string farCamera(const PinholeCamera& camera) const;
+  bool insideMargin(const Eigen::Vector3d& X_W) const;
+  size_t dropFarPairs();
+
   struct PairPoints {
     PinholeCamera left, right;
     std::vector<SurfacePoint> points;

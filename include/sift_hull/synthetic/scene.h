@@ -84,6 +84,16 @@ struct SceneData {
 /// Throws ParseError / std::runtime_error naming the file at fault.
 SceneData readScene(const std::string& directory);
 
+/// Throws std::runtime_error naming the scene directory, `views_source` (where the views were
+/// read from) and the first view at fault when the views are not views of the scene: a name the
+/// scene does not hold, a camera that sees the scene's solid (its bounding sphere) more than 1 %
+/// of the image diagonal (at least 2 px) from where the scene's camera of that name does, or a
+/// silhouette whose intersection over union with the scene's mask is below 0.5 (when the input
+/// holds silhouettes: without, the names and cameras are compared). A ground truth
+/// of another scene would otherwise score the views against the wrong solid.
+void requireViewsOfScene(const SceneData& scene, const std::string& scene_directory,
+                         const HullInput& input, const std::string& views_source);
+
 /// "view_0003.png" -> "view_0003.pfm".
 std::string depthFileName(const std::string& view_name);
 

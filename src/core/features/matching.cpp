@@ -13,10 +13,6 @@
 namespace sift_hull {
 namespace {
 
-void require(bool condition, const std::string& message) {
-  if (!condition) throw std::invalid_argument("MatchConfig: " + message);
-}
-
 cv::Ptr<cv::DescriptorMatcher> makeMatcher(const std::string& backend) {
   if (backend == "flann") return cv::FlannBasedMatcher::create();
   return cv::BFMatcher::create(cv::NORM_L2);

@@ -9,10 +9,6 @@
 namespace sift_hull {
 namespace {
 
-void require(bool condition, const std::string& message) {
-  if (!condition) throw std::invalid_argument("filter config: " + message);
-}
-
 /// A filter made of a function of the input and a config.
 template <typename Config>
 class FunctionFilter : public MatchFilter {

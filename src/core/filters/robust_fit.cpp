@@ -10,10 +10,6 @@
 namespace sift_hull {
 namespace {
 
-void requireFit(bool condition, const std::string& message) {
-  if (!condition) throw std::invalid_argument("filter config: " + message);
-}
-
 /// OpenCV's USAC_MAGSAC flag spelled out (its sampler, score and local optimisation), so that the
 /// random state can be set.
 cv::UsacParams magsacParams(double threshold_px, const RobustFitConfig& config, bool homography) {

@@ -122,8 +122,7 @@ void ringSearch(const Grid& grid, const std::vector<cv::Point2f>& points, int i,
 }
 
 /// The points of the 3x3 block of cells around (cx, cy).
-void gatherBlock(const Grid& grid, const std::vector<cv::Point2f>& points, int cx, int cy,
-                 std::vector<int>* block) {
+void gatherBlock(const Grid& grid, int cx, int cy, std::vector<int>* block) {
   block->clear();
   for (int y = std::max(0, cy - 1); y <= std::min(grid.rows - 1, cy + 1); ++y) {
     for (int x = std::max(0, cx - 1); x <= std::min(grid.columns - 1, cx + 1); ++x) {
@@ -171,7 +170,7 @@ SpatialNeighbours::SpatialNeighbours(const std::vector<cv::Point2f>& points, siz
     for (int cx = 0; cx < grid.columns; ++cx) {
       const int c = cy * grid.columns + cx;
       if (grid.start[c] == grid.start[c + 1]) continue;
-      gatherBlock(grid, points, cx, cy, &block);
+      gatherBlock(grid, cx, cy, &block);
       bx.resize(block.size()), by.resize(block.size());
       for (size_t b = 0; b < block.size(); ++b)
         bx[b] = points[block[b]].x, by[b] = points[block[b]].y;

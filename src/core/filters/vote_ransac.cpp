@@ -22,6 +22,10 @@ constexpr double kFurtherMotionShare = 2.0 / 3.0;
 /// A local sample is clean about as often as a global sample of two matches: its seed must lie on
 /// the motion and its neighbourhood must not straddle another.
 constexpr int kLocalSampleWeight = 2;
+/// A motion is compared with chance within a residual where chance explains at most this share of
+/// the pairs: 4 times as many then asks it to explain a quarter of them (at the default thresholds
+/// chance explains far less, and the comparison is made at the threshold itself).
+constexpr double kChanceShareJudged = 1.0 / 16.0;
 
 /// The matches the motions are fitted to, with what each one votes for (NaN: no vote).
 struct FitSet {
@@ -119,9 +123,9 @@ std::vector<int> votedPool(const FitSet& set, const VoteRansacConfig& config,
                                std::log2(config.max_scale_ratio), 0.0, &count);
 }
 
-/// How many pairs the model explains when each left point meets the right point of another
+/// A model's squared residuals of the pairs when each left point meets the right point of another
 /// match (the right points shifted by half the set): what chance alone gives it.
-size_t chanceInliers(const TwoViewModel& model, const PointPairs& pairs, double threshold_px) {
+void chanceResiduals(const TwoViewModel& model, const PointPairs& pairs, std::vector<float>* r2) {
   PointPairs shuffled = pairs;
   const size_t n = pairs.size(), shift = n == 0 ? 0 : (n / 2 + 1) % n;
   // right point i of the shuffled pairs is right point (i + shift) mod n
@@ -129,10 +133,35 @@ size_t chanceInliers(const TwoViewModel& model, const PointPairs& pairs, double 
                    shuffled.right_x.begin());
   std::rotate_copy(pairs.right_y.begin(), pairs.right_y.begin() + long(shift), pairs.right_y.end(),
                    shuffled.right_y.begin());
-  std::vector<float> r2;
-  squaredResiduals(model, shuffled, &r2);
-  const float t2 = static_cast<float>(threshold_px * threshold_px);
+  squaredResiduals(model, shuffled, r2);
+}
+
+size_t countWithin(const std::vector<float>& r2, float t2) {
   return static_cast<size_t>(std::count_if(r2.begin(), r2.end(), [&](float e) { return e <= t2; }));
+}
+
+size_t countBelow(const std::vector<float>& r2, float t2) {
+  return static_cast<size_t>(std::count_if(r2.begin(), r2.end(), [&](float e) { return e < t2; }));
+}
+
+/// How many pairs a model must explain within `threshold_px` to be more than chance: 4 times what
+/// chance gives it. Where chance alone explains more than kChanceShareJudged of the pairs within
+/// the threshold (a wide threshold over points that spread little: no motion with mismatches
+/// could then explain 4 times as many), the model is compared with chance within the narrower
+/// residual where chance explains that share, since a motion's matches lie near it at any
+/// threshold and chance's do not: 0 when it explains 4 times as many there, else more than all.
+size_t neededBeyondChance(const TwoViewModel& model, const PointPairs& pairs,
+                          double threshold_px) {
+  std::vector<float> chance_r2, r2;
+  chanceResiduals(model, pairs, &chance_r2);
+  const size_t chance = countWithin(chance_r2, static_cast<float>(threshold_px * threshold_px));
+  const size_t share = static_cast<size_t>(kChanceShareJudged * double(pairs.size()));
+  if (chance <= share || share == 0) return 4 * chance;
+  std::nth_element(chance_r2.begin(), chance_r2.begin() + long(share), chance_r2.end());
+  const float narrower2 = chance_r2[share];  // at most `share` chance residuals lie below it
+  squaredResiduals(model, pairs, &r2);
+  const size_t beyond = 4 * std::max<size_t>(1, countBelow(chance_r2, narrower2));
+  return countBelow(r2, narrower2) >= beyond ? 0 : pairs.size() + 1;
 }
 
 size_t countIn(const std::vector<int>& inliers, const std::vector<int>& pool, size_t size) {
@@ -188,7 +217,7 @@ TwoViewFit fitMotion(const FitSet& set, const std::vector<int>& pool, bool furth
   TwoViewFit chosen = use_h ? H : F;
   const double threshold = use_h ? guided.max_transfer_px : fit.max_epipolar_px;
   size_t needed = std::max<size_t>(size_t(guided.min_model_inliers),
-                                   4 * chanceInliers(chosen.model, set.pairs, threshold));
+                                   neededBeyondChance(chosen.model, set.pairs, threshold));
   if (further)
     needed = std::max<size_t>(needed, size_t(std::ceil(kFurtherMotionShare * pool_size)));
   const size_t explained_in_pool =

@@ -182,6 +182,21 @@ bool PinholeCamera::distortionInvertibleOver(const Eigen::Vector2d& raw_min_px,
   return true;
 }
 
+void requireUnfoldedDistortion(const std::string& name, const PinholeCamera& camera, int width_px,
+                               int height_px, int padding_px) {
+  if (!camera.distorted()) return;
+  // The image's pixels reach half a pixel past the first and last pixel centres.
+  const double pad = padding_px + 0.5;
+  const Eigen::Vector2d low(-pad, -pad);
+  const Eigen::Vector2d high(width_px - 1 + pad, height_px - 1 + pad);
+  if (!camera.distortionInvertibleOver(low, high)) {
+    throw std::invalid_argument("view '" + name + "': its lens distortion folds over within its " +
+                                std::to_string(width_px) + "x" + std::to_string(height_px) +
+                                " image (no one-to-one undistortion): check the coefficients and "
+                                "the image size");
+  }
+}
+
 Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
   Eigen::Matrix3d m;
   m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;

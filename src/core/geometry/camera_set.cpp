@@ -2,6 +2,9 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <cmath>
+#include <iomanip>
+#include <sstream>
 #include <stdexcept>
 
 namespace sift_hull {
@@ -75,6 +78,43 @@ double camerasMutualDistance(const std::vector<PinholeCamera>& cameras) {
     }
   }
   return distance;
+}
+
+namespace {
+
+/// The median of `values` (the upper one of an even count).
+double median(std::vector<double> values) {
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  return values[values.size() / 2];
+}
+
+}  // namespace
+
+void requireNoStrayCamera(const std::vector<PinholeCamera>& cameras,
+                          const std::vector<std::string>& names) {
+  if (cameras.size() < 3) return;
+  Eigen::Vector3d centre;
+  for (int axis = 0; axis < 3; ++axis) {
+    std::vector<double> coordinates;
+    for (const PinholeCamera& camera : cameras) coordinates.push_back(camera.centre()(axis));
+    centre(axis) = median(coordinates);
+  }
+  std::vector<double> distances;
+  for (const PinholeCamera& camera : cameras) {
+    distances.push_back((camera.centre() - centre).stableNorm());  // no overflow near 1e308
+  }
+  const double typical = median(distances);
+  if (!(typical > 0.0) || !std::isfinite(typical)) return;
+  for (size_t i = 0; i < cameras.size(); ++i) {
+    if (distances[i] <= kMaxCameraSpread * typical) continue;
+    std::ostringstream message;
+    message << std::setprecision(3) << "view '"
+            << (names.size() == cameras.size() ? names[i] : std::to_string(i))
+            << "': its camera lies " << distances[i]
+            << " from the cameras' median centre, more than " << kMaxCameraSpread
+            << " times their median distance from it (" << typical << "): check its translation";
+    throw std::invalid_argument(message.str());
+  }
 }
 
 }  // namespace sift_hull

@@ -4,6 +4,9 @@
 
 #include <array>
 #include <cmath>
+#include <stdexcept>
+#include <string>
+#include <utility>
 
 #include "hull/octree_node.h"
 #include "hull/voxel_key.h"
@@ -138,6 +141,58 @@ void VisualHull::addFreeField(const std::vector<Eigen::Vector3d>& points_W,
       }
     }
   }
+}
+
+
+namespace {
+
+/// The finest voxels of `cell` within [lo, hi] (inclusive), as two corners; false when none.
+bool cellSpan(const HullCell& cell, int depth, const Eigen::Vector3i& lo, const Eigen::Vector3i& hi,
+              Eigen::Vector3i* first, Eigen::Vector3i* last) {
+  const int scale = 1 << (depth - cell.depth);
+  *first = (cell.index * scale).cwiseMax(lo);
+  *last = ((cell.index + Eigen::Vector3i::Ones()) * scale - Eigen::Vector3i::Ones()).cwiseMin(hi);
+  return (first->array() <= last->array()).all();
+}
+
+}  // namespace
+
+std::vector<Eigen::Vector3i> occupiedVoxelsIn(const VisualHull& hull, const Box3d& box_W,
+                                              size_t max_voxels) {
+  const HullCube& cube = hull.cube();
+  const int cells = 1 << cube.depth;
+  const Eigen::Vector3d lo_f = ((box_W.min_W - cube.origin_W()) / cube.resolution_m).array().floor();
+  const Eigen::Vector3d hi_f = ((box_W.max_W - cube.origin_W()) / cube.resolution_m).array().floor();
+  const Eigen::Vector3d last(cells - 1, cells - 1, cells - 1);
+  // Clamped in double first: a box far outside the cube must not overflow an int.
+  const Eigen::Vector3i lo = lo_f.cwiseMax(Eigen::Vector3d::Zero()).cwiseMin(last).cast<int>();
+  const Eigen::Vector3i hi = hi_f.cwiseMax(Eigen::Vector3d::Zero()).cwiseMin(last).cast<int>();
+  std::vector<Eigen::Vector3i> voxels;
+  if ((lo_f.array() > last.array()).any() || (hi_f.array() < 0.0).any()) return voxels;
+  size_t count = 0;
+  std::vector<std::pair<Eigen::Vector3i, Eigen::Vector3i>> spans;
+  hull.forEachLeaf([&](const HullCell& cell) {
+    Eigen::Vector3i first, end;
+    if (cell.state == CellState::kOut || !cellSpan(cell, cube.depth, lo, hi, &first, &end)) return;
+    const Eigen::Vector3i extent = end - first + Eigen::Vector3i::Ones();
+    count += static_cast<size_t>(extent.x()) * static_cast<size_t>(extent.y()) *
+             static_cast<size_t>(extent.z());
+    spans.emplace_back(first, end);
+  });
+  if (count > max_voxels) {
+    throw std::invalid_argument("the box touches " + std::to_string(count) +
+                                " occupied voxels, more than " + std::to_string(max_voxels) +
+                                " cleared at once");
+  }
+  voxels.reserve(count);
+  for (const auto& span : spans) {
+    for (int z = span.first.z(); z <= span.second.z(); ++z) {
+      for (int y = span.first.y(); y <= span.second.y(); ++y) {
+        for (int x = span.first.x(); x <= span.second.x(); ++x) voxels.emplace_back(x, y, z);
+      }
+    }
+  }
+  return voxels;
 }
 
 }  // namespace sift_hull

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "common/parallel.h"
+#include "sift_hull/geometry/camera_set.h"
 #include "sift_hull/hull/bounding_box.h"
 #include "sift_hull/hull/reduced_distance_map.h"
 
@@ -73,6 +74,9 @@ HullResult buildHull(const HullInput& input, const HullConfig& config,
   time.masks_ms = millisecondsSince(start);
 
   Clock::time_point stage = Clock::now();
+  // One camera far from the others would set the LP's frame and scale, and the LP would then
+  // blame the others; it is named here instead.
+  if (!box) requireNoStrayCamera(input.cameras, input.names);
   const Box3d hull_box = box ? *box : hullBoundingBox(input.cameras, bounds, input.names);
   time.bbox_ms = millisecondsSince(stage);
 

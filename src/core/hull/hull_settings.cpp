@@ -104,7 +104,9 @@ const SettingTable<HullStreamConfig>& settingsOf<HullStreamConfig>() {
                 "[xmin, ymin, zmin, xmax, ymax, zmax] in the world frame; empty: the box the "
                 "first views bound",
                 boxNumbers, setBoxNumbers);
-    t.add("skip_views", &HullStreamConfig::skip_views, "", "names (frame ids) of views left out");
+    t.add("skip_views", &HullStreamConfig::skip_views, "",
+          "names of views left out: file names; in the hull node frame ids, or FRAME@SEC.NSEC "
+          "(the stamp's seconds, nanoseconds in 9 digits) for one view of a moving camera");
     t.add("min_view_distance_m", &HullStreamConfig::min_view_distance_m, "m",
           "a view whose camera centre is this close to a view taken, and ...")
         .atLeast(0.0);

@@ -41,26 +41,11 @@ bool withinBounds(const SilhouetteBounds& bounds, double u, double v) {
          (!bounds.has_v_min || v >= bounds.v_min_px) && (!bounds.has_v_max || v <= bounds.v_max_px);
 }
 
-/// The raw image with the distance map's padding, as a raw pixel rectangle (min, max).
-std::pair<Eigen::Vector2d, Eigen::Vector2d> paddedImage(cv::Size size, int padding_px) {
-  const double pad = padding_px + 0.5;
-  return {Eigen::Vector2d(-pad, -pad),
-          Eigen::Vector2d(size.width - 1 + pad, size.height - 1 + pad)};
-}
-
 /// Throws std::invalid_argument when the view's distortion cannot be inverted over its padded
 /// image: the coefficients do not describe a lens for an image of this size.
 void checkDistortion(const std::string& name, const PinholeCamera& camera, cv::Size size,
                      int padding_px) {
-  if (!camera.distorted()) return;
-  const auto [low, high] = paddedImage(size, padding_px);
-  if (!camera.distortionInvertibleOver(low, high)) {
-    throw std::invalid_argument("view '" + name + "': its lens distortion " +
-                                "folds over within its " + std::to_string(size.width) + "x" +
-                                std::to_string(size.height) +
-                                " image (no one-to-one undistortion): check the coefficients and "
-                                "the image size");
-  }
+  requireUnfoldedDistortion(name, camera, size.width, size.height, padding_px);
 }
 
 /// The bounds of the undistorted silhouette, in ideal pixels: the extremes of its boundary pixels'

@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <iomanip>
+#include <map>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
@@ -31,13 +32,15 @@ struct Line {
   std::vector<std::string> fields;
 };
 
-/// Non-blank, non-comment lines of a text file, split at white space and commas.
+/// Non-blank, non-comment lines of a text file, split at white space and commas; a UTF-8
+/// byte-order mark at its start is skipped.
 std::vector<Line> readFields(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw ParseError(path, 0, "cannot open file");
   std::vector<Line> lines;
   std::string text;
   for (int number = 1; std::getline(in, text); ++number) {
+    if (number == 1 && text.compare(0, 3, "\xEF\xBB\xBF") == 0) text.erase(0, 3);
     if (text.find('\0') != std::string::npos) {
       throw ParseError(path, number, "the line holds a NUL byte: not a text file");
     }
@@ -86,7 +89,11 @@ template <typename MakeCamera>
 CalibratedView makeView(const std::string& name, const Line& line, const std::string& path,
                         MakeCamera make_camera) {
   try {
-    return CalibratedView{name, make_camera(), location(path, line.number), {}};
+    CalibratedView view;
+    view.name = name;
+    view.camera = make_camera();
+    view.source = location(path, line.number);
+    return view;
   } catch (const std::invalid_argument& e) {
     throw ParseError(path, line.number, e.what());
   }
@@ -208,6 +215,23 @@ bool looksLikeCountLine(const Line& line) {
   return word.find_first_not_of("0123456789") == std::string::npos;
 }
 
+/// Throws ParseError naming both lines when two views have the same image name (a view counted
+/// twice); `lines[i]` is the line view i starts on. Unnamed views are not compared.
+void refuseDuplicateNames(const std::vector<CalibratedView>& views, const std::vector<int>& lines,
+                          const std::string& path) {
+  std::map<std::string, int> first_line;
+  for (size_t i = 0; i < views.size(); ++i) {
+    if (views[i].name.empty()) continue;
+    const auto [first, inserted] = first_line.emplace(views[i].name, lines[i]);
+    if (!inserted) {
+      throw ParseError(path, lines[i],
+                       "image '" + views[i].name + "' is given twice, on lines " +
+                           std::to_string(first->second) + " and " + std::to_string(lines[i]) +
+                           ": each view must be listed once");
+    }
+  }
+}
+
 }  // namespace
 
 ParseError::ParseError(const std::string& file, int line, const std::string& message)
@@ -218,12 +242,17 @@ std::vector<CalibratedView> readMiddleburyPar(const std::string& path) {
   if (lines.empty()) throw ParseError(path, 0, "empty file, expected a count line");
   const int count = parseCount(lines.front(), path);
   std::vector<CalibratedView> views;
-  for (size_t i = 1; i < lines.size(); ++i) views.push_back(parseParLine(lines[i], path));
+  std::vector<int> view_lines;
+  for (size_t i = 1; i < lines.size(); ++i) {
+    views.push_back(parseParLine(lines[i], path));
+    view_lines.push_back(lines[i].number);
+  }
   if (static_cast<int>(views.size()) != count) {
     throw ParseError(path, lines.front().number,
                      "count line says " + std::to_string(count) + " views but the file has " +
                          std::to_string(views.size()));
   }
+  refuseDuplicateNames(views, view_lines, path);
   return views;
 }
 
@@ -231,7 +260,12 @@ std::vector<CalibratedView> readProjectionList(const std::string& path) {
   const std::vector<Line> lines = readFields(path);
   if (lines.empty()) throw ParseError(path, 0, "empty file, expected 3x4 projection matrices");
   std::vector<CalibratedView> views;
-  for (size_t i = 0; i < lines.size();) views.push_back(parseProjection(lines, &i, path));
+  std::vector<int> view_lines;
+  for (size_t i = 0; i < lines.size();) {
+    view_lines.push_back(lines[i].number);
+    views.push_back(parseProjection(lines, &i, path));
+  }
+  refuseDuplicateNames(views, view_lines, path);
   orientViews(&views, path);
   return views;
 }

@@ -8,20 +8,16 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <iomanip>
 #include <set>
 #include <sstream>
 
+#include "colmap_internal.h"
 #include "sift_hull/limits.h"
 
 namespace sift_hull {
+namespace colmap_detail {
 namespace {
-
-struct ModelInfo {
-  int id;
-  const char* name;
-  int params;
-  bool supported;
-};
 
 // COLMAP's camera models (colmap/sensor/models.h), id, name and number of parameters.
 constexpr ModelInfo kModels[] = {
@@ -39,6 +35,8 @@ constexpr ModelInfo kModels[] = {
     {11, "RAD_TAN_THIN_PRISM_FISHEYE", 16, false},
 };
 
+}  // namespace
+
 const ModelInfo* modelById(int64_t id) {
   for (const ModelInfo& m : kModels) {
     if (m.id == id) return &m;
@@ -53,14 +51,9 @@ const ModelInfo* modelByName(const std::string& name) {
   return nullptr;
 }
 
-bool fileExists(const std::string& path) {
-  struct stat info;
-  return ::stat(path.c_str(), &info) == 0 && S_ISREG(info.st_mode);
-}
-
-/// Intrinsics from a model's parameters (COLMAP's order), or a ParseError at (file, line).
 ColmapCamera makeCamera(const ModelInfo& model, uint64_t width, uint64_t height,
-                        const std::vector<double>& p, const std::string& file, int line) {
+                        const std::vector<double>& p, const std::string& file, int line,
+                        const std::string& source) {
   if (!model.supported) {
     throw ParseError(file, line,
                      std::string("camera model ") + model.name +
@@ -86,6 +79,7 @@ ColmapCamera makeCamera(const ModelInfo& model, uint64_t width, uint64_t height,
   camera.model = model.name;
   camera.width_px = width;
   camera.height_px = height;
+  camera.source = source;
   const std::string name = model.name;
   const bool one_focal = name == "SIMPLE_PINHOLE" || name == "SIMPLE_RADIAL" || name == "RADIAL";
   const double fx = p[0];
@@ -120,21 +114,39 @@ ColmapCamera makeCamera(const ModelInfo& model, uint64_t width, uint64_t height,
   return camera;
 }
 
-/// A view from an image's pose; throws ParseError at (file, line) for a bad pose or camera id.
-CalibratedView makeView(const std::string& name, const double q[4], const double t[3],
-                        uint32_t camera_id, const std::map<uint32_t, ColmapCamera>& cameras,
-                        const std::string& file, int line, const std::string& source) {
+namespace {
+
+/// How far from 1 a quaternion's norm may be: within it the quaternion is normalised, as COLMAP
+/// does (its files hold rounded numbers); further from 1 it is refused, as a quaternion scaled by
+/// a wrong column or unit is no rotation as written.
+constexpr double kQuaternionNormTolerance = 0.01;
+
+/// The unit quaternion of q (w, x, y, z), or a ParseError at (file, line) naming its norm.
+Eigen::Quaterniond unitQuaternion(const double q[4], const std::string& file, int line) {
   for (int i = 0; i < 4; ++i) {
     if (!std::isfinite(q[i])) throw ParseError(file, line, "the quaternion is not finite");
   }
+  const Eigen::Quaterniond quaternion(q[0], q[1], q[2], q[3]);
+  const double norm = quaternion.norm();
+  if (!(std::abs(norm - 1.0) <= kQuaternionNormTolerance)) {
+    std::ostringstream message;
+    message << std::setprecision(9) << "the quaternion (" << q[0] << ", " << q[1] << ", " << q[2]
+            << ", " << q[3] << ") is not of unit length: its norm is " << norm << " (1 to within "
+            << kQuaternionNormTolerance << " is normalised)";
+    throw ParseError(file, line, message.str());
+  }
+  return quaternion.normalized();
+}
+
+}  // namespace
+
+CalibratedView makeView(const std::string& name, const double q[4], const double t[3],
+                        uint32_t camera_id, const std::map<uint32_t, ColmapCamera>& cameras,
+                        const std::string& file, int line, const std::string& source) {
+  const Eigen::Quaterniond quaternion = unitQuaternion(q, file, line);
   for (int i = 0; i < 3; ++i) {
     if (!std::isfinite(t[i])) throw ParseError(file, line, "the translation is not finite");
   }
-  Eigen::Quaterniond quaternion(q[0], q[1], q[2], q[3]);
-  if (!(quaternion.norm() > 1e-6) || !std::isfinite(quaternion.norm())) {
-    throw ParseError(file, line, "the quaternion is zero");
-  }
-  quaternion.normalize();
   const auto camera = cameras.find(camera_id);
   if (camera == cameras.end()) {
     throw ParseError(file, line,
@@ -146,6 +158,9 @@ CalibratedView makeView(const std::string& name, const double q[4], const double
   view.name = name;
   view.source = source;
   view.camera_model = camera->second.model;
+  view.width_px = camera->second.width_px;
+  view.height_px = camera->second.height_px;
+  view.size_source = camera->second.source;
   try {
     view.camera = PinholeCamera(camera->second.K, quaternion.toRotationMatrix(),
                                 Eigen::Vector3d(t[0], t[1], t[2]))
@@ -156,109 +171,15 @@ CalibratedView makeView(const std::string& name, const double q[4], const double
   return view;
 }
 
-// ---- text model ---------------------------------------------------------------------------------
+}  // namespace colmap_detail
 
-struct TextLine {
-  int number;
-  std::vector<std::string> fields;
-};
+namespace {
 
-/// Lines of a text file, comments ('#' first) dropped, blank lines kept (an image's second line).
-std::vector<TextLine> readTextLines(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw ParseError(path, 0, "cannot open file");
-  std::vector<TextLine> lines;
-  std::string text;
-  for (int number = 1; std::getline(in, text); ++number) {
-    if (text.find('\0') != std::string::npos) {
-      throw ParseError(path, number, "the line holds a NUL byte: not a text file");
-    }
-    std::istringstream words(text);
-    TextLine line{number, {}};
-    for (std::string word; words >> word;) line.fields.push_back(word);
-    if (!line.fields.empty() && line.fields.front()[0] == '#') continue;
-    lines.push_back(std::move(line));
-  }
-  return lines;
-}
+using colmap_detail::ModelInfo;
 
-double textNumber(const std::string& word, const std::string& file, int line) {
-  char* end = nullptr;
-  const double value = std::strtod(word.c_str(), &end);
-  if (word.empty() || end != word.c_str() + word.size()) {
-    throw ParseError(file, line, "'" + word + "' is not a number");
-  }
-  if (!std::isfinite(value)) throw ParseError(file, line, "'" + word + "' is not finite");
-  return value;
-}
-
-uint64_t textInteger(const std::string& word, uint64_t max, const std::string& file, int line) {
-  if (word.empty() || word.find_first_not_of("0123456789") != std::string::npos ||
-      word.size() > 12 || std::strtoull(word.c_str(), nullptr, 10) > max) {
-    throw ParseError(file, line, "'" + word + "' is not an integer in 0.." + std::to_string(max));
-  }
-  return std::strtoull(word.c_str(), nullptr, 10);
-}
-
-std::map<uint32_t, ColmapCamera> readCamerasText(const std::string& file) {
-  std::map<uint32_t, ColmapCamera> cameras;
-  for (const TextLine& line : readTextLines(file)) {
-    if (line.fields.empty()) continue;
-    if (line.fields.size() < 4) {
-      throw ParseError(file, line.number,
-                       "expected CAMERA_ID MODEL WIDTH HEIGHT PARAMS..., found " +
-                           std::to_string(line.fields.size()) + " fields");
-    }
-    const uint32_t id =
-        static_cast<uint32_t>(textInteger(line.fields[0], UINT32_MAX, file, line.number));
-    const ModelInfo* model = modelByName(line.fields[1]);
-    if (model == nullptr) {
-      throw ParseError(file, line.number, "unknown camera model '" + line.fields[1] + "'");
-    }
-    const uint64_t width = textInteger(line.fields[2], UINT32_MAX, file, line.number);
-    const uint64_t height = textInteger(line.fields[3], UINT32_MAX, file, line.number);
-    std::vector<double> params;
-    for (size_t i = 4; i < line.fields.size(); ++i) {
-      params.push_back(textNumber(line.fields[i], file, line.number));
-    }
-    if (cameras.count(id)) {
-      throw ParseError(file, line.number, "camera " + std::to_string(id) + " given twice");
-    }
-    if (cameras.size() >= limits::kMaxCalibrationViews) {
-      throw ParseError(file, line.number, "more cameras than the limit of 1000000");
-    }
-    cameras[id] = makeCamera(*model, width, height, params, file, line.number);
-  }
-  if (cameras.empty()) throw ParseError(file, 0, "no cameras");
-  return cameras;
-}
-
-std::vector<CalibratedView> readImagesText(const std::string& file,
-                                           const std::map<uint32_t, ColmapCamera>& cameras) {
-  const std::vector<TextLine> lines = readTextLines(file);
-  std::vector<CalibratedView> views;
-  for (size_t i = 0; i < lines.size(); ++i) {
-    const TextLine& line = lines[i];
-    if (line.fields.empty()) continue;  // blank lines between images
-    if (line.fields.size() != 10) {
-      throw ParseError(file, line.number,
-                       "expected IMAGE_ID QW QX QY QZ TX TY TZ CAMERA_ID NAME, found " +
-                           std::to_string(line.fields.size()) + " fields");
-    }
-    textInteger(line.fields[0], UINT32_MAX, file, line.number);
-    double q[4], t[3];
-    for (int k = 0; k < 4; ++k) q[k] = textNumber(line.fields[1 + k], file, line.number);
-    for (int k = 0; k < 3; ++k) t[k] = textNumber(line.fields[5 + k], file, line.number);
-    const uint32_t camera_id =
-        static_cast<uint32_t>(textInteger(line.fields[8], UINT32_MAX, file, line.number));
-    if (views.size() >= limits::kMaxCalibrationViews) {
-      throw ParseError(file, line.number, "more images than the limit of 1000000");
-    }
-    views.push_back(makeView(line.fields[9], q, t, camera_id, cameras, file, line.number,
-                             file + ":" + std::to_string(line.number)));
-    ++i;  // the POINTS2D line (possibly empty) follows; its content is not needed
-  }
-  return views;
+bool fileExists(const std::string& path) {
+  struct stat info;
+  return ::stat(path.c_str(), &info) == 0 && S_ISREG(info.st_mode);
 }
 
 // ---- binary model -------------------------------------------------------------------------------
@@ -356,7 +277,7 @@ std::map<uint32_t, ColmapCamera> parseColmapCamerasBinary(std::istream& in, uint
     const int32_t model_id = reader.read<int32_t>("a camera model");
     const uint64_t width = reader.read<uint64_t>("a width");
     const uint64_t height = reader.read<uint64_t>("a height");
-    const ModelInfo* model = modelById(model_id);
+    const ModelInfo* model = colmap_detail::modelById(model_id);
     const std::string where = "camera " + std::to_string(id) + " at byte " + std::to_string(at);
     if (model == nullptr)
       reader.fail(where + ": unknown camera model id " + std::to_string(model_id));
@@ -364,7 +285,8 @@ std::map<uint32_t, ColmapCamera> parseColmapCamerasBinary(std::istream& in, uint
     reader.bytes(params.data(), params.size() * sizeof(double), "camera parameters");
     if (cameras.count(id)) reader.fail(where + ": camera id given twice");
     try {
-      cameras[id] = makeCamera(*model, width, height, params, file, 0);
+      cameras[id] = colmap_detail::makeCamera(*model, width, height, params, file, 0,
+                                              file + " (" + where + ")");
     } catch (const ParseError& e) {
       reader.fail(where + ": " + std::string(e.what()).substr(file.size() + 2));
     }
@@ -395,7 +317,8 @@ std::vector<CalibratedView> parseColmapImagesBinary(
     reader.skip(points * 24, "the points");
     const std::string where = "image " + std::to_string(id) + " at byte " + std::to_string(at);
     try {
-      views.push_back(makeView(name, q, t, camera_id, cameras, file, 0, file + " (" + where + ")"));
+      views.push_back(colmap_detail::makeView(name, q, t, camera_id, cameras, file, 0,
+                                              file + " (" + where + ")"));
     } catch (const ParseError& e) {
       reader.fail(where + ": " + std::string(e.what()).substr(file.size() + 2));
     }
@@ -421,7 +344,9 @@ std::vector<CalibratedView> readColmapModel(const std::string& directory) {
   const std::string text_cameras = directory + "/cameras.txt";
   const std::string text_images = directory + "/images.txt";
   if (fileExists(text_cameras) && fileExists(text_images)) {
-    return sortedByName(readImagesText(text_images, readCamerasText(text_cameras)), text_images);
+    return sortedByName(
+        colmap_detail::readImagesText(text_images, colmap_detail::readCamerasText(text_cameras)),
+        text_images);
   }
   const std::string bin_cameras = directory + "/cameras.bin";
   const std::string bin_images = directory + "/images.bin";

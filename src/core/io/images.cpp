@@ -17,6 +17,21 @@ cv::Mat readImageFile(const std::string& path, int flags) {
 
 }  // namespace
 
+void checkImageSize(const CalibratedView& view, cv::Size image_size,
+                    const std::string& image_path) {
+  if (view.width_px == 0 && view.height_px == 0) return;
+  // Compared in 64 bits: the calibration's sides are not limited to int.
+  if (view.width_px == static_cast<uint64_t>(image_size.width) &&
+      view.height_px == static_cast<uint64_t>(image_size.height)) {
+    return;
+  }
+  throw std::runtime_error(view.size_source + ": the camera of view '" + view.name + "' is " +
+                           std::to_string(view.width_px) + "x" + std::to_string(view.height_px) +
+                           " (WIDTH x HEIGHT) but the image " + image_path + " is " +
+                           std::to_string(image_size.width) + "x" +
+                           std::to_string(image_size.height));
+}
+
 cv::Mat readImage(const std::string& path) {
   cv::Mat image = readImageFile(path, cv::IMREAD_COLOR);
   if (image.empty()) throw std::runtime_error(path + ": image missing or unreadable");
@@ -32,6 +47,7 @@ cv::Mat loadViewImage(const std::string& directory, const CalibratedView& view) 
   const std::string path = directory + "/" + view.name;
   cv::Mat image = readImageFile(path, cv::IMREAD_COLOR);
   if (image.empty()) throw std::runtime_error(path + ": image missing or unreadable" + named_at);
+  checkImageSize(view, image.size(), path);
   return image;
 }
 

@@ -179,14 +179,19 @@ double imageScale(const std::string& npy_path, const std::string& where, double 
                   double height, int image_width_px, int image_height_px) {
   if (image_width_px <= 0 || image_height_px <= 0) return 1.0;
   const double scale = image_width_px / width;
-  if (!(std::abs(scale * height - image_height_px) <= 1.0)) {
-    std::ostringstream message;
-    message << where << ": the images are " << image_width_px << "x" << image_height_px
-            << " but the poses' [height, width] is " << height << "x" << width
-            << ", not a downscaled copy of one factor";
-    fail(npy_path, message.str());
+  if (std::abs(scale * height - image_height_px) <= 1.0) return scale;
+  std::ostringstream message;
+  message << where << ": the images are " << image_width_px << "x" << image_height_px
+          << " (width x height) but the poses' [height, width] is " << height << "x" << width;
+  const double swapped_scale = image_width_px / height;
+  if (height != width && std::abs(swapped_scale * width - image_height_px) <= 1.0) {
+    message << ": height and width are swapped (the poses give height " << height << " and width "
+            << width << "; the images are " << image_height_px << " high and " << image_width_px
+            << " wide)";
+  } else {
+    message << ", not a downscaled copy of one factor";
   }
-  return scale;
+  fail(npy_path, message.str());
 }
 
 }  // namespace

@@ -190,10 +190,11 @@ std::vector<CalibratedView> sceneCameras(const SceneConfig& config, const Shape&
     const Eigen::Vector3d target = shape.boundingCentre();
     const Eigen::Vector3d centre =
         target + config.camera_distance_m * viewDirection(config, i, &rng);
-    views.push_back({numbered("view", i, "png"),
-                     PinholeCamera::fromCentre(K, lookAt(centre, target), centre)
-                         .withDistortion(config.distortion),
-                     "", ""});
+    CalibratedView view;
+    view.name = numbered("view", i, "png");
+    view.camera = PinholeCamera::fromCentre(K, lookAt(centre, target), centre)
+                      .withDistortion(config.distortion);
+    views.push_back(view);
   }
   return views;
 }

@@ -12,6 +12,7 @@
 #include <stdexcept>
 
 #include "lib/conversions.h"
+#include "sift_hull/limits.h"
 
 namespace sift_hull {
 namespace ros_conversions {
@@ -166,10 +167,21 @@ bool sizeMatches(const sensor_msgs::CameraInfo& info, cv::Size image_size, std::
   return true;
 }
 
-bool makeCamera(const CameraInfoGeometry& g, const Eigen::Matrix3d& R_I_W,
-                const Eigen::Vector3d& t_I_W, PinholeCamera* camera, std::string* why_not) {
+/// The camera, refused (as the hull refuses its views) when its lens distortion folds over within
+/// the camera_info's image.
+bool makeCamera(const CameraInfoGeometry& g, const sensor_msgs::CameraInfo& info,
+                const Eigen::Matrix3d& R_I_W, const Eigen::Vector3d& t_I_W, PinholeCamera* camera,
+                std::string* why_not) {
+  if (!g.distortion.isZero() &&
+      (info.width > limits::kMaxImageSidePx || info.height > limits::kMaxImageSidePx)) {
+    *why_not = "camera_info is " + std::to_string(info.width) + "x" + std::to_string(info.height) +
+               ", beyond the image side limit of 65536";
+    return false;
+  }
   try {
     *camera = PinholeCamera(g.K, R_I_W, t_I_W).withDistortion(g.distortion);
+    requireUnfoldedDistortion(info.header.frame_id, *camera, static_cast<int>(info.width),
+                              static_cast<int>(info.height));
   } catch (const std::invalid_argument& e) {
     *why_not = std::string("camera: ") + e.what();
     return false;
@@ -192,7 +204,7 @@ bool cameraFromInfo(const sensor_msgs::CameraInfo& info, const Eigen::Isometry3d
   const Eigen::Isometry3d T_C_W = T_W_C.inverse();
   // A rectified image's camera looks along the rectified frame, R from the camera's frame.
   const Eigen::Matrix3d R_I_C = g.rectified ? g.R_rect_C : Eigen::Matrix3d::Identity();
-  return makeCamera(g, R_I_C * T_C_W.linear(), R_I_C * T_C_W.translation(), camera, why_not);
+  return makeCamera(g, info, R_I_C * T_C_W.linear(), R_I_C * T_C_W.translation(), camera, why_not);
 }
 
 bool sharedFrameStereo(const sensor_msgs::CameraInfo& left_info,
@@ -215,7 +227,7 @@ bool sharedFrameStereo(const sensor_msgs::CameraInfo& left_info,
   for (int i = 0; i < 2; ++i) {
     const Eigen::Matrix3d R_I_rect =
         g[i].rectified ? Eigen::Matrix3d::Identity() : Eigen::Matrix3d(g[i].R_rect_C.transpose());
-    if (!makeCamera(g[i], R_I_rect * g[0].R_rect_C, R_I_rect * g[i].t_rect_m, cameras[i],
+    if (!makeCamera(g[i], *infos[i], R_I_rect * g[0].R_rect_C, R_I_rect * g[i].t_rect_m, cameras[i],
                     why_not)) {
       return false;
     }

@@ -13,6 +13,7 @@
 #include <Eigen/Geometry>
 #include <memory>
 #include <opencv2/core.hpp>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -157,6 +158,13 @@ visualization_msgs::MarkerArray occupiedCellsMarkers(const octomap::OcTree& tree
 /// not checked (isValidClearBox checks it).
 Box3d boxFromCorners(const geometry_msgs::Point& min, const geometry_msgs::Point& max);
 
+/// "(x, y, z)", for messages.
+std::string pointText(const geometry_msgs::Point& point);
+
+/// A box's twelve edges as a LINE_LIST marker in the header's frame (namespace "carving_box",
+/// yellow, lines 1 % of the box's longest edge wide).
+visualization_msgs::Marker boxMarker(const Box3d& box_W, const std_msgs::Header& header);
+
 /// Free leaves as CUBE_LIST markers, one per depth level as occupiedCellsMarkers (octomap_server's
 /// free_cells_vis_array), blue, in namespace "free_cells".
 visualization_msgs::MarkerArray freeCellsMarkers(const octomap::OcTree& tree,
@@ -198,11 +206,13 @@ sift_hull::SurfacePoints surfacePointsMessage(const std_msgs::Header& header,
 /// A SurfacePoints message taken into the world frame by T_W_F (the message's frame in the world):
 /// its two cameras, and its points with views 0 (left) and 1 (right), their depth sigma from the
 /// cameras. False, with `why_not`, for arrays of different lengths, a value that is not finite, a
-/// negative reprojection error, or a camera PinholeCamera refuses (K, R).
+/// negative reprojection error, or a camera PinholeCamera refuses (K, R). Every point is checked;
+/// at most `max_points` are converted, evenly spread in the message's order.
 bool surfacePointsFromMessage(const sift_hull::SurfacePoints& message,
                               const Eigen::Isometry3d& T_W_F, PinholeCamera* left,
                               PinholeCamera* right, std::vector<SurfacePoint>* points,
-                              std::string* why_not);
+                              std::string* why_not,
+                              size_t max_points = std::numeric_limits<size_t>::max());
 
 }  // namespace ros_conversions
 }  // namespace sift_hull

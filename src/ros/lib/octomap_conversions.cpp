@@ -170,5 +170,39 @@ Box3d boxFromCorners(const geometry_msgs::Point& min, const geometry_msgs::Point
   return {Eigen::Vector3d(min.x, min.y, min.z), Eigen::Vector3d(max.x, max.y, max.z)};
 }
 
+std::string pointText(const geometry_msgs::Point& point) {
+  std::ostringstream out;
+  out << "(" << point.x << ", " << point.y << ", " << point.z << ")";
+  return out.str();
+}
+
+visualization_msgs::Marker boxMarker(const Box3d& box_W, const std_msgs::Header& header) {
+  visualization_msgs::Marker marker;
+  marker.header = header;
+  marker.ns = "carving_box";
+  marker.type = visualization_msgs::Marker::LINE_LIST;
+  marker.action = visualization_msgs::Marker::ADD;
+  marker.pose.orientation.w = 1.0;
+  marker.scale.x = 0.01 * box_W.size().maxCoeff();
+  marker.color.r = 1.0f;
+  marker.color.g = 0.85f;
+  marker.color.a = 1.0f;
+  const auto corner = [&box_W](int c) {
+    geometry_msgs::Point p;
+    p.x = (c & 1) ? box_W.max_W.x() : box_W.min_W.x();
+    p.y = (c & 2) ? box_W.max_W.y() : box_W.min_W.y();
+    p.z = (c & 4) ? box_W.max_W.z() : box_W.min_W.z();
+    return p;
+  };
+  for (int c = 0; c < 8; ++c) {  // each edge once: from a corner to the one a bit above it
+    for (int bit : {1, 2, 4}) {
+      if (c & bit) continue;
+      marker.points.push_back(corner(c));
+      marker.points.push_back(corner(c | bit));
+    }
+  }
+  return marker;
+}
+
 }  // namespace ros_conversions
 }  // namespace sift_hull

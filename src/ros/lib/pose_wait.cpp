@@ -56,6 +56,16 @@ void PoseWait::add(const sensor_msgs::ImageConstPtr& image,
   filter_.add(image);  // no lock held: the filter may drop an older image (onFailure) here
 }
 
+size_t PoseWait::clear() {
+  {
+    // Without its camera_info an image the filter still passes on is ignored (onPose).
+    std::lock_guard<std::mutex> lock(infos_mutex_);
+    infos_.clear();
+  }
+  filter_.clear();
+  return waits_.clear();
+}
+
 sensor_msgs::CameraInfoConstPtr PoseWait::takeInfo(const sensor_msgs::Image* image) {
   std::lock_guard<std::mutex> lock(infos_mutex_);
   const auto found = infos_.find(image);

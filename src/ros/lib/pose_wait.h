@@ -36,6 +36,9 @@ class PoseWait {
            double timeout_s, Posed posed, Dropped dropped);
 
   void add(const sensor_msgs::ImageConstPtr& image, const sensor_msgs::CameraInfoConstPtr& info);
+  /// Drops every view waiting for its pose (~reset): none of them comes out later. Returns how
+  /// many there were.
+  size_t clear();
   /// Views dropped without a pose (timed out or given up by tf), each counted once.
   size_t dropped() const { return dropped_; }
 

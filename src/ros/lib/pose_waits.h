@@ -67,6 +67,15 @@ class PoseWaits {
     return waits_.size();
   }
 
+  /// Forgets every wait; returns how many had not expired.
+  size_t clear() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    size_t waiting = 0;
+    for (const auto& entry : waits_) waiting += entry.second.expired ? 0 : 1;
+    waits_.clear();
+    return waiting;
+  }
+
  private:
   struct Wait {
     Clock::time_point since;

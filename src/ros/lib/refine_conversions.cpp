@@ -1,5 +1,6 @@
 // SurfacePoints messages: a pair's triangulated matches and its cameras, to and from the core.
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -62,7 +63,7 @@ sift_hull::SurfacePoints surfacePointsMessage(const std_msgs::Header& header,
 bool surfacePointsFromMessage(const sift_hull::SurfacePoints& message,
                               const Eigen::Isometry3d& T_W_F, PinholeCamera* left,
                               PinholeCamera* right, std::vector<SurfacePoint>* points,
-                              std::string* why_not) {
+                              std::string* why_not, size_t max_points) {
   if (message.points.size() != message.reprojection_px.size()) {
     *why_not = std::to_string(message.points.size()) + " points but " +
                std::to_string(message.reprojection_px.size()) + " reprojection errors";
@@ -80,8 +81,8 @@ bool surfacePointsFromMessage(const sift_hull::SurfacePoints& message,
     *why_not = std::string("a camera is refused: ") + e.what();
     return false;
   }
-  points->clear();
-  for (size_t i = 0; i < message.points.size(); ++i) {
+  const size_t n = message.points.size();
+  for (size_t i = 0; i < n; ++i) {
     const geometry_msgs::Point& p = message.points[i];
     const double error = message.reprojection_px[i];
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z) || !(error >= 0.0) ||
@@ -91,10 +92,17 @@ bool surfacePointsFromMessage(const sift_hull::SurfacePoints& message,
                  "number (>= 0 for the error)";
       return false;
     }
+  }
+  const size_t keep = std::min(n, std::max<size_t>(max_points, 1));
+  points->clear();
+  points->reserve(keep);
+  for (size_t k = 0; k < keep; ++k) {
+    const size_t i = keep == n ? k : static_cast<size_t>(static_cast<double>(k) * n / keep);
+    const geometry_msgs::Point& p = message.points[i];
     SurfacePoint point;
     point.X_W = T_W_F * Eigen::Vector3d(p.x, p.y, p.z);
-    point.reprojection_px = error;
-    point.depth_sigma_m = depthSigma(*left, *right, point.X_W, error);
+    point.reprojection_px = message.reprojection_px[i];
+    point.depth_sigma_m = depthSigma(*left, *right, point.X_W, point.reprojection_px);
     point.views = {0, 1};
     points->push_back(point);
   }

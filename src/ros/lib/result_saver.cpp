@@ -28,6 +28,9 @@ const SettingTable<ResultSaverConfig>& settingsOf<ResultSaverConfig>() {
     t.add("timeout_s", &ResultSaverConfig::timeout_s, "s",
           "give up waiting this long after start (wall time) and save what there is")
         .above(0.0);
+    t.add("end_launch", &ResultSaverConfig::end_launch, "",
+          "once every view and pair is saved, end the roslaunch that started this node, as Ctrl-C "
+          "does (incomplete results end it by the node's exit)");
     return t;
   }();
   return table;

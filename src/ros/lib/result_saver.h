@@ -21,6 +21,8 @@ struct ResultSaverConfig {
   std::string hull_save_service = "hull/save";
   /// Give up waiting this long after start (wall time) and save what there is.
   double timeout_s = 120.0;
+  /// Once everything is saved, end the roslaunch that started the node (as Ctrl-C does).
+  bool end_launch = false;
 };
 
 /// Its settings (sift_hull/settings.h): save_results' private parameters.

@@ -5,11 +5,48 @@
 #include <cstdint>
 #include <deque>
 #include <functional>
+#include <future>
+#include <memory>
 #include <mutex>
 #include <thread>
 #include <vector>
 
 namespace sift_hull {
+
+/// A queue of bounded length shared between threads: when full, the oldest item makes room.
+template <typename Item>
+class BoundedQueue {
+ public:
+  explicit BoundedQueue(size_t capacity) : capacity_(std::max<size_t>(capacity, 1)) {}
+  /// Queues `item`; false when the oldest item was dropped to make room.
+  bool push(Item item) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    items_.push_back(std::move(item));
+    if (items_.size() <= capacity_) return true;
+    items_.pop_front();
+    return false;
+  }
+  /// The oldest item, or false when there is none.
+  bool pop(Item* item) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (items_.empty()) return false;
+    *item = std::move(items_.front());
+    items_.pop_front();
+    return true;
+  }
+  /// Drops every item; returns how many there were.
+  size_t clear() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const size_t size = items_.size();
+    items_.clear();
+    return size;
+  }
+
+ private:
+  const size_t capacity_;
+  std::mutex mutex_;
+  std::deque<Item> items_;
+};
 
 /// What a WorkQueue has seen so far.
 struct WorkCounts {
@@ -62,6 +99,36 @@ class WorkQueue {
     return counts;
   }
 
+  /// Runs `task` on a worker before the next item (commands run in the order posted, before any
+  /// waiting item); false, and nothing queued, when kMaxCommands wait already or after stop().
+  /// What a task throws is ignored.
+  bool post(std::function<void()> task) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (stopping_ || commands_.size() >= kMaxCommands) return false;
+      commands_.push_back(std::move(task));
+    }
+    ready_.notify_one();
+    return true;
+  }
+  static constexpr size_t kMaxCommands = 64;
+
+  /// post(task), then waits for it at most timeout_s: false when it had not run by then (it
+  /// still runs later: it must own what it uses) or could not be queued.
+  bool call(std::function<void()> task, double timeout_s) {
+    auto done = std::make_shared<std::promise<void>>();
+    std::future<void> finished = done->get_future();
+    const bool queued = post([task = std::move(task), done] {
+      try {
+        task();
+      } catch (...) {  // never out of the worker
+      }
+      done->set_value();
+    });
+    return queued && finished.wait_for(std::chrono::duration<double>(timeout_s)) ==
+                         std::future_status::ready;
+  }
+
   /// Discards the waiting items (not counted as dropped); returns how many there were.
   size_t clear() {
     std::lock_guard<std::mutex> lock(mutex_);
@@ -74,7 +141,7 @@ class WorkQueue {
   /// Blocks until no item waits and no worker is busy.
   void waitIdle() {
     std::unique_lock<std::mutex> lock(mutex_);
-    idle_.wait(lock, [this] { return queue_.empty() && busy_ == 0; });
+    idle_.wait(lock, [this] { return queue_.empty() && commands_.empty() && busy_ == 0; });
   }
 
   /// Lets the workers finish the items in hand, discards the waiting ones and joins the workers.
@@ -83,6 +150,7 @@ class WorkQueue {
       std::lock_guard<std::mutex> lock(mutex_);
       stopping_ = true;
       queue_.clear();
+      commands_.clear();
     }
     ready_.notify_all();
     idle_.notify_all();
@@ -95,8 +163,12 @@ class WorkQueue {
   void work() {
     std::unique_lock<std::mutex> lock(mutex_);
     while (true) {
-      ready_.wait(lock, [this] { return stopping_ || !queue_.empty(); });
+      ready_.wait(lock, [this] { return stopping_ || !queue_.empty() || !commands_.empty(); });
       if (stopping_) return;
+      if (!commands_.empty()) {
+        runCommand(&lock);
+        continue;
+      }
       Item item = std::move(queue_.front());
       queue_.pop_front();
       ++busy_;
@@ -108,6 +180,20 @@ class WorkQueue {
       counts_.failed += failed;
       idle_.notify_all();
     }
+  }
+
+  void runCommand(std::unique_lock<std::mutex>* lock) {
+    std::function<void()> task = std::move(commands_.front());
+    commands_.pop_front();
+    ++busy_;
+    lock->unlock();
+    try {
+      task();
+    } catch (...) {
+    }
+    lock->lock();
+    --busy_;
+    idle_.notify_all();
   }
 
   bool processes(Item& item) {
@@ -124,6 +210,7 @@ class WorkQueue {
   mutable std::mutex mutex_;
   std::condition_variable ready_, idle_;
   std::deque<Item> queue_;
+  std::deque<std::function<void()>> commands_;
   WorkCounts counts_;
   int busy_ = 0;
   bool stopping_ = false;

@@ -3,14 +3,15 @@
 #include <image_transport/camera_common.h>
 #include <tf2_eigen/tf2_eigen.h>
 
+#include <malloc.h>
+
 #include <algorithm>
-#include <sstream>
+#include <cstdio>
+#include <future>
 
 #include "lib/conversions.h"
 #include "lib/ros_params.h"
-#include "lib/save_paths.h"
 #include "sift_hull/hull/silhouette.h"
-#include "sift_hull/io/ply.h"
 
 namespace sift_hull {
 namespace {
@@ -20,14 +21,8 @@ constexpr double kThrottle_s = 5.0;
 constexpr double kPairingPatience_s = 5.0;
 /// Wall time a changed hull may wait for the queue to drain before it is published anyway.
 constexpr double kMaxPublishDelay_s = 1.0;
-/// Wall time a pair's surface points may wait for the pose of their frame in tf.
-constexpr double kSurfacePoseWait_s = 0.5;
-
-std::string pointText(const geometry_msgs::Point& point) {
-  std::ostringstream out;
-  out << "(" << point.x << ", " << point.y << ", " << point.z << ")";
-  return out.str();
-}
+/// Wall time between returns of freed memory to the system, when the views' queue drains.
+constexpr double kTrimPeriod_s = 1.0;
 
 }  // namespace
 
@@ -40,8 +35,13 @@ HullNode::HullNode(ros::NodeHandle nh, ros::NodeHandle private_nh, HullNodeConfi
     : nh_(nh),
       private_nh_(private_nh),
       config_(std::move(node_config)),
+      skip_views_(hull_config.skip_views.begin(), hull_config.skip_views.end()),
       hull_(std::move(hull_config), config_.carving),
-      work_(config_.queue_size, 1, [this](View& view) { integrate(view); }),
+      points_(static_cast<size_t>(config_.queue_size)),
+      start_wall_(ros::WallTime::now()),
+      work_(config_.queue_size, 1, [this](Posed& posed) { integrate(posed); }),
+      outputs_(nh_, config_.world_frame, &hull_.stream(),
+               [this](std::function<void()> task) { return work_.post(std::move(task)); }),
       pairing_({config_.from_image ? "image" : "silhouette", "camera_info"}, kPairingPatience_s,
                "a silhouette pairs with the camera_info of an equal stamp once tf has its "
                "camera's pose in ~world_frame (a node making masks must copy its image's header: "
@@ -54,35 +54,50 @@ HullNode::HullNode(ros::NodeHandle nh, ros::NodeHandle private_nh, HullNodeConfi
                  const sensor_msgs::CameraInfoConstPtr& info,
                  const Eigen::Isometry3d& T_W_C) { onPosed(silhouette, info, T_W_C); },
           [this](const std::string&, const std::string& why) {
-            log_.error("hull: dropped a silhouette: ", why);  // each reason names the frame
+            problem("hull: dropped a silhouette: ", why);  // each reason names the frame
           }),
       diagnostics_(nh_, private_nh_, "hull", config_.diagnostic_period,
                    [this](diagnostic_updater::DiagnosticStatusWrapper& status) {
                      reportDiagnostics(status);
                    }),
+      image_transport_(nh_),
       sync_(config_.queue_size) {
-  advertiseOutputs();
+  outputs_.advertise();
   refine_timer_ = nh_.createWallTimer(ros::WallDuration(config_.refine_period_s),
-                                      [this](const ros::WallTimerEvent&) { refineIfDue(); });
+                                      [this](const ros::WallTimerEvent&) {
+                                        if (!refine_posted_.exchange(true)) {
+                                          work_.post([this] { refineIfDue(); });
+                                        }
+                                      });
   advertiseServices();
   subscribe();
 }
 
-// --- Input -------------------------------------------------------------------------------------
+HullNode::~HullNode() {
+  work_.stop();  // first: the worker uses what is destroyed after it; later posts are ignored
+}
+
+// --- Input (callbacks: they only take messages in) ---------------------------------------------
 void HullNode::subscribe() {
   silhouette_sub_.registerCallback(&HullNode::onArrival, this);
   info_sub_.registerCallback(&HullNode::onInfoArrival, this);
   sync_.connectInput(silhouette_sub_, info_sub_);
   sync_.registerCallback(&HullNode::onPair, this);
-  surface_points_sub_ = nh_.subscribe("surface_points", static_cast<uint32_t>(config_.queue_size),
-                                      &HullNode::onSurfacePoints, this);
-  // camera_info beside the image, wherever remapping put it (image_transport's convention).
+  // Surface points are looked up in tf as they come (a matcher publishes them after it has
+  // looked up the same poses): one without a pose is counted at once, not kept waiting.
+  points_sub_.registerCallback(&HullNode::onSurfacePoints, this);
+  points_sub_.subscribe(nh_, "surface_points", static_cast<uint32_t>(config_.queue_size));
+  // camera_info beside the image, wherever remapping put it (image_transport's convention);
+  // the image through the transport ~image_transport names (raw, compressed, ...).
   const std::string image_topic = nh_.resolveName(config_.from_image ? "image" : "silhouette");
   info_sub_.subscribe(nh_, image_transport::getCameraInfoTopic(image_topic), config_.queue_size);
-  silhouette_sub_.subscribe(nh_, image_topic, config_.queue_size);
+  silhouette_sub_.subscribe(image_transport_, image_topic, config_.queue_size,
+                            image_transport::TransportHints("raw", ros::TransportHints(),
+                                                            private_nh_));
 }
 
 void HullNode::onArrival(const sensor_msgs::ImageConstPtr& silhouette) {
+  ++counts_.silhouettes;
   pairing_.arrived(0, silhouette->header.stamp.toSec(), PairingWatch::Clock::now());
 }
 
@@ -92,6 +107,7 @@ void HullNode::onInfoArrival(const sensor_msgs::CameraInfoConstPtr& info) {
 
 void HullNode::onPair(const sensor_msgs::ImageConstPtr& silhouette,
                       const sensor_msgs::CameraInfoConstPtr& info) {
+  ++counts_.paired;
   pairing_.paired();
   pose_wait_.add(silhouette, info);
 }
@@ -99,62 +115,69 @@ void HullNode::onPair(const sensor_msgs::ImageConstPtr& silhouette,
 void HullNode::onPosed(const sensor_msgs::ImageConstPtr& silhouette,
                        const sensor_msgs::CameraInfoConstPtr& info,
                        const Eigen::Isometry3d& T_W_C) {
-  View view;
-  if (!viewOf(silhouette, *info, T_W_C, &view)) return;
-  pushCounted(&work_, std::move(view), "hull: views waiting to be carved (~queue_size)");
+  pushCounted(&work_, Posed{silhouette, info, T_W_C, generation_},
+              "hull: views waiting to be carved (~queue_size)");
 }
 
-bool HullNode::viewOf(const sensor_msgs::ImageConstPtr& silhouette,
-                      const sensor_msgs::CameraInfo& info, const Eigen::Isometry3d& T_W_C,
-                      View* view) {
-  const std::string& name = silhouette->header.frame_id;
+void HullNode::onSurfacePoints(const sift_hull::SurfacePointsConstPtr& message) {
+  ++counts_.pairs;
+  PosedPoints posed{message, Eigen::Isometry3d::Identity()};
+  try {
+    posed.T_W_F = tf2::transformToEigen(tf_buffer_.lookupTransform(
+        config_.world_frame, message->header.frame_id, message->header.stamp));
+  } catch (const tf2::TransformException& e) {
+    ++counts_.pairs_no_pose;
+    problem("hull: surface points ignored: ", e.what());
+    return;
+  }
+  if (!points_.push(std::move(posed))) {
+    ++counts_.pairs_queue_full;
+    ROS_WARN_THROTTLE(kThrottle_s, "hull: surface points come faster than they are taken: "
+                                   "the oldest pair waiting dropped (~queue_size)");
+  }
+  if (!points_posted_.exchange(true)) work_.post([this] { takeSurfacePoints(); });
+}
+
+// --- Work (the worker thread) ------------------------------------------------------------------
+bool HullNode::viewOf(const Posed& posed, View* view) {
+  const sensor_msgs::Image& silhouette = *posed.silhouette;
+  const std::string& name = silhouette.header.frame_id;
   std::string why_not;
-  view->mask = config_.from_image ? ros_conversions::eightBitImage(silhouette, &why_not)
-                                  : ros_conversions::maskFromImage(*silhouette, &why_not);
+  view->mask = config_.from_image ? ros_conversions::eightBitImage(posed.silhouette, &why_not)
+                                  : ros_conversions::maskFromImage(silhouette, &why_not);
   if (config_.from_image && !view->mask.empty()) {
     view->mask = silhouetteFromImage(view->mask, config_.recipe);
   }
   if (view->mask.empty() ||
-      !ros_conversions::cameraFromInfo(info, T_W_C, cv::Size(silhouette->width, silhouette->height),
+      !ros_conversions::cameraFromInfo(*posed.info, posed.T_W_C,
+                                       cv::Size(silhouette.width, silhouette.height),
                                        &view->camera, &why_not, config_.rectified)) {
-    log_.error("hull: view '" + name + "' ignored: ", why_not);
+    problem("hull: view '" + name + "' ignored: ", why_not);
     return false;
   }
   view->name = name;
-  view->stamp = silhouette->header.stamp;
-  view->generation = generation_;
+  view->stamp = silhouette.header.stamp;
   return true;
 }
 
-void HullNode::onSurfacePoints(const sift_hull::SurfacePointsConstPtr& message) {
-  Eigen::Isometry3d T_W_F;
-  try {
-    T_W_F = tf2::transformToEigen(
-        tf_buffer_.lookupTransform(config_.world_frame, message->header.frame_id,
-                                   message->header.stamp, ros::Duration(kSurfacePoseWait_s)));
-  } catch (const tf2::TransformException& e) {
-    log_.error("hull: surface points ignored: ", "no pose of '" + message->header.frame_id +
-                                                     "' in '" + config_.world_frame +
-                                                     "' at their stamp (" + e.what() + ")");
+void HullNode::integrate(Posed& posed) {
+  if (posed.generation != generation_) {  // queued before a ~reset
+    ++counts_.reset;
     return;
   }
-  PinholeCamera left, right;
-  std::vector<SurfacePoint> points;
-  std::string why_not;
-  if (!ros_conversions::surfacePointsFromMessage(*message, T_W_F, &left, &right, &points,
-                                                 &why_not)) {
-    log_.error("hull: surface points ignored: ", why_not);
-    return;
-  }
-  hull_.addSurfacePoints(left, right, std::move(points),
-                         static_cast<int64_t>(message->header.stamp.toNSec()));
-}
-
-// --- Work --------------------------------------------------------------------------------------
-void HullNode::integrate(View& view) {
-  std::lock_guard<std::mutex> lock(hull_mutex_);
-  if (view.generation != generation_) return;  // queued before a ~reset
   const ros::WallTime start = ros::WallTime::now();
+  const std_msgs::Header& header = posed.silhouette->header;
+  char stamp[32];
+  std::snprintf(stamp, sizeof stamp, "@%u.%09u", header.stamp.sec, header.stamp.nsec);
+  if (skip_views_.count(header.frame_id + stamp) > 0) {
+    ++counts_.skipped;  // one frame of a moving camera, named by its stamp
+    return;
+  }
+  View view;
+  if (!viewOf(posed, &view)) {
+    ++counts_.bad;
+    return;
+  }
   const bool changed = carve(view);
   const ros::WallTime carved = ros::WallTime::now();
   last_carve_ms_ = (carved - start).toSec() * 1e3;
@@ -164,31 +187,36 @@ void HullNode::integrate(View& view) {
   // the hull at once: each state would cost a conversion the next view replaces, so the hull is
   // published when the queue has drained, or kMaxPublishDelay_s after the last publication under
   // a stream that never lets it drain, stamped with the newest view that changed it.
-  if (unpublished_stamp_.isZero()) return;
-  if (work_.counts().waiting > 0 &&
-      (ros::WallTime::now() - last_publish_wall_).toSec() < kMaxPublishDelay_s) {
-    return;
+  const bool drained = work_.counts().waiting == 0;
+  if (drained && (carved - last_trim_wall_).toSec() > kTrimPeriod_s) {
+    malloc_trim(0);  // a flood's buffers back to the system
+    last_trim_wall_ = carved;
   }
+  if (unpublished_stamp_.isZero()) return;
+  if (!drained && (ros::WallTime::now() - last_publish_wall_).toSec() < kMaxPublishDelay_s) return;
   publishPending();
   last_publish_ms_ = (ros::WallTime::now() - carved).toSec() * 1e3;
 }
 
 bool HullNode::carve(const View& view) {
   const std::string& name = view.name;
+  const size_t before = hull_.stream().hasHull() ? hull_.stream().hull().views().size() : 0;
   try {
     const HullStream::Outcome outcome = hull_.add(name, view.camera, view.mask);
     const HullStream& stream = hull_.stream();
     for (const std::string& refusal : hull_.takeRefusals()) {
-      log_.error("hull: view refused: ", refusal);
+      problem("hull: view refused: ", refusal);
+      ++counts_.refused;
     }
-    refused_views_ = stream.refusedViews();
-    redundant_views_ = stream.redundantViews();
+    counts_.waiting = stream.waitingViews();
+    if (stream.hasHull()) counts_.carved += stream.hull().views().size() - before;
     if (outcome == HullStream::Outcome::kWaiting) {
       ROS_INFO_THROTTLE(kThrottle_s, "hull: %zu view(s) waiting for a bounding box: %s",
                         stream.waitingViews(), stream.whyNoBox().c_str());
     }
-    if (outcome == HullStream::Outcome::kSkipped) ROS_INFO("hull: view '%s' skipped", name.c_str());
+    if (outcome == HullStream::Outcome::kSkipped) ++counts_.skipped;  // as ~skip_views asks
     if (outcome == HullStream::Outcome::kRedundant) {
+      ++counts_.redundant;
       ROS_INFO_THROTTLE(kThrottle_s,
                         "hull: %zu view(s) left out so far: seen from where a view already taken "
                         "was (~min_view_distance_m, ~min_view_angle_deg)",
@@ -196,156 +224,84 @@ bool HullNode::carve(const View& view) {
     }
     return outcome == HullStream::Outcome::kCarved;
   } catch (const std::exception& e) {
-    log_.error("hull: view '" + name + "' ignored: ", e.what());
+    ++counts_.bad;
+    problem("hull: view '" + name + "' ignored: ", e.what());
     return false;
   }
 }
 
+void HullNode::takeSurfacePoints() {
+  points_posted_ = false;
+  PosedPoints posed;
+  while (points_.pop(&posed)) mergeSurfacePoints(posed);
+}
+
+void HullNode::mergeSurfacePoints(const PosedPoints& posed) {
+  const sift_hull::SurfacePoints& message = *posed.message;
+  PinholeCamera left, right;
+  std::vector<SurfacePoint> points;
+  std::string why_not;
+  const size_t max_points = static_cast<size_t>(config_.carving.max_points_per_pair);
+  if (!ros_conversions::surfacePointsFromMessage(message, posed.T_W_F, &left, &right, &points,
+                                                 &why_not, max_points)) {
+    ++counts_.pairs_bad;
+    problem("hull: surface points ignored: ", why_not);
+    return;
+  }
+  counts_.points_subsampled += message.points.size() - points.size();
+  const PointCarvedStream::AddedPoints added = hull_.addSurfacePoints(
+      left, right, std::move(points), static_cast<int64_t>(message.header.stamp.toNSec()));
+  counts_.points_outside += added.outside;
+  if (!added.refused.empty()) {
+    ++counts_.pairs_refused;
+    problem("hull: surface points refused: ", added.refused);
+  } else if (added.kept == 0) {
+    ++counts_.pairs_empty;
+  } else {
+    ++counts_.pairs_merged;
+  }
+}
+
 void HullNode::refineIfDue() {
-  std::lock_guard<std::mutex> lock(hull_mutex_);
+  refine_posted_ = false;
   if (!hull_.refineDue()) return;
   try {
     const PointCarvedStream::Refinement refinement = hull_.refine();
-    free_voxels_ = refinement.free_voxels;
+    counts_.free_voxels = refinement.free_voxels;
+    counts_.pairs_refused += refinement.pairs_refused;
+    if (refinement.pairs_refused > 0) {
+      problem("hull: surface points refused: ",
+              "a pair that came before the hull has a camera beyond ~max_distance_cube_edges");
+    }
     ros::Time newest;
-    newest.fromNSec(static_cast<uint64_t>(refinement.newest_stamp_ns));
-    publish(std::max(newest, header_.stamp));
+    newest.fromNSec(static_cast<uint64_t>(std::max<int64_t>(refinement.newest_stamp_ns, 0)));
+    publish(std::max(newest, outputs_.header().stamp));
   } catch (const std::exception& e) {
-    log_.error("hull: cannot carve with the surface points: ", e.what());
+    problem("hull: cannot carve with the surface points: ", e.what());
   }
 }
 
-// --- Output ------------------------------------------------------------------------------------
-template <typename Message>
-void HullNode::addOutput(const std::string& topic, bool lazy, std::function<Message()> hull,
-                         std::function<Message()> empty) {
-  const size_t index = outputs_.size();
-  Output output;
-  output.lazy = lazy;
-  // Latched, so that a later subscriber gets the newest map; the lazy ones are also sent to each
-  // new subscriber, since they are built only while someone looks.
-  output.pub = lazy ? nh_.advertise<Message>(
-                          topic, 1,
-                          [this, index](const ros::SingleSubscriberPublisher&) {
-                            sendToNewSubscriber(index);
-                          },
-                          ros::SubscriberStatusCallback(), ros::VoidConstPtr(), true)
-                    : nh_.advertise<Message>(topic, 1, true);
-  output.send = [this, index, hull, empty] {
-    outputs_[index].pub.publish(published_ ? hull() : empty());
-  };
-  outputs_.push_back(std::move(output));
-}
-
-void HullNode::advertiseOutputs() {
-  using ros_conversions::octomapFullMessage;
-  using ros_conversions::octomapMessage;
-  using Cloud = sensor_msgs::PointCloud2;
-  using Markers = visualization_msgs::MarkerArray;
-  // No reallocation while a subscriber's connect callback reads an entry (nodelets spin while
-  // this runs); such a callback sends nothing anyway until a hull is published.
-  outputs_.reserve(7);
-  const auto emptyTree = [this] { return octomap::OcTree(empty_resolution_m_); };
-  const auto centres = [this] {
-    return cleared_boxes_.empty() ? ros_conversions::pointCloudMessage(
-                                        publishedCompact(true).occupied_centres_W, header_)
-                                  : ros_conversions::occupiedCellsCloud(publishedTree(), header_);
-  };
-  const auto noCentres = [this, emptyTree] {
-    return ros_conversions::occupiedCellsCloud(emptyTree(), header_);
-  };
-  addOutput<sift_hull::Octomap>(
-      "octomap_binary", false,
-      [this] {  // the compact map needs no OctoMap nodes, unless boxes were cleared
-        return cleared_boxes_.empty() ? octomapMessage(publishedCompact(centres_wanted_), header_)
-                                      : octomapMessage(publishedTree(), header_);
-      },
-      [this, emptyTree] { return octomapMessage(emptyTree(), header_); });
-  addOutput<sift_hull::Octomap>(
-      "octomap_full", true, [this] { return octomapFullMessage(publishedTree(), header_); },
-      [this, emptyTree] { return octomapFullMessage(emptyTree(), header_); });
-  addOutput<Cloud>("occupied_cells", true, centres, noCentres);
-  outputs_.back().centres = true;
-  addOutput<Cloud>("octomap_point_cloud_centers", true, centres, noCentres);
-  outputs_.back().centres = true;
-  addOutput<Markers>(
-      "occupied_cells_vis_array", true,
-      [this] { return ros_conversions::occupiedCellsMarkers(publishedTree(), header_); },
-      [this] { return ros_conversions::deleteAllMarkers(header_); });
-  addOutput<Markers>(
-      "free_cells_vis_array", true,
-      [this] { return ros_conversions::freeCellsMarkers(publishedTree(), header_); },
-      [this] { return ros_conversions::deleteAllMarkers(header_); });
-  addOutput<visualization_msgs::Marker>(
-      "mesh", true, [this] { return ros_conversions::meshMarker(publishedMesh(), header_); },
-      [this] { return ros_conversions::deleteAllMarkers(header_).markers.front(); });
-  outputs_.back().map = false;
-}
-
-void HullNode::publish(const ros::Time& stamp, bool hull_changed, bool all) {
-  header_.stamp = stamp;
-  header_.frame_id = config_.world_frame;
-  last_publish_wall_ = ros::WallTime::now();
-  unpublished_stamp_ = ros::Time();
-  if (hull_changed) {
-    tree_.reset();
-    compact_.reset();
-    mesh_.reset();
-  }
-  published_ = hull_.stream().hasHull();
-  const auto sent = [all](const Output& output) {
-    return all || !output.lazy || output.pub.getNumSubscribers() > 0;
-  };
-  centres_wanted_ = std::any_of(outputs_.begin(), outputs_.end(),
-                                [&](const Output& o) { return o.centres && sent(o); });
-  for (const Output& output : outputs_) {
-    if (sent(output) && (hull_changed || output.map)) output.send();
-  }
+void HullNode::problem(const std::string& prefix, const std::string& why) {
+  log_.error(prefix, why);
+  std::lock_guard<std::mutex> lock(problem_mutex_);
+  last_problem_ = prefix + why;
 }
 
 void HullNode::publishPending() {
-  if (unpublished_stamp_.isZero()) return;
+  if (!unpublished_stamp_.isZero()) publish(unpublished_stamp_);
+}
+
+void HullNode::publish(ros::Time stamp, bool all) {
+  last_publish_wall_ = ros::WallTime::now();
+  unpublished_stamp_ = ros::Time();
   try {
-    publish(unpublished_stamp_);
+    outputs_.publish(stamp, all);
   } catch (const std::exception& e) {  // e.g. a hull beyond OctoMap's key range
-    unpublished_stamp_ = ros::Time();
-    log_.error("hull: cannot publish the hull: ", e.what());
+    problem("hull: cannot publish the hull: ", e.what());
   }
 }
 
-void HullNode::sendToNewSubscriber(size_t output) {
-  std::lock_guard<std::mutex> lock(hull_mutex_);
-  publishPending();  // views carved but not yet published: their map, with their stamp
-  if (!published_) return;
-  try {
-    outputs_[output].send();
-  } catch (const std::exception& e) {  // never into roscpp's callback
-    log_.error("hull: cannot publish the hull: ", e.what());
-  }
-}
-
-const octomap::OcTree& HullNode::publishedTree() {
-  if (!tree_) {
-    tree_ = toOctomap(hull_.stream().hull());
-    for (const Box3d& box : cleared_boxes_) clearBox(box, tree_.get());
-  }
-  return *tree_;
-}
-
-const CompactOctomap& HullNode::publishedCompact(bool centres) {
-  if (!compact_ || (centres && !compact_centres_)) {
-    compact_ = std::make_unique<CompactOctomap>(compactOctomap(hull_.stream().hull(), centres));
-    compact_centres_ = centres;
-  }
-  return *compact_;
-}
-
-const TriangleMesh& HullNode::publishedMesh() {
-  if (!mesh_) mesh_ = std::make_unique<TriangleMesh>(hull_.stream().hull().mesh());
-  return *mesh_;
-}
-
-// --- Services and diagnostics ------------------------------------------------------------------
+// --- Services and diagnostics (callbacks; the work on the worker) -------------------------------
 void HullNode::advertiseServices() {
   reset_srv_ = private_nh_.advertiseService("reset", &HullNode::reset, this);
   save_srv_ = private_nh_.advertiseService("save", &HullNode::save, this);
@@ -360,88 +316,122 @@ void HullNode::advertiseServices() {
 }
 
 bool HullNode::reset(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
-  std::lock_guard<std::mutex> lock(hull_mutex_);
-  ++generation_;
-  const size_t discarded = work_.clear();  // views from before the reset
-  if (hull_.stream().hasHull()) empty_resolution_m_ = hull_.stream().hull().cube().resolution_m;
-  hull_.reset();
-  free_voxels_ = 0;
-  refused_views_ = 0;
-  cleared_boxes_.clear();
-  publish(ros::Time::now(), true, true);  // the empty map and no markers, on every output
-  ROS_INFO("hull: reset (%zu view(s) waiting to be carved discarded)", discarded);
+  ++generation_;  // what is queued now is not carved, whenever the worker gets to it
+  const size_t posed = work_.clear();
+  const size_t waiting_pose = pose_wait_.clear();
+  const size_t pairs = points_.clear();
+  counts_.reset += posed + waiting_pose;
+  counts_.pairs_reset += pairs;
+  if (!work_.call([this] { resetOnWorker(); }, kServiceWait_s)) {
+    problem("hull: ~reset: ", "the worker is busy; the hull is reset as soon as it is free");
+  }
+  ROS_INFO("hull: reset (%zu view(s) waiting to be carved, %zu waiting for their pose and %zu "
+           "pairs of surface points discarded)",
+           posed, waiting_pose, pairs);
   return true;
+}
+
+void HullNode::resetOnWorker() {
+  counts_.reset += hull_.stream().waitingViews();
+  hull_.reset();
+  counts_.free_voxels = 0;
+  counts_.waiting = 0;
+  publish(ros::Time::now(), true);  // the empty map and no markers, on every output
 }
 
 bool HullNode::save(sift_hull::Save::Request& request, sift_hull::Save::Response& response) {
-  std::lock_guard<std::mutex> lock(hull_mutex_);
-  publishPending();  // views carved but not yet published: saved as published
-  response.success = false;
-  if (!published_) {
-    response.message = "no hull yet";
-    return true;
-  }
-  try {
-    const SavePaths paths = savePaths(request.path);
-    writeOctomap(publishedTree(), paths.octree);
-    writePly(paths.mesh, publishedMesh());
-    response.success = true;
-    response.message = "wrote " + paths.octree + " and " + paths.mesh;
-  } catch (const std::exception& e) {
-    response.message = e.what();
-  }
+  // Filled on the worker: a promise, so that a save that outlasts the wait writes nothing here.
+  auto result = std::make_shared<std::promise<sift_hull::Save::Response>>();
+  std::future<sift_hull::Save::Response> saved = result->get_future();
+  const std::string path = request.path;
+  work_.call([this, path, result] { result->set_value(saveOnWorker(path)); }, kSaveWait_s);
+  const bool done = saved.wait_for(std::chrono::seconds(0)) == std::future_status::ready;
+  if (done) response = saved.get();
+  if (!done) response.message = "still saving; the node's log says when it is done";
   return true;
 }
 
+sift_hull::Save::Response HullNode::saveOnWorker(const std::string& path) {
+  publishPending();  // views carved but not yet published: saved as published
+  sift_hull::Save::Response response;
+  response.success = outputs_.save(path, &response.message);
+  if (response.success) ROS_INFO("hull: ~save %s", response.message.c_str());
+  if (!response.success) problem("hull: ~save refused: ", response.message);
+  return response;
+}
+
 bool HullNode::getMap(bool binary, sift_hull::GetOctomap::Response* response) {
-  std::lock_guard<std::mutex> lock(hull_mutex_);
-  publishPending();
-  if (!published_) {
-    log_.error(binary ? "hull: octomap_binary refused: " : "hull: octomap_full refused: ",
-               "no map yet (no view carved since the start or ~reset)");
+  std::shared_ptr<const sift_hull::Octomap> map =
+      binary ? outputs_.binarySnapshot() : outputs_.fullSnapshot();
+  if (!map && !binary && !outputs_.keepsFullMap()) {  // the first ask: made once, then kept
+    outputs_.keepFullMap();
+    work_.call([this] {
+      publishPending();
+      if (outputs_.published() && !outputs_.fullSnapshot()) publish(outputs_.header().stamp);
+    }, kServiceWait_s);
+    map = outputs_.fullSnapshot();
+  }
+  if (!map) {
+    problem(binary ? "hull: octomap_binary refused: " : "hull: octomap_full refused: ",
+            "no map yet (no view carved since the start or ~reset), or the worker was busy for "
+            "more than " + std::to_string(kServiceWait_s) + " s");
     return false;
   }
-  response->map = binary ? ros_conversions::octomapMessage(publishedTree(), header_)
-                         : ros_conversions::octomapFullMessage(publishedTree(), header_);
+  response->map = *map;
   return true;
 }
 
 bool HullNode::clearBbx(sift_hull::BoundingBoxQuery::Request& request,
                         sift_hull::BoundingBoxQuery::Response&) {
   const Box3d box = ros_conversions::boxFromCorners(request.min, request.max);
+  const std::string corners = ros_conversions::pointText(request.min) + " to " + ros_conversions::pointText(request.max);
   if (!isValidClearBox(box)) {
-    log_.error("hull: ~clear_bbx refused: ", "min " + pointText(request.min) + " and max " +
-                                                 pointText(request.max) +
-                                                 " must be finite with min <= max on each axis");
+    problem("hull: ~clear_bbx refused: ",
+            corners + ": the corners must be finite with min <= max on each axis");
     return false;
   }
-  std::lock_guard<std::mutex> lock(hull_mutex_);
-  publishPending();
-  cleared_boxes_.push_back(box);  // applied to every later map too, until ~reset
-  if (!published_) {
-    ROS_INFO("hull: ~clear_bbx: no map yet; the box will be cleared in the first one");
-    return true;
-  }
-  if (tree_) clearBox(box, tree_.get());  // else built with every cleared box when needed
-  publish(ros::Time::now(), false);       // the maps again; the mesh is unchanged
-  ROS_INFO("hull: ~clear_bbx: cleared %s to %s", pointText(request.min).c_str(),
-           pointText(request.max).c_str());
-  return true;
+  auto ok = std::make_shared<std::atomic<bool>>(false);
+  const bool done = work_.call([this, box, corners, ok] {
+    publishPending();
+    if (!hull_.stream().hasHull()) {
+      problem("hull: ~clear_bbx refused: ", "no map yet to clear " + corners + " in");
+      return;
+    }
+    try {
+      const size_t voxels = hull_.clearBox(box);  // into the hull: every later map has it
+      counts_.free_voxels = hull_.freeVoxelCount();
+      publish(ros::Time::now());
+      ROS_INFO("hull: ~clear_bbx: cleared %s (%zu occupied voxels)", corners.c_str(), voxels);
+      *ok = true;
+    } catch (const std::exception& e) {
+      problem("hull: ~clear_bbx refused: ", corners + ": " + e.what());
+    }
+  }, kServiceWait_s);
+  if (!done) ROS_WARN("hull: ~clear_bbx: the worker is busy; %s is cleared once it is free",
+                      corners.c_str());
+  return !done || *ok;
 }
 
 void HullNode::reportDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& status) {
-  reportQueue(work_.counts(), "views", &status);
-  status.add("views redundant", redundant_views_.load());
-  status.add("views refused", refused_views_.load());
-  status.add("views without pose", pose_wait_.dropped());
-  status.add("free voxels (surface_points)", free_voxels_.load());
+  reportQueue(work_.counts(), "views", &status);  // received, processed, dropped, waiting
+  counts_.report(pose_wait_.dropped(), &status);
   status.add("last view carve ms", last_carve_ms_.load());
   status.add("last view publish ms", last_publish_ms_.load());
   status.add("last view stamp", last_view_stamp_.load());
+  const auto warn = [&status](const std::string& text) {
+    status.mergeSummary(diagnostic_msgs::DiagnosticStatus::WARN, text);
+    ROS_WARN_THROTTLE(kThrottle_s, "hull: %s", text.c_str());
+  };
   const std::string unpaired = pairing_.problem(PairingWatch::Clock::now());
-  if (!unpaired.empty()) {
-    status.mergeSummary(diagnostic_msgs::DiagnosticStatus::WARN, unpaired);
-    ROS_WARN_THROTTLE(kThrottle_s, "hull: %s", unpaired.c_str());
+  if (!unpaired.empty()) warn(unpaired);
+  const std::string image_topic = silhouette_sub_.getTopic();
+  if (counts_.silhouettes == 0 && (ros::WallTime::now() - start_wall_).toSec() > kPairingPatience_s) {
+    warn("nothing arrived on " + image_topic + " (and " +
+         image_transport::getCameraInfoTopic(image_topic) + ") since the start: check the remaps");
+  }
+  std::lock_guard<std::mutex> lock(problem_mutex_);
+  if (counts_.carved == 0 && counts_.silhouettes > 0 && !last_problem_.empty()) {
+    warn("no view carved yet; the last problem: " + last_problem_);
   }
 }
 

@@ -33,11 +33,11 @@ std::vector<std::string> pairedInputs(const MatcherNodeConfig& config) {
 
 /// What pairing needs, for the warning.
 std::string pairingHint(const MatcherNodeConfig& config) {
+  if (config.approximate_sync) return "approximate sync found no stamps near enough";
   if (config.calibrated) {
     return "the two images and the camera_info beside each (the image's namespace + camera_info) "
-           "pair by equal stamps";
+           "pair by equal stamps (~approximate_sync: true pairs the nearest ones)";
   }
-  if (config.approximate_sync) return "approximate sync found no two stamps near enough";
   return "the left and right images pair by equal stamps (~approximate_sync: true pairs the "
          "nearest ones)";
 }
@@ -187,7 +187,6 @@ std::unique_ptr<ImageInput> MatcherNode::imageInput(const std::string& topic) {
 }
 
 void MatcherNode::setUpInputs() {
-  const int queue = settings_.node.queue_size;
   if (settings_.node.frame_to_frame) {
     frame_sub_ = imageInput("image");
     frame_sub_->registerCallback(&MatcherNode::onFrame, this);
@@ -196,19 +195,29 @@ void MatcherNode::setUpInputs() {
   left_sub_ = imageInput("left/image");
   right_sub_ = imageInput("right/image");
   watchArrivals();
-  if (settings_.node.calibrated) {
+  setUpSync();
+}
+
+void MatcherNode::setUpSync() {
+  namespace policies = message_filters::sync_policies;
+  const int queue = settings_.node.queue_size;
+  if (settings_.node.calibrated && settings_.node.approximate_sync) {
+    calibrated_approximate_sync_ = std::make_unique<CalibratedApproximateSync>(
+        policies::ApproximateTime<Image, Image, Info, Info>(queue), *left_sub_, *right_sub_,
+        left_info_sub_, right_info_sub_);
+    calibrated_approximate_sync_->registerCallback(&MatcherNode::onCalibratedPair, this);
+  } else if (settings_.node.calibrated) {
     calibrated_sync_ = std::make_unique<CalibratedSync>(
-        message_filters::sync_policies::ExactTime<Image, Image, Info, Info>(queue), *left_sub_,
-        *right_sub_, left_info_sub_, right_info_sub_);
+        policies::ExactTime<Image, Image, Info, Info>(queue), *left_sub_, *right_sub_,
+        left_info_sub_, right_info_sub_);
     calibrated_sync_->registerCallback(&MatcherNode::onCalibratedPair, this);
   } else if (settings_.node.approximate_sync) {
     approximate_sync_ = std::make_unique<ApproximateSync>(
-        message_filters::sync_policies::ApproximateTime<Image, Image>(queue), *left_sub_,
-        *right_sub_);
+        policies::ApproximateTime<Image, Image>(queue), *left_sub_, *right_sub_);
     approximate_sync_->registerCallback(&MatcherNode::onPair, this);
   } else {
-    exact_sync_ = std::make_unique<ExactSync>(
-        message_filters::sync_policies::ExactTime<Image, Image>(queue), *left_sub_, *right_sub_);
+    exact_sync_ = std::make_unique<ExactSync>(policies::ExactTime<Image, Image>(queue),
+                                              *left_sub_, *right_sub_);
     exact_sync_->registerCallback(&MatcherNode::onPair, this);
   }
 }

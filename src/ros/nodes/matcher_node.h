@@ -61,6 +61,8 @@ class MatcherNode {
   using Info = sensor_msgs::CameraInfo;
   using CalibratedSync = message_filters::Synchronizer<
       message_filters::sync_policies::ExactTime<Image, Image, Info, Info>>;
+  using CalibratedApproximateSync = message_filters::Synchronizer<
+      message_filters::sync_policies::ApproximateTime<Image, Image, Info, Info>>;
 
   /// The pair's cameras, the left one at the origin of its own frame.
   struct StereoCameras {
@@ -84,6 +86,9 @@ class MatcherNode {
   void advertise();
   /// Builds the inputs and their synchronisers, subscribing nothing.
   void setUpInputs();
+  /// The synchroniser of the two images (and their camera_infos with ~calibrated), by equal
+  /// stamps or, with ~approximate_sync, the nearest ones.
+  void setUpSync();
   /// Subscribes the inputs while someone subscribes an output; unsubscribes when none does.
   void onOutputsChanged();
   /// Counts each input's arrivals for pairing_.
@@ -147,6 +152,7 @@ class MatcherNode {
   std::unique_ptr<ApproximateSync> approximate_sync_;
   message_filters::Subscriber<Info> left_info_sub_, right_info_sub_;
   std::unique_ptr<CalibratedSync> calibrated_sync_;
+  std::unique_ptr<CalibratedApproximateSync> calibrated_approximate_sync_;
 };
 
 }  // namespace sift_hull
