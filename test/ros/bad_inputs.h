@@ -153,15 +153,21 @@ inline int nodePid(const std::string& node) {
   return static_cast<int>(result[2]);
 }
 
-/// VmRSS of a process in KiB, -1 when it cannot be read.
-inline long rssKiB(int pid) {
+/// A memory field of /proc/PID/status ("VmRSS:", "VmHWM:") in KiB, -1 when it cannot be read.
+inline long statusKiB(int pid, const std::string& field) {
   std::ifstream status("/proc/" + std::to_string(pid) + "/status");
   std::string line;
   while (std::getline(status, line)) {
-    if (line.rfind("VmRSS:", 0) == 0) return std::stol(line.substr(6));
+    if (line.rfind(field, 0) == 0) return std::stol(line.substr(field.size()));
   }
   return -1;
 }
+
+/// VmRSS (resident memory now) of a process in KiB, -1 when it cannot be read.
+inline long rssKiB(int pid) { return statusKiB(pid, "VmRSS:"); }
+
+/// VmHWM (peak resident memory) of a process in KiB, -1 when it cannot be read.
+inline long peakRssKiB(int pid) { return statusKiB(pid, "VmHWM:"); }
 
 /// Whether the process is there and not a zombie.
 inline bool processRunning(int pid) {

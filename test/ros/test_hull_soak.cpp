@@ -14,7 +14,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
 #include <map>
 #include <mutex>
 #include <string>
@@ -40,26 +39,6 @@ using test::kDeadline_s;
 using test::kViews;
 using test::waitFor;
 namespace rc = ros_conversions;
-
-/// VmHWM (peak resident memory) of a process in KiB, -1 when it cannot be read.
-long peakRssKiB(int pid) {
-  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
-  std::string line;
-  while (std::getline(status, line)) {
-    if (line.rfind("VmHWM:", 0) == 0) return std::stol(line.substr(6));
-  }
-  return -1;
-}
-
-/// VmRSS (resident memory now) of a process in KiB, -1 when it cannot be read.
-long rssKiB(int pid) {
-  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
-  std::string line;
-  while (std::getline(status, line)) {
-    if (line.rfind("VmRSS:", 0) == 0) return std::stol(line.substr(6));
-  }
-  return -1;
-}
 
 /// The hull node's /diagnostics values, the newest report.
 class HullDiagnostics {
@@ -118,7 +97,7 @@ class HullSoakTest : public test::HullNodeTest {
     EXPECT_LT(slowest_s_.load(), 1.0) << "octomap_binary answered after " << slowest_s_ << " s";
     EXPECT_GT(probes_.load(), 0u);
     EXPECT_TRUE(bad_inputs::processRunning(pid_)) << "the hull node died";
-    const long peak_kib = peakRssKiB(pid_);
+    const long peak_kib = bad_inputs::peakRssKiB(pid_);
     std::printf("hull node peak RSS %ld KiB, slowest octomap_binary %.3f s of %zu calls\n",
                 peak_kib, slowest_s_.load(), probes_.load());
     EXPECT_GT(peak_kib, 0);
@@ -199,7 +178,7 @@ TEST_F(HullSoakTest, AFloodOfViewsIsCarvedOrCountedByReason) {
   HullDiagnostics diagnostics(nh_);
   const auto before = diagnostics.when([](const std::map<std::string, double>&) { return true; });
   ASSERT_FALSE(before.empty());
-  const long idle_kib = rssKiB(pid_);
+  const long idle_kib = bad_inputs::rssKiB(pid_);
   const int kFlood = 111;
   ros::Time last;
   for (int i = 0; i < kFlood; ++i) {  // 30 Hz, the fixture's 0.05 s sleep included
@@ -215,7 +194,7 @@ TEST_F(HullSoakTest, AFloodOfViewsIsCarvedOrCountedByReason) {
   EXPECT_EQ(accountedViews(after) - accountedViews(before), kFlood);
   // The flood's memory given back: 10 s after it, within 25 % of the idle level before it.
   ros::WallDuration(10.0).sleep();
-  const long after_kib = rssKiB(pid_);
+  const long after_kib = bad_inputs::rssKiB(pid_);
   std::printf("hull node RSS: idle %ld KiB, 10 s after the flood %ld KiB\n", idle_kib, after_kib);
   EXPECT_GT(idle_kib, 0);
   EXPECT_LE(after_kib, idle_kib + idle_kib / 4) << "RSS " << after_kib << " KiB, idle " << idle_kib;
