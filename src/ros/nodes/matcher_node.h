@@ -7,6 +7,7 @@
 #include <message_filters/sync_policies/approximate_time.h>
 #include <message_filters/sync_policies/exact_time.h>
 #include <message_filters/synchronizer.h>
+#include <message_filters/time_synchronizer.h>
 #include <ros/ros.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
@@ -22,6 +23,7 @@
 #include <vector>
 
 #include "lib/image_input.h"
+#include "lib/pose_wait.h"
 #include "lib/node_diagnostics.h"
 #include "lib/pairing_watch.h"
 #include "lib/throttled_log.h"
@@ -63,6 +65,8 @@ class MatcherNode {
       message_filters::sync_policies::ExactTime<Image, Image, Info, Info>>;
   using CalibratedApproximateSync = message_filters::Synchronizer<
       message_filters::sync_policies::ApproximateTime<Image, Image, Info, Info>>;
+  /// Calibrated frame to frame: each frame with the camera_info of an equal stamp.
+  using FrameSync = message_filters::TimeSynchronizer<Image, Info>;
 
   /// The pair's cameras, the left one at the origin of its own frame.
   struct StereoCameras {
@@ -80,6 +84,27 @@ class MatcherNode {
   struct Pair {
     sensor_msgs::ImageConstPtr left, right;
     sensor_msgs::CameraInfoConstPtr left_info, right_info;
+    /// Calibrated frame to frame: the right (later) camera's pose in the left (keyframe) camera's
+    /// frame, from the two poses in ~world_frame; then tf is not asked again.
+    bool posed = false;
+    Eigen::Isometry3d T_L_R = Eigen::Isometry3d::Identity();
+  };
+  /// Calibrated frame to frame: the frame later frames are matched with, and its pose.
+  struct Keyframe {
+    sensor_msgs::ImageConstPtr image;
+    sensor_msgs::CameraInfoConstPtr info;
+    Eigen::Isometry3d T_W_C = Eigen::Isometry3d::Identity();
+  };
+  /// Calibrated frame to frame: where each frame went, every one counted once.
+  struct FrameCounts {
+    size_t received = 0;        ///< frames paired with their camera_info
+    size_t keyframes = 0;       ///< started a keyframe (the first, or after a pause)
+    size_t out_of_order = 0;    ///< stamp not after the keyframe's
+    size_t skipped = 0;         ///< baseline to the keyframe below ~min_baseline_m
+    size_t turned = 0;          ///< turned beyond ~max_rotation_deg: became the keyframe unmatched
+    size_t paired = 0;          ///< matched with the keyframe (then became it)
+    size_t unusable = 0;        ///< pose not finite (logged)
+    size_t cleared = 0;         ///< waiting for their pose when the last listener left
   };
 
   /// Advertises the outputs, with the connect callbacks that subscribe the inputs.
@@ -101,6 +126,15 @@ class MatcherNode {
   void onReconfigure(sift_hull::MatcherConfig& config, uint32_t level);
   void onPair(const sensor_msgs::ImageConstPtr& left, const sensor_msgs::ImageConstPtr& right);
   void onFrame(const sensor_msgs::ImageConstPtr& frame);
+  /// Calibrated frame to frame: a frame and its camera_info, on to pose_wait_.
+  void onCalibratedFrame(const sensor_msgs::ImageConstPtr& frame,
+                         const sensor_msgs::CameraInfoConstPtr& info);
+  /// A frame with its camera pose: skipped, matched with the keyframe, or made the keyframe.
+  void onPosedFrame(const sensor_msgs::ImageConstPtr& frame,
+                    const sensor_msgs::CameraInfoConstPtr& info, const Eigen::Isometry3d& T_W_C);
+  bool calibratedFrames() const {
+    return settings_.node.frame_to_frame && settings_.node.calibrated;
+  }
   void onCalibratedPair(const sensor_msgs::ImageConstPtr& left,
                         const sensor_msgs::ImageConstPtr& right,
                         const sensor_msgs::CameraInfoConstPtr& left_info,
@@ -117,6 +151,10 @@ class MatcherNode {
   void reportDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& status);
   bool stereoCameras(const Image& left, const Image& right, const Info& left_info,
                      const Info& right_info, StereoCameras* cameras);
+  /// The two cameras from their camera_infos, the right one at T_L_R in the left's frame.
+  bool posedCameras(const Image& left, const Image& right, const Info& left_info,
+                    const Info& right_info, const Eigen::Isometry3d& T_L_R,
+                    StereoCameras* cameras);
   /// The right camera's pose in the left camera's frame from tf.
   bool rightPoseFromTf(const Image& left, const Image& right, Eigen::Isometry3d* T_L_R);
   /// The first filter's kept matches triangulated (in the left camera's frame): `points`, and
@@ -153,6 +191,13 @@ class MatcherNode {
   message_filters::Subscriber<Info> left_info_sub_, right_info_sub_;
   std::unique_ptr<CalibratedSync> calibrated_sync_;
   std::unique_ptr<CalibratedApproximateSync> calibrated_approximate_sync_;
+  // Calibrated frame to frame, destroyed before the keyframe pose_wait_ hands frames to.
+  std::mutex keyframe_mutex_;  ///< keyframe_ and frame_counts_
+  Keyframe keyframe_;
+  FrameCounts frame_counts_;
+  std::unique_ptr<PoseWait> pose_wait_;
+  message_filters::Subscriber<Info> frame_info_sub_;
+  std::unique_ptr<FrameSync> frame_sync_;
 };
 
 }  // namespace sift_hull
