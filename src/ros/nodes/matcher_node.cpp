@@ -99,6 +99,7 @@ MatcherNode::MatcherNode(ros::NodeHandle nh, ros::NodeHandle private_nh, Matcher
       work_(settings_.node.max_waiting_pairs, settings_.node.workers,
             [this](Pair& pair) { matchPair(pair); }),
       pairing_(pairedInputs(settings_.node), kPairingPatience_s, pairingHint(settings_.node)),
+      pose_wait_(makePoseWait()),
       diagnostics_(nh_, private_nh_, "matcher", settings_.node.diagnostic_period,
                    [this](diagnostic_updater::DiagnosticStatusWrapper& status) {
                      reportDiagnostics(status);
@@ -149,7 +150,7 @@ std::shared_ptr<const MatcherNode::Pipeline> MatcherNode::pipeline() const {
 
 void MatcherNode::reportDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& status) {
   reportQueue(work_.counts(), "pairs", &status);
-  if (calibratedFrames()) {
+  if (pose_wait_) {  // calibrated frame to frame
     // Every frame paired with its camera_info is in exactly one of these, or still waiting for
     // its pose: received = keyframes + out of order + skipped + turned + paired + unusable +
     // without pose + cleared + waiting.
@@ -220,6 +221,18 @@ std::unique_ptr<ImageInput> MatcherNode::imageInput(const std::string& topic) {
                                       settings_.node.queue_size, settings_.node.image_transport);
 }
 
+std::unique_ptr<PoseWait> MatcherNode::makePoseWait() {
+  if (!calibratedFrames()) return nullptr;
+  return std::make_unique<PoseWait>(
+      nh_, &tf_buffer_, settings_.node.world_frame,
+      static_cast<uint32_t>(settings_.node.queue_size), settings_.node.pose_timeout_s,
+      [this](const sensor_msgs::ImageConstPtr& frame, const sensor_msgs::CameraInfoConstPtr& info,
+             const Eigen::Isometry3d& T_W_C) { onPosedFrame(frame, info, T_W_C); },
+      [this](const std::string&, const std::string& why) {
+        log_.error("matcher: frame dropped: ", why);  // each reason names the frame
+      });
+}
+
 void MatcherNode::setUpInputs() {
   if (calibratedFrames()) {
     frame_sub_ = imageInput("image");
@@ -232,14 +245,6 @@ void MatcherNode::setUpInputs() {
         InfoCallback([this](const sensor_msgs::CameraInfoConstPtr& m) {
           pairing_.arrived(1, m->header.stamp.toSec(), PairingWatch::Clock::now());
         }));
-    pose_wait_ = std::make_unique<PoseWait>(
-        nh_, &tf_buffer_, settings_.node.world_frame,
-        static_cast<uint32_t>(settings_.node.queue_size), settings_.node.pose_timeout_s,
-        [this](const sensor_msgs::ImageConstPtr& frame, const sensor_msgs::CameraInfoConstPtr& info,
-               const Eigen::Isometry3d& T_W_C) { onPosedFrame(frame, info, T_W_C); },
-        [this](const std::string&, const std::string& why) {
-          log_.error("matcher: frame dropped: ", why);  // each reason names the frame
-        });
     frame_sync_ = std::make_unique<FrameSync>(static_cast<uint32_t>(settings_.node.queue_size));
     frame_sync_->connectInput(*frame_sub_, frame_info_sub_);
     frame_sync_->registerCallback(&MatcherNode::onCalibratedFrame, this);

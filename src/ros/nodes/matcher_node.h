@@ -132,6 +132,8 @@ class MatcherNode {
   /// A frame with its camera pose: skipped, matched with the keyframe, or made the keyframe.
   void onPosedFrame(const sensor_msgs::ImageConstPtr& frame,
                     const sensor_msgs::CameraInfoConstPtr& info, const Eigen::Isometry3d& T_W_C);
+  /// Calibrated frame to frame: the wait for each frame's pose; otherwise none.
+  std::unique_ptr<PoseWait> makePoseWait();
   bool calibratedFrames() const {
     return settings_.node.frame_to_frame && settings_.node.calibrated;
   }
@@ -181,6 +183,12 @@ class MatcherNode {
   FeatureCache features_{8};
   WorkQueue<Pair> work_;
   PairingWatch pairing_;  ///< images (and camera_infos) that arrive but do not pair
+  // Calibrated frame to frame: after work_ (pose_wait_ queues pairs there), before diagnostics_
+  // (which reads them), the keyframe before pose_wait_ (which hands it frames).
+  std::mutex keyframe_mutex_;  ///< keyframe_ and frame_counts_
+  Keyframe keyframe_;
+  FrameCounts frame_counts_;
+  std::unique_ptr<PoseWait> pose_wait_;
   NodeDiagnostics diagnostics_;
   boost::recursive_mutex reconfigure_mutex_;  // the server's, so updateConfig cannot race it
   std::unique_ptr<dynamic_reconfigure::Server<sift_hull::MatcherConfig>> reconfigure_;
@@ -191,11 +199,7 @@ class MatcherNode {
   message_filters::Subscriber<Info> left_info_sub_, right_info_sub_;
   std::unique_ptr<CalibratedSync> calibrated_sync_;
   std::unique_ptr<CalibratedApproximateSync> calibrated_approximate_sync_;
-  // Calibrated frame to frame, destroyed before the keyframe pose_wait_ hands frames to.
-  std::mutex keyframe_mutex_;  ///< keyframe_ and frame_counts_
-  Keyframe keyframe_;
-  FrameCounts frame_counts_;
-  std::unique_ptr<PoseWait> pose_wait_;
+  // Calibrated frame to frame: the synchroniser feeding pose_wait_.
   message_filters::Subscriber<Info> frame_info_sub_;
   std::unique_ptr<FrameSync> frame_sync_;
 };
