@@ -396,17 +396,16 @@ class CalibratedFrameToFrameMatcherTest : public FrameToFrameMatcherTest {
     FrameToFrameMatcherTest::SetUp();
     info_pub_ = nh_.advertise<sensor_msgs::CameraInfo>("camera_info", 5);
     points_sub_ = nh_.subscribe("points", 5, &CalibratedFrameToFrameMatcherTest::onPoints, this);
-    ASSERT_TRUE(waitFor([&] {
-      return info_pub_.getNumSubscribers() > 0 && points_sub_.getNumPublishers() > 0;
-    }));
+    ASSERT_TRUE(waitFor(
+        [&] { return info_pub_.getNumSubscribers() > 0 && points_sub_.getNumPublishers() > 0; }));
   }
 
   /// A frame of `view` at `stamp`, with its camera_info, and its pose in tf unless `posed` is
   /// false.
   void publishFrame(const RenderedView& view, const ros::Time& stamp, bool posed = true) {
     if (posed) {
-      tf_.sendTransform(ros_conversions::cameraPoseMessage(view.view.camera, "world", "camera",
-                                                           stamp));
+      tf_.sendTransform(
+          ros_conversions::cameraPoseMessage(view.view.camera, "world", "camera", stamp));
     }
     std_msgs::Header header;
     header.stamp = stamp;
@@ -451,9 +450,9 @@ TEST_F(CalibratedFrameToFrameMatcherTest, MatchesTheKeyframeOnceTheCameraHasMove
 
   // A frame whose pose never comes is dropped after ~pose_timeout_s; every frame is counted.
   publishFrame(left_, moved + ros::Duration(0.5), false);
-  EXPECT_EQ(test::diagnosticValue(nh_, "matcher", "frames without pose",
-                                  [](double v) { return v >= 1; }),
-            1.0);
+  EXPECT_EQ(
+      test::diagnosticValue(nh_, "matcher", "frames without pose", [](double v) { return v >= 1; }),
+      1.0);
   const auto count = [&](const std::string& key) {
     return test::diagnosticValue(nh_, "matcher", key, [](double) { return true; });
   };

@@ -241,10 +241,9 @@ void MatcherNode::setUpInputs() {
     frame_sub_->registerCallback(ImageCallback([this](const sensor_msgs::ImageConstPtr& m) {
       pairing_.arrived(0, m->header.stamp.toSec(), PairingWatch::Clock::now());
     }));
-    frame_info_sub_.registerCallback(
-        InfoCallback([this](const sensor_msgs::CameraInfoConstPtr& m) {
-          pairing_.arrived(1, m->header.stamp.toSec(), PairingWatch::Clock::now());
-        }));
+    frame_info_sub_.registerCallback(InfoCallback([this](const sensor_msgs::CameraInfoConstPtr& m) {
+      pairing_.arrived(1, m->header.stamp.toSec(), PairingWatch::Clock::now());
+    }));
     frame_sync_ = std::make_unique<FrameSync>(static_cast<uint32_t>(settings_.node.queue_size));
     frame_sync_->connectInput(*frame_sub_, frame_info_sub_);
     frame_sync_->registerCallback(&MatcherNode::onCalibratedFrame, this);
@@ -304,9 +303,8 @@ void MatcherNode::watchArrivals() {
 void MatcherNode::subscribeInputs() {
   if (calibratedFrames()) {
     frame_sub_->subscribe();
-    frame_info_sub_.subscribe(
-        nh_, image_transport::getCameraInfoTopic(frame_sub_->resolvedTopic()),
-        static_cast<uint32_t>(settings_.node.queue_size));
+    frame_info_sub_.subscribe(nh_, image_transport::getCameraInfoTopic(frame_sub_->resolvedTopic()),
+                              static_cast<uint32_t>(settings_.node.queue_size));
     return;
   }
   if (frame_sub_) return frame_sub_->subscribe();
@@ -386,8 +384,7 @@ void MatcherNode::onPosedFrame(const sensor_msgs::ImageConstPtr& frame,
     // The frame's camera in the keyframe camera's frame.
     const Eigen::Isometry3d T_K_C = keyframe_.T_W_C.inverse() * T_W_C;
     const double baseline_m = T_K_C.translation().norm();
-    const double rotation_deg =
-        Eigen::AngleAxisd(T_K_C.rotation()).angle() / kRadiansPerDegree;
+    const double rotation_deg = Eigen::AngleAxisd(T_K_C.rotation()).angle() / kRadiansPerDegree;
     if (!std::isfinite(baseline_m) || !std::isfinite(rotation_deg)) {
       ++frame_counts_.unusable;
       log_.error("matcher: frame ignored: ", "its pose in tf is not finite");

@@ -23,9 +23,9 @@
 #include <vector>
 
 #include "lib/image_input.h"
-#include "lib/pose_wait.h"
 #include "lib/node_diagnostics.h"
 #include "lib/pairing_watch.h"
+#include "lib/pose_wait.h"
 #include "lib/throttled_log.h"
 #include "lib/work_queue.h"
 #include "nodes/matcher_node_config.h"
@@ -97,14 +97,14 @@ class MatcherNode {
   };
   /// Calibrated frame to frame: where each frame went, every one counted once.
   struct FrameCounts {
-    size_t received = 0;        ///< frames paired with their camera_info
-    size_t keyframes = 0;       ///< started a keyframe (the first, or after a pause)
-    size_t out_of_order = 0;    ///< stamp not after the keyframe's
-    size_t skipped = 0;         ///< baseline to the keyframe below ~min_baseline_m
-    size_t turned = 0;          ///< turned beyond ~max_rotation_deg: became the keyframe unmatched
-    size_t paired = 0;          ///< matched with the keyframe (then became it)
-    size_t unusable = 0;        ///< pose not finite (logged)
-    size_t cleared = 0;         ///< waiting for their pose when the last listener left
+    size_t received = 0;      ///< frames paired with their camera_info
+    size_t keyframes = 0;     ///< started a keyframe (the first, or after a pause)
+    size_t out_of_order = 0;  ///< stamp not after the keyframe's
+    size_t skipped = 0;       ///< baseline to the keyframe below ~min_baseline_m
+    size_t turned = 0;        ///< turned beyond ~max_rotation_deg: became the keyframe unmatched
+    size_t paired = 0;        ///< matched with the keyframe (then became it)
+    size_t unusable = 0;      ///< pose not finite (logged)
+    size_t cleared = 0;       ///< waiting for their pose when the last listener left
   };
 
   /// Advertises the outputs, with the connect callbacks that subscribe the inputs.
@@ -155,8 +155,7 @@ class MatcherNode {
                      const Info& right_info, StereoCameras* cameras);
   /// The two cameras from their camera_infos, the right one at T_L_R in the left's frame.
   bool posedCameras(const Image& left, const Image& right, const Info& left_info,
-                    const Info& right_info, const Eigen::Isometry3d& T_L_R,
-                    StereoCameras* cameras);
+                    const Info& right_info, const Eigen::Isometry3d& T_L_R, StereoCameras* cameras);
   /// The right camera's pose in the left camera's frame from tf.
   bool rightPoseFromTf(const Image& left, const Image& right, Eigen::Isometry3d* T_L_R);
   /// The first filter's kept matches triangulated (in the left camera's frame): `points`, and
