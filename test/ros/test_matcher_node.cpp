@@ -11,6 +11,7 @@
 #include <sensor_msgs/PointCloud2.h>
 #include <sensor_msgs/point_cloud2_iterator.h>
 #include <tf2_ros/static_transform_broadcaster.h>
+#include <tf2_ros/transform_broadcaster.h>
 
 #include <functional>
 #include <limits>
@@ -384,6 +385,81 @@ TEST_F(CalibratedMatcherTest, FiltersByEpipolarLinesAndTriangulatesOntoTheScene)
   size_t small_error = 0;
   for (const SurfacePoint& p : surface_points) small_error += p.reprojection_px < 1.0 ? 1 : 0;
   EXPECT_GE(small_error, 0.9 * surface_points.size());
+}
+
+/// ~frame_to_frame with ~calibrated: one moving camera (frame `camera`), its pose in `world` from
+/// tf at each frame's stamp, the camera_info beside `image`. Views 0 and 1 of the scene are two
+/// positions of the camera.
+class CalibratedFrameToFrameMatcherTest : public FrameToFrameMatcherTest {
+ protected:
+  void SetUp() override {
+    FrameToFrameMatcherTest::SetUp();
+    info_pub_ = nh_.advertise<sensor_msgs::CameraInfo>("camera_info", 5);
+    points_sub_ = nh_.subscribe("points", 5, &CalibratedFrameToFrameMatcherTest::onPoints, this);
+    ASSERT_TRUE(waitFor(
+        [&] { return info_pub_.getNumSubscribers() > 0 && points_sub_.getNumPublishers() > 0; }));
+  }
+
+  /// A frame of `view` at `stamp`, with its camera_info, and its pose in tf unless `posed` is
+  /// false.
+  void publishFrame(const RenderedView& view, const ros::Time& stamp, bool posed = true) {
+    if (posed) {
+      tf_.sendTransform(
+          ros_conversions::cameraPoseMessage(view.view.camera, "world", "camera", stamp));
+    }
+    std_msgs::Header header;
+    header.stamp = stamp;
+    header.frame_id = "camera";
+    info_pub_.publish(
+        ros_conversions::cameraInfoMessage(view.view.camera, view.image.size(), header));
+    frame_pub_.publish(bgrImage(view.image, stamp, "camera"));
+  }
+
+  void onPoints(const sensor_msgs::PointCloud2ConstPtr& message) { points_ = message; }
+
+  tf2_ros::TransformBroadcaster tf_;
+  ros::Publisher info_pub_;
+  ros::Subscriber points_sub_;
+  sensor_msgs::PointCloud2ConstPtr points_;
+};
+
+TEST_F(CalibratedFrameToFrameMatcherTest, MatchesTheKeyframeOnceTheCameraHasMoved) {
+  // The keyframe; the same pose again (no baseline: skipped); then the camera moved: matched.
+  const ros::Time first = ros::Time::now();
+  publishFrame(left_, first);
+  ros::WallDuration(0.2).sleep();
+  const ros::Time still = first + ros::Duration(0.5);
+  publishFrame(left_, still);
+  ros::WallDuration(0.2).sleep();
+  const ros::Time moved = still + ros::Duration(0.5);
+  publishFrame(right_, moved);
+  ASSERT_TRUE(waitFor([&] { return last_ && last_->right_header.stamp == moved; }))
+      << "no correspondences once the camera moved";
+  EXPECT_EQ(last_->header.stamp, first);  // the keyframe is the left image
+  ASSERT_EQ(last_->filters, (std::vector<std::string>{"epipolar", "gsc"}));
+  EXPECT_GE(last_->matches.size(), 50u);
+  expectNoneAnswered({still});
+  // The points, in the keyframe camera's frame, lie where its depth map says.
+  ASSERT_TRUE(waitFor([&] { return points_ && points_->header.stamp == first; }));
+  EXPECT_EQ(points_->header.frame_id, "camera");
+  const PinholeCamera camera(left_.view.camera.K(), Eigen::Matrix3d::Identity(),
+                             Eigen::Vector3d::Zero());
+  const test::DepthAgreement agreement = test::depthAgreement(*points_, camera, left_.depth);
+  ASSERT_GE(agreement.points, 20u);
+  EXPECT_GE(static_cast<double>(agreement.on_surface) / agreement.points, 0.9);
+
+  // A frame whose pose never comes is dropped after ~pose_timeout_s; every frame is counted.
+  publishFrame(left_, moved + ros::Duration(0.5), false);
+  EXPECT_EQ(
+      test::diagnosticValue(nh_, "matcher", "frames without pose", [](double v) { return v >= 1; }),
+      1.0);
+  const auto count = [&](const std::string& key) {
+    return test::diagnosticValue(nh_, "matcher", key, [](double) { return true; });
+  };
+  EXPECT_EQ(count("frames received"), 4.0);
+  EXPECT_EQ(count("frames started a keyframe"), 1.0);
+  EXPECT_EQ(count("frames skipped (baseline below ~min_baseline_m)"), 1.0);
+  EXPECT_EQ(count("frames matched with the keyframe"), 1.0);
 }
 
 /// ~approximate_sync with ~calibrated: the images and camera_infos pair by the nearest stamps.

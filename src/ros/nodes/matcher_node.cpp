@@ -26,6 +26,7 @@ constexpr double kPairingPatience_s = 5.0;
 
 /// The inputs a synchronizer pairs (none frame to frame), for PairingWatch.
 std::vector<std::string> pairedInputs(const MatcherNodeConfig& config) {
+  if (config.frame_to_frame && config.calibrated) return {"image", "camera_info"};
   if (config.frame_to_frame) return {};
   if (!config.calibrated) return {"left/image", "right/image"};
   return {"left/image", "right/image", "left/camera_info", "right/camera_info"};
@@ -33,6 +34,10 @@ std::vector<std::string> pairedInputs(const MatcherNodeConfig& config) {
 
 /// What pairing needs, for the warning.
 std::string pairingHint(const MatcherNodeConfig& config) {
+  if (config.frame_to_frame) {
+    return "each frame pairs with the camera_info of an equal stamp beside it (the image's "
+           "namespace + camera_info)";
+  }
   if (config.approximate_sync) return "approximate sync found no stamps near enough";
   if (config.calibrated) {
     return "the two images and the camera_info beside each (the image's namespace + camera_info) "
@@ -61,11 +66,21 @@ std::vector<std::unique_ptr<MatchFilter>> makeFilters(const MatcherSettings& set
     filters.push_back(makeFilter(spec, settings.filters));
   }
   if (filters.empty()) throw std::invalid_argument("~filters names no filter");
-  if (settings.node.frame_to_frame && settings.node.calibrated) {
-    throw std::invalid_argument("~frame_to_frame and ~calibrated do not go together yet");
-  }
   return filters;
 }
+
+/// Two cameras from their camera_infos, the left at the origin of its own frame and the right at
+/// T_L_R in it.
+bool camerasFromInfos(const sensor_msgs::CameraInfo& left_info,
+                      const sensor_msgs::CameraInfo& right_info, const cv::Size& left_size,
+                      const cv::Size& right_size, const Eigen::Isometry3d& T_L_R, bool rectified,
+                      PinholeCamera* left, PinholeCamera* right, std::string* why_not) {
+  return ros_conversions::cameraFromInfo(left_info, Eigen::Isometry3d::Identity(), left_size, left,
+                                         why_not, rectified) &&
+         ros_conversions::cameraFromInfo(right_info, T_L_R, right_size, right, why_not, rectified);
+}
+
+constexpr double kRadiansPerDegree = M_PI / 180.0;
 
 }  // namespace
 
@@ -84,6 +99,7 @@ MatcherNode::MatcherNode(ros::NodeHandle nh, ros::NodeHandle private_nh, Matcher
       work_(settings_.node.max_waiting_pairs, settings_.node.workers,
             [this](Pair& pair) { matchPair(pair); }),
       pairing_(pairedInputs(settings_.node), kPairingPatience_s, pairingHint(settings_.node)),
+      pose_wait_(makePoseWait()),
       diagnostics_(nh_, private_nh_, "matcher", settings_.node.diagnostic_period,
                    [this](diagnostic_updater::DiagnosticStatusWrapper& status) {
                      reportDiagnostics(status);
@@ -134,6 +150,25 @@ std::shared_ptr<const MatcherNode::Pipeline> MatcherNode::pipeline() const {
 
 void MatcherNode::reportDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& status) {
   reportQueue(work_.counts(), "pairs", &status);
+  if (pose_wait_) {  // calibrated frame to frame
+    // Every frame paired with its camera_info is in exactly one of these, or still waiting for
+    // its pose: received = keyframes + out of order + skipped + turned + paired + unusable +
+    // without pose + cleared + waiting.
+    FrameCounts counts;
+    {
+      std::lock_guard<std::mutex> lock(keyframe_mutex_);
+      counts = frame_counts_;
+    }
+    status.add("frames received", counts.received);
+    status.add("frames without pose", pose_wait_->dropped());
+    status.add("frames started a keyframe", counts.keyframes);
+    status.add("frames out of order", counts.out_of_order);
+    status.add("frames skipped (baseline below ~min_baseline_m)", counts.skipped);
+    status.add("frames turned beyond ~max_rotation_deg", counts.turned);
+    status.add("frames matched with the keyframe", counts.paired);
+    status.add("frames unusable", counts.unusable);
+    status.add("frames cleared waiting for their pose", counts.cleared);
+  }
   status.add("last pair ms", last_pair_ms_.load());
   status.add("images described", features_.misses());
   status.add("features reused", features_.hits());
@@ -186,7 +221,34 @@ std::unique_ptr<ImageInput> MatcherNode::imageInput(const std::string& topic) {
                                       settings_.node.queue_size, settings_.node.image_transport);
 }
 
+std::unique_ptr<PoseWait> MatcherNode::makePoseWait() {
+  if (!calibratedFrames()) return nullptr;
+  return std::make_unique<PoseWait>(
+      nh_, &tf_buffer_, settings_.node.world_frame,
+      static_cast<uint32_t>(settings_.node.queue_size), settings_.node.pose_timeout_s,
+      [this](const sensor_msgs::ImageConstPtr& frame, const sensor_msgs::CameraInfoConstPtr& info,
+             const Eigen::Isometry3d& T_W_C) { onPosedFrame(frame, info, T_W_C); },
+      [this](const std::string&, const std::string& why) {
+        log_.error("matcher: frame dropped: ", why);  // each reason names the frame
+      });
+}
+
 void MatcherNode::setUpInputs() {
+  if (calibratedFrames()) {
+    frame_sub_ = imageInput("image");
+    using ImageCallback = boost::function<void(const sensor_msgs::ImageConstPtr&)>;
+    using InfoCallback = boost::function<void(const sensor_msgs::CameraInfoConstPtr&)>;
+    frame_sub_->registerCallback(ImageCallback([this](const sensor_msgs::ImageConstPtr& m) {
+      pairing_.arrived(0, m->header.stamp.toSec(), PairingWatch::Clock::now());
+    }));
+    frame_info_sub_.registerCallback(InfoCallback([this](const sensor_msgs::CameraInfoConstPtr& m) {
+      pairing_.arrived(1, m->header.stamp.toSec(), PairingWatch::Clock::now());
+    }));
+    frame_sync_ = std::make_unique<FrameSync>(static_cast<uint32_t>(settings_.node.queue_size));
+    frame_sync_->connectInput(*frame_sub_, frame_info_sub_);
+    frame_sync_->registerCallback(&MatcherNode::onCalibratedFrame, this);
+    return;
+  }
   if (settings_.node.frame_to_frame) {
     frame_sub_ = imageInput("image");
     frame_sub_->registerCallback(&MatcherNode::onFrame, this);
@@ -239,6 +301,12 @@ void MatcherNode::watchArrivals() {
 }
 
 void MatcherNode::subscribeInputs() {
+  if (calibratedFrames()) {
+    frame_sub_->subscribe();
+    frame_info_sub_.subscribe(nh_, image_transport::getCameraInfoTopic(frame_sub_->resolvedTopic()),
+                              static_cast<uint32_t>(settings_.node.queue_size));
+    return;
+  }
   if (frame_sub_) return frame_sub_->subscribe();
   left_sub_->subscribe();
   right_sub_->subscribe();
@@ -257,7 +325,14 @@ void MatcherNode::unsubscribeInputs() {
   }
   left_info_sub_.unsubscribe();
   right_info_sub_.unsubscribe();
+  frame_info_sub_.unsubscribe();
   previous_frame_.reset();  // frame to frame: no pairing across a pause without listeners
+  if (pose_wait_) {
+    const size_t cleared = pose_wait_->clear();
+    std::lock_guard<std::mutex> lock(keyframe_mutex_);
+    frame_counts_.cleared += cleared;
+    keyframe_ = Keyframe{};  // the next frame starts a new keyframe
+  }
 }
 
 void MatcherNode::onCalibratedPair(const sensor_msgs::ImageConstPtr& left,
@@ -280,6 +355,70 @@ bool MatcherNode::rightPoseFromTf(const Image& left, const Image& right, Eigen::
   return true;
 }
 
+void MatcherNode::onCalibratedFrame(const sensor_msgs::ImageConstPtr& frame,
+                                    const sensor_msgs::CameraInfoConstPtr& info) {
+  pairing_.paired();
+  {
+    std::lock_guard<std::mutex> lock(keyframe_mutex_);
+    ++frame_counts_.received;
+  }
+  pose_wait_->add(frame, info);
+}
+
+void MatcherNode::onPosedFrame(const sensor_msgs::ImageConstPtr& frame,
+                               const sensor_msgs::CameraInfoConstPtr& info,
+                               const Eigen::Isometry3d& T_W_C) {
+  Pair pair;
+  {
+    std::lock_guard<std::mutex> lock(keyframe_mutex_);
+    if (!keyframe_.image) {
+      ++frame_counts_.keyframes;
+      keyframe_ = Keyframe{frame, info, T_W_C};
+      return;
+    }
+    if (frame->header.stamp <= keyframe_.image->header.stamp) {
+      ++frame_counts_.out_of_order;
+      log_.error("matcher: frame ignored: ", "its stamp is not after the keyframe's");
+      return;
+    }
+    // The frame's camera in the keyframe camera's frame.
+    const Eigen::Isometry3d T_K_C = keyframe_.T_W_C.inverse() * T_W_C;
+    const double baseline_m = T_K_C.translation().norm();
+    const double rotation_deg = Eigen::AngleAxisd(T_K_C.rotation()).angle() / kRadiansPerDegree;
+    if (!std::isfinite(baseline_m) || !std::isfinite(rotation_deg)) {
+      ++frame_counts_.unusable;
+      log_.error("matcher: frame ignored: ", "its pose in tf is not finite");
+      return;
+    }
+    if (rotation_deg > settings_.node.max_rotation_deg) {
+      ++frame_counts_.turned;
+      keyframe_ = Keyframe{frame, info, T_W_C};
+      return;
+    }
+    if (baseline_m <= settings_.node.min_baseline_m) {
+      ++frame_counts_.skipped;
+      return;
+    }
+    ++frame_counts_.paired;
+    pair = Pair{keyframe_.image, frame, keyframe_.info, info, true, T_K_C};
+    keyframe_ = Keyframe{frame, info, T_W_C};
+  }
+  enqueue(std::move(pair));  // the keyframe is the left image, as frame to frame uncalibrated
+}
+
+bool MatcherNode::posedCameras(const Image& left, const Image& right, const Info& left_info,
+                               const Info& right_info, const Eigen::Isometry3d& T_L_R,
+                               StereoCameras* cameras) {
+  std::string why_not;
+  if (!camerasFromInfos(left_info, right_info, cv::Size(left.width, left.height),
+                        cv::Size(right.width, right.height), T_L_R, settings_.node.rectified,
+                        &cameras->left, &cameras->right, &why_not)) {
+    log_.error("matcher: pair ignored: ", why_not);
+    return false;
+  }
+  return true;
+}
+
 bool MatcherNode::stereoCameras(const Image& left, const Image& right, const Info& left_info,
                                 const Info& right_info, StereoCameras* cameras) {
   const bool rectified = settings_.node.rectified;
@@ -293,10 +432,8 @@ bool MatcherNode::stereoCameras(const Image& left, const Image& right, const Inf
   } else {
     Eigen::Isometry3d T_L_R;
     if (!rightPoseFromTf(left, right, &T_L_R)) return false;
-    ok = ros_conversions::cameraFromInfo(left_info, Eigen::Isometry3d::Identity(), left_size,
-                                         &cameras->left, &why_not, rectified) &&
-         ros_conversions::cameraFromInfo(right_info, T_L_R, right_size, &cameras->right, &why_not,
-                                         rectified);
+    ok = camerasFromInfos(left_info, right_info, left_size, right_size, T_L_R, rectified,
+                          &cameras->left, &cameras->right, &why_not);
   }
   if (!ok) {
     log_.error("matcher: pair ignored: ", why_not);
@@ -353,8 +490,14 @@ void MatcherNode::matchPair(Pair& pair) {
   try {
     StereoCameras cameras;
     const bool calibrated = pair.left_info && pair.right_info;
-    if (calibrated &&
-        !stereoCameras(*pair.left, *pair.right, *pair.left_info, *pair.right_info, &cameras)) {
+    if (calibrated && pair.posed) {
+      // Calibrated frame to frame: the relative pose came with the pair.
+      if (!posedCameras(*pair.left, *pair.right, *pair.left_info, *pair.right_info, pair.T_L_R,
+                        &cameras)) {
+        return;
+      }
+    } else if (calibrated && !stereoCameras(*pair.left, *pair.right, *pair.left_info,
+                                            *pair.right_info, &cameras)) {
       return;
     }
     process(*pipeline(), pair.left, pair.right, calibrated ? &cameras : nullptr);

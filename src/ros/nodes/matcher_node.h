@@ -7,6 +7,7 @@
 #include <message_filters/sync_policies/approximate_time.h>
 #include <message_filters/sync_policies/exact_time.h>
 #include <message_filters/synchronizer.h>
+#include <message_filters/time_synchronizer.h>
 #include <ros/ros.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
@@ -24,6 +25,7 @@
 #include "lib/image_input.h"
 #include "lib/node_diagnostics.h"
 #include "lib/pairing_watch.h"
+#include "lib/pose_wait.h"
 #include "lib/throttled_log.h"
 #include "lib/work_queue.h"
 #include "nodes/matcher_node_config.h"
@@ -63,6 +65,8 @@ class MatcherNode {
       message_filters::sync_policies::ExactTime<Image, Image, Info, Info>>;
   using CalibratedApproximateSync = message_filters::Synchronizer<
       message_filters::sync_policies::ApproximateTime<Image, Image, Info, Info>>;
+  /// Calibrated frame to frame: each frame with the camera_info of an equal stamp.
+  using FrameSync = message_filters::TimeSynchronizer<Image, Info>;
 
   /// The pair's cameras, the left one at the origin of its own frame.
   struct StereoCameras {
@@ -80,6 +84,27 @@ class MatcherNode {
   struct Pair {
     sensor_msgs::ImageConstPtr left, right;
     sensor_msgs::CameraInfoConstPtr left_info, right_info;
+    /// Calibrated frame to frame: the right (later) camera's pose in the left (keyframe) camera's
+    /// frame, from the two poses in ~world_frame; then tf is not asked again.
+    bool posed = false;
+    Eigen::Isometry3d T_L_R = Eigen::Isometry3d::Identity();
+  };
+  /// Calibrated frame to frame: the frame later frames are matched with, and its pose.
+  struct Keyframe {
+    sensor_msgs::ImageConstPtr image;
+    sensor_msgs::CameraInfoConstPtr info;
+    Eigen::Isometry3d T_W_C = Eigen::Isometry3d::Identity();
+  };
+  /// Calibrated frame to frame: where each frame went, every one counted once.
+  struct FrameCounts {
+    size_t received = 0;      ///< frames paired with their camera_info
+    size_t keyframes = 0;     ///< started a keyframe (the first, or after a pause)
+    size_t out_of_order = 0;  ///< stamp not after the keyframe's
+    size_t skipped = 0;       ///< baseline to the keyframe below ~min_baseline_m
+    size_t turned = 0;        ///< turned beyond ~max_rotation_deg: became the keyframe unmatched
+    size_t paired = 0;        ///< matched with the keyframe (then became it)
+    size_t unusable = 0;      ///< pose not finite (logged)
+    size_t cleared = 0;       ///< waiting for their pose when the last listener left
   };
 
   /// Advertises the outputs, with the connect callbacks that subscribe the inputs.
@@ -101,6 +126,17 @@ class MatcherNode {
   void onReconfigure(sift_hull::MatcherConfig& config, uint32_t level);
   void onPair(const sensor_msgs::ImageConstPtr& left, const sensor_msgs::ImageConstPtr& right);
   void onFrame(const sensor_msgs::ImageConstPtr& frame);
+  /// Calibrated frame to frame: a frame and its camera_info, on to pose_wait_.
+  void onCalibratedFrame(const sensor_msgs::ImageConstPtr& frame,
+                         const sensor_msgs::CameraInfoConstPtr& info);
+  /// A frame with its camera pose: skipped, matched with the keyframe, or made the keyframe.
+  void onPosedFrame(const sensor_msgs::ImageConstPtr& frame,
+                    const sensor_msgs::CameraInfoConstPtr& info, const Eigen::Isometry3d& T_W_C);
+  /// Calibrated frame to frame: the wait for each frame's pose; otherwise none.
+  std::unique_ptr<PoseWait> makePoseWait();
+  bool calibratedFrames() const {
+    return settings_.node.frame_to_frame && settings_.node.calibrated;
+  }
   void onCalibratedPair(const sensor_msgs::ImageConstPtr& left,
                         const sensor_msgs::ImageConstPtr& right,
                         const sensor_msgs::CameraInfoConstPtr& left_info,
@@ -117,6 +153,9 @@ class MatcherNode {
   void reportDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& status);
   bool stereoCameras(const Image& left, const Image& right, const Info& left_info,
                      const Info& right_info, StereoCameras* cameras);
+  /// The two cameras from their camera_infos, the right one at T_L_R in the left's frame.
+  bool posedCameras(const Image& left, const Image& right, const Info& left_info,
+                    const Info& right_info, const Eigen::Isometry3d& T_L_R, StereoCameras* cameras);
   /// The right camera's pose in the left camera's frame from tf.
   bool rightPoseFromTf(const Image& left, const Image& right, Eigen::Isometry3d* T_L_R);
   /// The first filter's kept matches triangulated (in the left camera's frame): `points`, and
@@ -143,6 +182,12 @@ class MatcherNode {
   FeatureCache features_{8};
   WorkQueue<Pair> work_;
   PairingWatch pairing_;  ///< images (and camera_infos) that arrive but do not pair
+  // Calibrated frame to frame: after work_ (pose_wait_ queues pairs there), before diagnostics_
+  // (which reads them), the keyframe before pose_wait_ (which hands it frames).
+  std::mutex keyframe_mutex_;  ///< keyframe_ and frame_counts_
+  Keyframe keyframe_;
+  FrameCounts frame_counts_;
+  std::unique_ptr<PoseWait> pose_wait_;
   NodeDiagnostics diagnostics_;
   boost::recursive_mutex reconfigure_mutex_;  // the server's, so updateConfig cannot race it
   std::unique_ptr<dynamic_reconfigure::Server<sift_hull::MatcherConfig>> reconfigure_;
@@ -153,6 +198,9 @@ class MatcherNode {
   message_filters::Subscriber<Info> left_info_sub_, right_info_sub_;
   std::unique_ptr<CalibratedSync> calibrated_sync_;
   std::unique_ptr<CalibratedApproximateSync> calibrated_approximate_sync_;
+  // Calibrated frame to frame: the synchroniser feeding pose_wait_.
+  message_filters::Subscriber<Info> frame_info_sub_;
+  std::unique_ptr<FrameSync> frame_sync_;
 };
 
 }  // namespace sift_hull

@@ -37,8 +37,21 @@ struct MatcherNodeConfig {
   /// P that rectifies counts as rectified too (ros_conversions::cameraInfoGeometry).
   bool rectified = false;
   /// Subscribe one `image` topic instead, and match each frame with the one before it (the
-  /// earlier frame is the left image). Not with `calibrated`.
+  /// earlier frame is the left image). With `calibrated` too: the camera_info beside `image`,
+  /// each frame's camera pose in `world_frame` from tf, and a keyframe matched with the first
+  /// later frame whose camera centre is more than `min_baseline_m` from the keyframe's.
   bool frame_to_frame = false;
+  /// Calibrated frame to frame: the frame the camera poses are looked up in.
+  std::string world_frame = "world";
+  /// Calibrated frame to frame: a frame whose pose is not in tf within this much wall time is
+  /// dropped (counted in /diagnostics); <= 0: no limit.
+  double pose_timeout_s = 5.0;
+  /// Calibrated frame to frame: frames whose camera centre is this close to the keyframe's are
+  /// skipped (counted); the first one further away is matched with the keyframe and becomes it.
+  double min_baseline_m = 0.05;
+  /// Calibrated frame to frame: a frame turned further than this from the keyframe is not matched
+  /// (the views differ too much); it becomes the keyframe (counted).
+  double max_rotation_deg = 30.0;
   /// How the images arrive: "raw", "compressed" (decoded here when no plugin provides it), or
   /// another installed image_transport plugin.
   std::string image_transport = "raw";

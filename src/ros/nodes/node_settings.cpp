@@ -72,7 +72,21 @@ const SettingTable<MatcherNodeConfig>& settingsOf<MatcherNodeConfig>() {
     t.add("rectified", &MatcherNodeConfig::rectified, "",
           "the images are image_rect (image_proc): cameras from P and R, whatever D says");
     t.add("frame_to_frame", &MatcherNodeConfig::frame_to_frame, "",
-          "one `image` topic, each frame matched with the one before it");
+          "one `image` topic, each frame matched with the one before it (with calibrated: with "
+          "the keyframe, once the camera has moved min_baseline_m)");
+    t.add("world_frame", &MatcherNodeConfig::world_frame, "",
+          "calibrated frame to frame: frame the camera poses are looked up in (tf)");
+    t.add("pose_timeout_s", &MatcherNodeConfig::pose_timeout_s, "s",
+          "calibrated frame to frame: a frame whose pose is not in tf by then is dropped; <= 0: "
+          "no limit");
+    t.add("min_baseline_m", &MatcherNodeConfig::min_baseline_m, "m",
+          "calibrated frame to frame: frames whose camera centre is this close to the keyframe's "
+          "are skipped; the first further away is matched with it and becomes the keyframe")
+        .atLeast(0.0);
+    t.add("max_rotation_deg", &MatcherNodeConfig::max_rotation_deg, "deg",
+          "calibrated frame to frame: a frame turned further from the keyframe is not matched "
+          "and becomes the keyframe")
+        .range(0.0, 180.0);
     t.add("image_transport", &MatcherNodeConfig::image_transport, "",
           "raw, compressed (decoded here when no plugin provides it), or another image_transport "
           "plugin");
