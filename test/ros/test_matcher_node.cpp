@@ -10,11 +10,12 @@
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <sensor_msgs/point_cloud2_iterator.h>
+#include <tf2_msgs/TFMessage.h>
 #include <tf2_ros/static_transform_broadcaster.h>
-#include <tf2_ros/transform_broadcaster.h>
 
 #include <functional>
 #include <limits>
+#include <map>
 #include <mutex>
 #include <opencv2/imgcodecs.hpp>
 #include <set>
@@ -395,17 +396,24 @@ class CalibratedFrameToFrameMatcherTest : public FrameToFrameMatcherTest {
   void SetUp() override {
     FrameToFrameMatcherTest::SetUp();
     info_pub_ = nh_.advertise<sensor_msgs::CameraInfo>("camera_info", 5);
+    tf_pub_ = nh_.advertise<tf2_msgs::TFMessage>("/tf", 100);
     points_sub_ = nh_.subscribe("points", 5, &CalibratedFrameToFrameMatcherTest::onPoints, this);
-    ASSERT_TRUE(waitFor(
-        [&] { return info_pub_.getNumSubscribers() > 0 && points_sub_.getNumPublishers() > 0; }));
+    // The node's tf listener connected before any pose is sent (a pose sent earlier is lost).
+    ASSERT_TRUE(waitFor([&] {
+      return info_pub_.getNumSubscribers() > 0 && points_sub_.getNumPublishers() > 0 &&
+             tf_pub_.getNumSubscribers() > 0;
+    }));
   }
 
   /// A frame of `view` at `stamp`, with its camera_info, and its pose in tf unless `posed` is
-  /// false.
-  void publishFrame(const RenderedView& view, const ros::Time& stamp, bool posed = true) {
+  /// false; `pose` replaces the view's own camera pose where given.
+  void publishFrame(const RenderedView& view, const ros::Time& stamp, bool posed = true,
+                    const PinholeCamera* pose = nullptr) {
     if (posed) {
-      tf_.sendTransform(
-          ros_conversions::cameraPoseMessage(view.view.camera, "world", "camera", stamp));
+      tf2_msgs::TFMessage poses;
+      poses.transforms.push_back(ros_conversions::cameraPoseMessage(pose ? *pose : view.view.camera,
+                                                                    "world", "camera", stamp));
+      tf_pub_.publish(poses);
     }
     std_msgs::Header header;
     header.stamp = stamp;
@@ -417,8 +425,7 @@ class CalibratedFrameToFrameMatcherTest : public FrameToFrameMatcherTest {
 
   void onPoints(const sensor_msgs::PointCloud2ConstPtr& message) { points_ = message; }
 
-  tf2_ros::TransformBroadcaster tf_;
-  ros::Publisher info_pub_;
+  ros::Publisher info_pub_, tf_pub_;
   ros::Subscriber points_sub_;
   sensor_msgs::PointCloud2ConstPtr points_;
 };
@@ -460,6 +467,48 @@ TEST_F(CalibratedFrameToFrameMatcherTest, MatchesTheKeyframeOnceTheCameraHasMove
   EXPECT_EQ(count("frames started a keyframe"), 1.0);
   EXPECT_EQ(count("frames skipped (baseline below ~min_baseline_m)"), 1.0);
   EXPECT_EQ(count("frames matched with the keyframe"), 1.0);
+}
+
+TEST_F(CalibratedFrameToFrameMatcherTest, ATurnedFrameStartsAKeyframeAndAnOlderOneIsRefused) {
+  // The counts go on across the cases of one node: each is checked as a rise from its value now.
+  const std::vector<std::string> keys = {
+      "frames received", "frames started a keyframe", "frames out of order",
+      "frames turned beyond ~max_rotation_deg", "frames matched with the keyframe"};
+  std::map<std::string, double> before;
+  for (const std::string& key : keys) {
+    before[key] = test::diagnosticValue(nh_, "matcher", key, [](double) { return true; });
+  }
+  const auto count = [&](const std::string& key, double rise) {
+    return test::diagnosticValue(nh_, "matcher", key,
+                                 [&](double v) { return v >= before[key] + rise; }) -
+           before[key];
+  };
+  const ros::Time first = ros::Time::now();
+  publishFrame(left_, first);  // the keyframe
+  ASSERT_EQ(count("frames started a keyframe", 1), 1.0);
+  publishFrame(left_, first - ros::Duration(0.5));  // older than the keyframe: refused
+  ASSERT_EQ(count("frames out of order", 1), 1.0);
+  // The right view's camera turned 120 degrees about its optical axis (centre unchanged): beyond
+  // ~max_rotation_deg (90), so it is not matched and becomes the keyframe.
+  const PinholeCamera& right = right_.view.camera;
+  const Eigen::Matrix3d turn =
+      Eigen::AngleAxisd(120.0 * M_PI / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const PinholeCamera turned(right.K(), turn * right.R(), turn * right.t());
+  const ros::Time second = first + ros::Duration(0.5);
+  publishFrame(right_, second, true, &turned);
+  ASSERT_EQ(count("frames turned beyond ~max_rotation_deg", 1), 1.0);
+  // The same camera moved 5 cm sideways without turning: matched with the turned keyframe.
+  const Eigen::Vector3d centre =
+      turned.centre() + turned.R().transpose() * Eigen::Vector3d(0.05, 0, 0);
+  const PinholeCamera moved(turned.K(), turned.R(), -turned.R() * centre);
+  const ros::Time third = second + ros::Duration(0.5);
+  publishFrame(right_, third, true, &moved);
+  ASSERT_TRUE(waitFor([&] { return last_ && last_->right_header.stamp == third; }))
+      << "no correspondences with the turned keyframe";
+  EXPECT_EQ(last_->header.stamp, second);
+  EXPECT_EQ(count("frames matched with the keyframe", 1), 1.0);
+  expectNoneAnswered({first, first - ros::Duration(0.5)});
+  EXPECT_EQ(count("frames received", 4), 4.0);
 }
 
 /// ~approximate_sync with ~calibrated: the images and camera_infos pair by the nearest stamps.
