@@ -3,8 +3,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <tuple>
 
 #include "concave_scene.h"
 #include "sift_hull/eval/hull_evaluation.h"
@@ -75,6 +77,42 @@ TEST_F(CupStream, PointsWaitForTheBoxThenCarveTheCavityAndNothingOfTheSolid) {
   EXPECT_FALSE(stream.refineDue()) << "the points were forgotten by the reset";
 }
 
+TEST_F(CupStream, ARefinementInSlicesCarvesWhatOneAtOnceCarves) {
+  PointCarvedStream whole(streamConfig(7), {}), sliced(streamConfig(7), {});
+  for (PointCarvedStream* stream : {&whole, &sliced}) {
+    for (uint32_t v = 0; v < scene.views.size(); ++v) addPoints(stream, v);
+    for (size_t v = 0; v < scene.views.size(); ++v) addView(stream, v);
+  }
+  const PointCarvedStream::Refinement at_once = whole.refine();
+  PointCarvedStream::Refinement in_slices;
+  size_t slices = 0;
+  for (; slices < 100000 && !sliced.refineFor(1e-4, &in_slices); ++slices) {
+    ASSERT_TRUE(sliced.refining());
+    ASSERT_TRUE(sliced.refineDue()) << "a refinement not done is due";
+    ASSERT_EQ(sliced.stream().hull().freeVoxelCount(), 0u) << "carved only at the last slice";
+  }
+  EXPECT_GE(slices, 5u) << "a 0.1 ms budget must take several slices";
+  EXPECT_FALSE(sliced.refining());
+  EXPECT_FALSE(sliced.refineDue());
+  ASSERT_GT(at_once.free_voxels, 0u);
+  EXPECT_EQ(in_slices.free_voxels, at_once.free_voxels);
+  EXPECT_EQ(in_slices.points_used, at_once.points_used);
+  std::vector<Eigen::Vector3i> a = whole.stream().hull().freeVoxels(),
+                               b = sliced.stream().hull().freeVoxels();
+  const auto order = [](const Eigen::Vector3i& p, const Eigen::Vector3i& q) {
+    return std::tie(p.z(), p.y(), p.x()) < std::tie(q.z(), q.y(), q.x());
+  };
+  std::sort(a.begin(), a.end(), order);
+  std::sort(b.begin(), b.end(), order);
+  EXPECT_TRUE(a == b) << "the same free voxels";
+  // A reset in the middle drops the refinement with everything else.
+  for (uint32_t v = 0; v < scene.views.size(); ++v) addPoints(&sliced, v);
+  ASSERT_FALSE(sliced.refineFor(1e-4, &in_slices));
+  sliced.reset();
+  EXPECT_FALSE(sliced.refining());
+  EXPECT_FALSE(sliced.refineDue());
+}
+
 TEST_F(CupStream, ATreeThatStartsAnewIsCarvedAgain) {
   PointCarvedStream stream(streamConfig(6), {});
   for (uint32_t v = 0; v < scene.views.size(); ++v) addPoints(&stream, v);
@@ -137,8 +175,8 @@ TEST_F(CupStream, AFarCameraOrPointIsRefusedAndTheCarvingGoesOn) {
   for (size_t v = 0; v < scene.views.size(); ++v) addView(&stream, v);
   ASSERT_TRUE(stream.stream().hasHull());
   const PinholeCamera& near = scene.views[0].view.camera;
-  const PinholeCamera far = PinholeCamera::fromCentre(near.K(), near.R(),
-                                                      Eigen::Vector3d(1e300, 0.0, 0.0));
+  const PinholeCamera far =
+      PinholeCamera::fromCentre(near.K(), near.R(), Eigen::Vector3d(1e300, 0.0, 0.0));
   std::vector<SurfacePoint> points = pointsOfView(scene.views, 0);
   const PointCarvedStream::AddedPoints refused = stream.addSurfacePoints(near, far, points, 0);
   EXPECT_EQ(refused.kept, 0u);

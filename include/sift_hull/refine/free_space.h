@@ -1,6 +1,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <memory>
 #include <vector>
 
 #include "sift_hull/geometry/camera.h"
@@ -52,5 +53,32 @@ std::vector<Eigen::Vector3i> freeVoxels(const VisualHull& hull,
                                         const std::vector<PinholeCamera>& cameras,
                                         const std::vector<SurfacePoint>& points,
                                         const FreeSpaceConfig& config);
+
+/// freeVoxels in slices of bounded time, so that a caller with other work (the hull node's
+/// worker, whose views must not wait behind a refinement of seconds) can do it between them. The
+/// views' surfaces are made one view per slice at most, then the hull's occupied leaves (as they
+/// were at construction) are examined in runs sized to the time left. The union of what the
+/// slices find equals freeVoxels(hull, ...) at construction, in no particular order.
+///
+/// Threads: one caller at a time; each slice runs on the hull's threads.
+class FreeSpaceCarving {
+ public:
+  /// Takes the occupied leaves of `hull` as they are now; the hull is not read afterwards.
+  /// Throws std::invalid_argument as freeVoxels does.
+  FreeSpaceCarving(const VisualHull& hull, std::vector<PinholeCamera> cameras,
+                   std::vector<SurfacePoint> points, const FreeSpaceConfig& config);
+  ~FreeSpaceCarving();
+  FreeSpaceCarving(const FreeSpaceCarving&) = delete;
+  FreeSpaceCarving& operator=(const FreeSpaceCarving&) = delete;
+
+  /// Works until `budget_s` of wall time is spent (at least one view's surface or one run of
+  /// leaves; infinity: to the end), appending the free voxels found to `free`. True once done.
+  bool step(double budget_s, std::vector<Eigen::Vector3i>* free);
+  bool done() const;
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
 
 }  // namespace sift_hull

@@ -3,6 +3,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <deque>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -80,8 +81,8 @@ class PointCarvedStream {
   size_t clearBox(const Box3d& box_W);
   static constexpr size_t kMaxClearedVoxels = size_t{1} << 20;
 
-  /// Whether refine() has work: a hull, and points that arrived since the last refine() or a tree
-  /// that started anew while points are kept.
+  /// Whether refine() has work: a hull, and a refinement not done (refineFor), points that arrived
+  /// since the last refinement, or a tree that started anew while points are kept.
   bool refineDue();
 
   struct Refinement {
@@ -93,6 +94,14 @@ class PointCarvedStream {
   /// Carves the hull with the free voxels of every point kept that lies inside it. Requires
   /// stream().hasHull().
   Refinement refine();
+  /// refine() in slices of about `budget_s` of wall time (FreeSpaceCarving): false while work is
+  /// left (call again; views may be added in between), true when the refinement is done and
+  /// carved, with its result in `refinement`. The free voxels are judged on the hull as it was at
+  /// the first slice and carved at the last, except those that views carved out meanwhile. A tree
+  /// that starts anew, or reset(), begins the refinement again. Requires stream().hasHull().
+  bool refineFor(double budget_s, Refinement* refinement);
+  /// A refinement begun by refineFor and not done.
+  bool refining() const { return carving_ != nullptr; }
 
   /// Back to no views, no hull and no points.
   void reset();
@@ -125,6 +134,12 @@ class PointCarvedStream {
   bool points_new_ = false;          ///< points arrived since the last refine()
   uint64_t refined_generation_ = 0;  ///< the stream's hull generation last carved with points
   size_t free_voxels_ = 0;
+  // The refinement in progress (refineFor): its carving, the tree generation it judges, what it
+  // found so far and its result but for the free voxels.
+  std::unique_ptr<FreeSpaceCarving> carving_;
+  uint64_t carving_generation_ = 0;
+  std::vector<Eigen::Vector3i> carving_found_;
+  Refinement carving_result_;
 };
 
 }  // namespace sift_hull

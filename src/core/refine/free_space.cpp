@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -204,74 +205,143 @@ void checkViews(const std::vector<PinholeCamera>& cameras,
 
 }  // namespace
 
+/// The state of one carving between its slices.
+struct FreeSpaceCarving::State {
+  FreeSpaceConfig config;
+  HullCube cube;
+  int threads = 1;
+  std::vector<PinholeCamera> cameras;  ///< the surfaces point into these
+  std::vector<SurfacePoint> points;    ///< each one's views sorted
+  std::vector<ViewSurface> surfaces;
+  uint32_t next_view = 0;  ///< the next view whose surface is made
+  bool kept_done = false;
+  std::unordered_set<uint64_t> kept;  ///< voxels near a surface point: never free
+  std::vector<HullCell> leaves;       ///< the hull's occupied leaves at the start
+  size_t next_leaf = 0;
+  bool too_few_views = false;
+};
+
+FreeSpaceCarving::FreeSpaceCarving(const VisualHull& hull, std::vector<PinholeCamera> cameras,
+                                   std::vector<SurfacePoint> points, const FreeSpaceConfig& config)
+    : state_(std::make_unique<State>()) {
+  validate(config);
+  checkViews(cameras, points);
+  State& s = *state_;
+  s.config = config;
+  s.cube = hull.cube();
+  s.threads = hull.config().threads;
+  s.cameras = std::move(cameras);
+  s.points = std::move(points);
+  for (SurfacePoint& point : s.points) std::sort(point.views.begin(), point.views.end());
+  hull.forEachLeaf([&](const HullCell& cell) {
+    if (cell.state != CellState::kOut) s.leaves.push_back(cell);
+  });
+}
+
+FreeSpaceCarving::~FreeSpaceCarving() = default;
+
+bool FreeSpaceCarving::done() const {
+  const State& s = *state_;
+  return s.too_few_views || s.next_leaf >= s.leaves.size();
+}
+
+bool FreeSpaceCarving::step(double budget_s, std::vector<Eigen::Vector3i>* free) {
+  using Clock = std::chrono::steady_clock;
+  const Clock::time_point start = Clock::now();
+  const auto elapsed_s = [&] {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+  };
+  State& s = *state_;
+  const double voxel_m = s.cube.resolution_m;
+  const int cells = 1 << s.cube.depth;
+  // Each view's surface, one view at a time.
+  while (s.next_view < s.cameras.size()) {
+    ViewSurface surface = viewSurface(
+        s.cameras[s.next_view], s.next_view, s.points, s.config.max_edge_fraction * s.cube.edge_m(),
+        std::cos(s.config.max_slant_deg * M_PI / 180.0), s.config.bulge_fraction);
+    ++s.next_view;
+    if (!surface.depth_m.empty()) s.surfaces.push_back(std::move(surface));
+    if (s.next_view < s.cameras.size() && elapsed_s() >= budget_s) return false;
+  }
+  if (static_cast<int>(s.surfaces.size()) < s.config.min_views) s.too_few_views = true;
+  if (done()) return true;
+  if (!s.kept_done) {
+    // The surface and a little around it stay.
+    const int reach = static_cast<int>(std::ceil(s.config.keep_radius_voxels));
+    const int side = 2 * reach + 1;
+    for (const SurfacePoint& point : s.points) {
+      const Eigen::Vector3d g = (point.X_W - s.cube.origin_W()) / voxel_m;
+      const Eigen::Vector3i base = g.array().floor().cast<int>();
+      for (int c = 0; c < side * side * side; ++c) {
+        const Eigen::Vector3i voxel =
+            base +
+            Eigen::Vector3i(c % side - reach, c / side % side - reach, c / side / side - reach);
+        if (detail::inCube(voxel, cells) &&
+            ((voxel.cast<double>().array() + 0.5).matrix() - g).norm() <=
+                s.config.keep_radius_voxels) {
+          s.kept.insert(detail::voxelKey(voxel));
+        }
+      }
+    }
+    s.kept_done = true;
+    if (elapsed_s() >= budget_s) return done();
+  }
+  // Every occupied finest voxel, a run of leaves at a time. The silhouettes settle the hull's
+  // surface cells within a voxel already: those need two views (the lid a visual hull puts over a
+  // cup's opening has them; the faces silhouettes see stay smooth).
+  const int surface_views = std::max(s.config.min_views, 2);
+  const double margin_m = s.config.stop_margin_voxels * voxel_m;
+  const auto voxelsOf = [&](const HullCell& cell) {
+    const size_t edge = size_t{1} << (s.cube.depth - cell.depth);
+    return edge * edge * edge;
+  };
+  std::mutex free_mutex;
+  double run_voxels = 4096.0, examined = 0.0;
+  while (s.next_leaf < s.leaves.size()) {
+    const size_t first = s.next_leaf;
+    size_t end = first;
+    double voxels = 0.0;
+    while (end < s.leaves.size() && (voxels == 0.0 || voxels < run_voxels)) {
+      voxels += static_cast<double>(voxelsOf(s.leaves[end++]));
+    }
+    detail::parallelFor(end - first, s.threads, [&](size_t i) {
+      const HullCell& cell = s.leaves[first + i];
+      const int edge = 1 << (s.cube.depth - cell.depth);
+      std::vector<Eigen::Vector3i> found;
+      for (int n = 0; n < edge * edge * edge; ++n) {
+        const Eigen::Vector3i voxel =
+            cell.index * edge + Eigen::Vector3i(n % edge, n / edge % edge, n / edge / edge);
+        const Eigen::Vector3d centre_W =
+            s.cube.origin_W() + (voxel.cast<double>().array() + 0.5).matrix() * voxel_m;
+        const int needed = cell.state == CellState::kIn ? s.config.min_views : surface_views;
+        int empty = 0;
+        for (size_t v = 0; v < s.surfaces.size() && empty < needed; ++v) {
+          empty += s.surfaces[v].seesEmpty(centre_W, margin_m) ? 1 : 0;
+        }
+        if (empty >= needed && s.kept.count(detail::voxelKey(voxel)) == 0) found.push_back(voxel);
+      }
+      if (found.empty()) return;
+      std::lock_guard<std::mutex> lock(free_mutex);
+      free->insert(free->end(), found.begin(), found.end());
+    });
+    s.next_leaf = end;
+    examined += voxels;
+    const double spent_s = elapsed_s();
+    if (spent_s >= budget_s) break;
+    // The next run: what the rest of the budget allows at the pace so far.
+    run_voxels = spent_s > 0.0 ? std::min(4096.0 + (budget_s - spent_s) * examined / spent_s, 1e15)
+                               : 2.0 * run_voxels;
+  }
+  return done();
+}
 
 std::vector<Eigen::Vector3i> freeVoxels(const VisualHull& hull,
                                         const std::vector<PinholeCamera>& cameras,
                                         const std::vector<SurfacePoint>& points,
                                         const FreeSpaceConfig& config) {
-  validate(config);
-  checkViews(cameras, points);
-  std::vector<SurfacePoint> sorted = points;
-  for (SurfacePoint& point : sorted) std::sort(point.views.begin(), point.views.end());
-  const HullCube& cube = hull.cube();
-  const double voxel_m = cube.resolution_m;
-  const int cells = 1 << cube.depth;
-  std::vector<ViewSurface> surfaces;
-  for (uint32_t view = 0; view < cameras.size(); ++view) {
-    ViewSurface surface =
-        viewSurface(cameras[view], view, sorted, config.max_edge_fraction * cube.edge_m(),
-                    std::cos(config.max_slant_deg * M_PI / 180.0), config.bulge_fraction);
-    if (!surface.depth_m.empty()) surfaces.push_back(std::move(surface));
-  }
-  if (static_cast<int>(surfaces.size()) < config.min_views) return {};
-  // The surface and a little around it stay.
-  std::unordered_set<uint64_t> kept;
-  const int reach = static_cast<int>(std::ceil(config.keep_radius_voxels));
-  for (const SurfacePoint& point : sorted) {
-    const Eigen::Vector3d g = (point.X_W - cube.origin_W()) / voxel_m;
-    const Eigen::Vector3i base = g.array().floor().cast<int>();
-    for (int c = 0; c < (2 * reach + 1) * (2 * reach + 1) * (2 * reach + 1); ++c) {
-      const int side = 2 * reach + 1;
-      const Eigen::Vector3i voxel =
-          base +
-          Eigen::Vector3i(c % side - reach, c / side % side - reach, c / side / side - reach);
-      if (detail::inCube(voxel, cells) &&
-          ((voxel.cast<double>().array() + 0.5).matrix() - g).norm() <= config.keep_radius_voxels) {
-        kept.insert(detail::voxelKey(voxel));
-      }
-    }
-  }
-  // Every occupied finest voxel. The silhouettes settle the hull's surface cells within a voxel
-  // already: those need two views (the lid a visual hull puts over a cup's opening has them; the
-  // faces silhouettes see stay smooth).
-  std::vector<HullCell> leaves;
-  hull.forEachLeaf([&](const HullCell& cell) {
-    if (cell.state != CellState::kOut) leaves.push_back(cell);
-  });
-  const int surface_views = std::max(config.min_views, 2);
-  const double margin_m = config.stop_margin_voxels * voxel_m;
+  FreeSpaceCarving carving(hull, cameras, points, config);
   std::vector<Eigen::Vector3i> free;
-  std::mutex free_mutex;
-  detail::parallelFor(leaves.size(), hull.config().threads, [&](size_t i) {
-    const HullCell& cell = leaves[i];
-    const int edge = 1 << (cube.depth - cell.depth);
-    std::vector<Eigen::Vector3i> found;
-    for (int n = 0; n < edge * edge * edge; ++n) {
-      const Eigen::Vector3i voxel =
-          cell.index * edge + Eigen::Vector3i(n % edge, n / edge % edge, n / edge / edge);
-      const Eigen::Vector3d centre_W =
-          cube.origin_W() + (voxel.cast<double>().array() + 0.5).matrix() * voxel_m;
-      const int needed = cell.state == CellState::kIn ? config.min_views : surface_views;
-      int empty = 0;
-      for (size_t s = 0; s < surfaces.size() && empty < needed; ++s) {
-        empty += surfaces[s].seesEmpty(centre_W, margin_m) ? 1 : 0;
-      }
-      if (empty >= needed && kept.count(detail::voxelKey(voxel)) == 0) found.push_back(voxel);
-    }
-    if (found.empty()) return;
-    std::lock_guard<std::mutex> lock(free_mutex);
-    free.insert(free.end(), found.begin(), found.end());
-  });
+  carving.step(std::numeric_limits<double>::infinity(), &free);
   std::sort(free.begin(), free.end(), [](const Eigen::Vector3i& a, const Eigen::Vector3i& b) {
     return std::tie(a.z(), a.y(), a.x()) < std::tie(b.z(), b.y(), b.x());
   });

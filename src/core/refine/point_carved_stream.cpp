@@ -1,6 +1,7 @@
 #include "sift_hull/refine/point_carved_stream.h"
 
 #include <algorithm>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 #include <utility>
@@ -55,8 +56,8 @@ void subsample(std::vector<SurfacePoint>* points, size_t keep) {
   points->swap(kept);
 }
 
-template <typename Predicate>
-size_t eraseIf(std::vector<SurfacePoint>* points, Predicate predicate) {
+template <typename T, typename Predicate>
+size_t eraseIf(std::vector<T>* points, Predicate predicate) {
   const size_t before = points->size();
   points->erase(std::remove_if(points->begin(), points->end(), predicate), points->end());
   return before - points->size();
@@ -81,15 +82,17 @@ bool PointCarvedStream::insideMargin(const Eigen::Vector3d& X_W) const {
   return cube.box().contains(X_W, config_.max_distance_cube_edges * cube.edge_m());
 }
 
-PointCarvedStream::AddedPoints PointCarvedStream::addSurfacePoints(
-    const PinholeCamera& left, const PinholeCamera& right, std::vector<SurfacePoint> points,
-    int64_t stamp_ns) {
+PointCarvedStream::AddedPoints PointCarvedStream::addSurfacePoints(const PinholeCamera& left,
+                                                                   const PinholeCamera& right,
+                                                                   std::vector<SurfacePoint> points,
+                                                                   int64_t stamp_ns) {
   AddedPoints added;
   if (stream_.hasHull()) {
     added.refused = farCamera(left);
     if (added.refused.empty()) added.refused = farCamera(right);
     if (!added.refused.empty()) return added;
-    added.outside = eraseIf(&points, [this](const SurfacePoint& p) { return !insideMargin(p.X_W); });
+    added.outside =
+        eraseIf(&points, [this](const SurfacePoint& p) { return !insideMargin(p.X_W); });
   }
   const double max_px = config_.surface_points.max_reprojection_px;
   added.over_reprojection =
@@ -130,7 +133,8 @@ size_t PointCarvedStream::clearBox(const Box3d& box_W) {
   if (!isValidClearBox(box_W)) {
     throw std::invalid_argument("a box to clear must be finite with min <= max on each axis");
   }
-  const std::vector<Eigen::Vector3i> voxels = occupiedVoxelsIn(stream_.hull(), box_W, kMaxClearedVoxels);
+  const std::vector<Eigen::Vector3i> voxels =
+      occupiedVoxelsIn(stream_.hull(), box_W, kMaxClearedVoxels);
   stream_.carveFree(voxels);
   free_voxels_ = stream_.hull().freeVoxelCount();
   return voxels.size();
@@ -138,41 +142,75 @@ size_t PointCarvedStream::clearBox(const Box3d& box_W) {
 
 bool PointCarvedStream::refineDue() {
   if (!stream_.hasHull()) return false;  // the points wait for the first box
+  if (carving_) return true;             // a refinement not done
   std::lock_guard<std::mutex> lock(points_mutex_);
   if (pairs_.empty()) return false;
   return points_new_ || stream_.hullGeneration() != refined_generation_;
 }
 
 PointCarvedStream::Refinement PointCarvedStream::refine() {
-  std::vector<PinholeCamera> cameras;
-  std::vector<SurfacePoint> points;
   Refinement refinement;
-  refinement.pairs_refused = dropFarPairs();
-  {
-    std::lock_guard<std::mutex> lock(points_mutex_);
-    points_new_ = false;
-    for (const PairPoints& pair : pairs_) {
-      const uint32_t first = static_cast<uint32_t>(cameras.size());
-      cameras.push_back(pair.left);
-      cameras.push_back(pair.right);
-      for (SurfacePoint point : pair.points) {
-        if (stream_.hull().leafAt(point.X_W).state == CellState::kOut) continue;
-        point.views = {first, first + 1};
-        points.push_back(std::move(point));
-      }
-      refinement.newest_stamp_ns = std::max(refinement.newest_stamp_ns, pair.stamp_ns);
-    }
+  while (!refineFor(std::numeric_limits<double>::infinity(), &refinement)) {
   }
-  stream_.carveFree(sift_hull::freeVoxels(stream_.hull(), cameras, points, config_.free_space));
-  refined_generation_ = stream_.hullGeneration();
-  free_voxels_ = stream_.hull().freeVoxelCount();
-  refinement.free_voxels = free_voxels_;
-  refinement.points_used = points.size();
   return refinement;
+}
+
+bool PointCarvedStream::refineFor(double budget_s, Refinement* refinement) {
+  if (carving_ && stream_.hullGeneration() != carving_generation_) carving_.reset();
+  if (!carving_) {  // a refinement begins: every point kept that lies inside the hull
+    std::vector<PinholeCamera> cameras;
+    std::vector<SurfacePoint> points;
+    carving_result_ = Refinement();
+    carving_result_.pairs_refused = dropFarPairs();
+    {
+      std::lock_guard<std::mutex> lock(points_mutex_);
+      points_new_ = false;
+      for (const PairPoints& pair : pairs_) {
+        const uint32_t first = static_cast<uint32_t>(cameras.size());
+        cameras.push_back(pair.left);
+        cameras.push_back(pair.right);
+        for (SurfacePoint point : pair.points) {
+          if (stream_.hull().leafAt(point.X_W).state == CellState::kOut) continue;
+          point.views = {first, first + 1};
+          points.push_back(std::move(point));
+        }
+        carving_result_.newest_stamp_ns = std::max(carving_result_.newest_stamp_ns, pair.stamp_ns);
+      }
+    }
+    carving_result_.points_used = points.size();
+    carving_found_.clear();
+    carving_ = std::make_unique<FreeSpaceCarving>(stream_.hull(), std::move(cameras),
+                                                  std::move(points), config_.free_space);
+    carving_generation_ = stream_.hullGeneration();
+  }
+  try {
+    if (!carving_->step(budget_s, &carving_found_)) return false;
+  } catch (...) {  // not begun again and again: the next refinement starts afresh
+    carving_.reset();
+    carving_found_ = {};
+    throw;
+  }
+  // Views carved while the slices ran: what they made out is not free space.
+  const HullCube& cube = stream_.hull().cube();
+  eraseIf(&carving_found_, [&](const Eigen::Vector3i& voxel) {
+    const Eigen::Vector3d centre_W =
+        cube.origin_W() + (voxel.cast<double>().array() + 0.5).matrix() * cube.resolution_m;
+    return stream_.hull().leafAt(centre_W).state == CellState::kOut;
+  });
+  stream_.carveFree(carving_found_);
+  carving_.reset();
+  carving_found_ = {};
+  refined_generation_ = carving_generation_;
+  free_voxels_ = stream_.hull().freeVoxelCount();
+  *refinement = carving_result_;
+  refinement->free_voxels = free_voxels_;
+  return true;
 }
 
 void PointCarvedStream::reset() {
   stream_.reset();
+  carving_.reset();
+  carving_found_ = {};
   std::lock_guard<std::mutex> lock(points_mutex_);
   pairs_.clear();
   stored_points_ = 0;

@@ -1,9 +1,8 @@
 #include "nodes/hull_node.h"
 
 #include <image_transport/camera_common.h>
-#include <tf2_eigen/tf2_eigen.h>
-
 #include <malloc.h>
+#include <tf2_eigen/tf2_eigen.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -39,7 +38,11 @@ HullNode::HullNode(ros::NodeHandle nh, ros::NodeHandle private_nh, HullNodeConfi
       hull_(std::move(hull_config), config_.carving),
       points_(static_cast<size_t>(config_.queue_size)),
       start_wall_(ros::WallTime::now()),
-      work_(config_.queue_size, 1, [this](Posed& posed) { integrate(posed); }),
+      work_(config_.queue_size, 1,
+            [this](Posed& posed) {
+              integrate(posed);
+              if (hull_.refining()) continueRefining();
+            }),
       outputs_(nh_, config_.world_frame, &hull_.stream(),
                [this](std::function<void()> task) { return work_.post(std::move(task)); }),
       pairing_({config_.from_image ? "image" : "silhouette", "camera_info"}, kPairingPatience_s,
@@ -91,9 +94,9 @@ void HullNode::subscribe() {
   // the image through the transport ~image_transport names (raw, compressed, ...).
   const std::string image_topic = nh_.resolveName(config_.from_image ? "image" : "silhouette");
   info_sub_.subscribe(nh_, image_transport::getCameraInfoTopic(image_topic), config_.queue_size);
-  silhouette_sub_.subscribe(image_transport_, image_topic, config_.queue_size,
-                            image_transport::TransportHints("raw", ros::TransportHints(),
-                                                            private_nh_));
+  silhouette_sub_.subscribe(
+      image_transport_, image_topic, config_.queue_size,
+      image_transport::TransportHints("raw", ros::TransportHints(), private_nh_));
 }
 
 void HullNode::onArrival(const sensor_msgs::ImageConstPtr& silhouette) {
@@ -132,8 +135,9 @@ void HullNode::onSurfacePoints(const sift_hull::SurfacePointsConstPtr& message) 
   }
   if (!points_.push(std::move(posed))) {
     ++counts_.pairs_queue_full;
-    ROS_WARN_THROTTLE(kThrottle_s, "hull: surface points come faster than they are taken: "
-                                   "the oldest pair waiting dropped (~queue_size)");
+    ROS_WARN_THROTTLE(kThrottle_s,
+                      "hull: surface points come faster than they are taken: "
+                      "the oldest pair waiting dropped (~queue_size)");
   }
   if (!points_posted_.exchange(true)) work_.post([this] { takeSurfacePoints(); });
 }
@@ -150,8 +154,8 @@ bool HullNode::viewOf(const Posed& posed, View* view) {
   }
   if (view->mask.empty() ||
       !ros_conversions::cameraFromInfo(*posed.info, posed.T_W_C,
-                                       cv::Size(silhouette.width, silhouette.height),
-                                       &view->camera, &why_not, config_.rectified)) {
+                                       cv::Size(silhouette.width, silhouette.height), &view->camera,
+                                       &why_not, config_.rectified)) {
     problem("hull: view '" + name + "' ignored: ", why_not);
     return false;
   }
@@ -230,57 +234,6 @@ bool HullNode::carve(const View& view) {
   }
 }
 
-void HullNode::takeSurfacePoints() {
-  points_posted_ = false;
-  PosedPoints posed;
-  while (points_.pop(&posed)) mergeSurfacePoints(posed);
-}
-
-void HullNode::mergeSurfacePoints(const PosedPoints& posed) {
-  const sift_hull::SurfacePoints& message = *posed.message;
-  PinholeCamera left, right;
-  std::vector<SurfacePoint> points;
-  std::string why_not;
-  const size_t max_points = static_cast<size_t>(config_.carving.max_points_per_pair);
-  if (!ros_conversions::surfacePointsFromMessage(message, posed.T_W_F, &left, &right, &points,
-                                                 &why_not, max_points)) {
-    ++counts_.pairs_bad;
-    problem("hull: surface points ignored: ", why_not);
-    return;
-  }
-  counts_.points_subsampled += message.points.size() - points.size();
-  const PointCarvedStream::AddedPoints added = hull_.addSurfacePoints(
-      left, right, std::move(points), static_cast<int64_t>(message.header.stamp.toNSec()));
-  counts_.points_outside += added.outside;
-  if (!added.refused.empty()) {
-    ++counts_.pairs_refused;
-    problem("hull: surface points refused: ", added.refused);
-  } else if (added.kept == 0) {
-    ++counts_.pairs_empty;
-  } else {
-    ++counts_.pairs_merged;
-  }
-}
-
-void HullNode::refineIfDue() {
-  refine_posted_ = false;
-  if (!hull_.refineDue()) return;
-  try {
-    const PointCarvedStream::Refinement refinement = hull_.refine();
-    counts_.free_voxels = refinement.free_voxels;
-    counts_.pairs_refused += refinement.pairs_refused;
-    if (refinement.pairs_refused > 0) {
-      problem("hull: surface points refused: ",
-              "a pair that came before the hull has a camera beyond ~max_distance_cube_edges");
-    }
-    ros::Time newest;
-    newest.fromNSec(static_cast<uint64_t>(std::max<int64_t>(refinement.newest_stamp_ns, 0)));
-    publish(std::max(newest, outputs_.header().stamp));
-  } catch (const std::exception& e) {
-    problem("hull: cannot carve with the surface points: ", e.what());
-  }
-}
-
 void HullNode::problem(const std::string& prefix, const std::string& why) {
   log_.error(prefix, why);
   std::lock_guard<std::mutex> lock(problem_mutex_);
@@ -325,9 +278,10 @@ bool HullNode::reset(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
   if (!work_.call([this] { resetOnWorker(); }, kServiceWait_s)) {
     problem("hull: ~reset: ", "the worker is busy; the hull is reset as soon as it is free");
   }
-  ROS_INFO("hull: reset (%zu view(s) waiting to be carved, %zu waiting for their pose and %zu "
-           "pairs of surface points discarded)",
-           posed, waiting_pose, pairs);
+  ROS_INFO(
+      "hull: reset (%zu view(s) waiting to be carved, %zu waiting for their pose and %zu "
+      "pairs of surface points discarded)",
+      posed, waiting_pose, pairs);
   return true;
 }
 
@@ -365,16 +319,19 @@ bool HullNode::getMap(bool binary, sift_hull::GetOctomap::Response* response) {
       binary ? outputs_.binarySnapshot() : outputs_.fullSnapshot();
   if (!map && !binary && !outputs_.keepsFullMap()) {  // the first ask: made once, then kept
     outputs_.keepFullMap();
-    work_.call([this] {
-      publishPending();
-      if (outputs_.published() && !outputs_.fullSnapshot()) publish(outputs_.header().stamp);
-    }, kServiceWait_s);
+    work_.call(
+        [this] {
+          publishPending();
+          if (outputs_.published() && !outputs_.fullSnapshot()) publish(outputs_.header().stamp);
+        },
+        kServiceWait_s);
     map = outputs_.fullSnapshot();
   }
   if (!map) {
     problem(binary ? "hull: octomap_binary refused: " : "hull: octomap_full refused: ",
             "no map yet (no view carved since the start or ~reset), or the worker was busy for "
-            "more than " + std::to_string(kServiceWait_s) + " s");
+            "more than " +
+                std::to_string(kServiceWait_s) + " s");
     return false;
   }
   response->map = *map;
@@ -384,31 +341,35 @@ bool HullNode::getMap(bool binary, sift_hull::GetOctomap::Response* response) {
 bool HullNode::clearBbx(sift_hull::BoundingBoxQuery::Request& request,
                         sift_hull::BoundingBoxQuery::Response&) {
   const Box3d box = ros_conversions::boxFromCorners(request.min, request.max);
-  const std::string corners = ros_conversions::pointText(request.min) + " to " + ros_conversions::pointText(request.max);
+  const std::string corners =
+      ros_conversions::pointText(request.min) + " to " + ros_conversions::pointText(request.max);
   if (!isValidClearBox(box)) {
     problem("hull: ~clear_bbx refused: ",
             corners + ": the corners must be finite with min <= max on each axis");
     return false;
   }
   auto ok = std::make_shared<std::atomic<bool>>(false);
-  const bool done = work_.call([this, box, corners, ok] {
-    publishPending();
-    if (!hull_.stream().hasHull()) {
-      problem("hull: ~clear_bbx refused: ", "no map yet to clear " + corners + " in");
-      return;
-    }
-    try {
-      const size_t voxels = hull_.clearBox(box);  // into the hull: every later map has it
-      counts_.free_voxels = hull_.freeVoxelCount();
-      publish(ros::Time::now());
-      ROS_INFO("hull: ~clear_bbx: cleared %s (%zu occupied voxels)", corners.c_str(), voxels);
-      *ok = true;
-    } catch (const std::exception& e) {
-      problem("hull: ~clear_bbx refused: ", corners + ": " + e.what());
-    }
-  }, kServiceWait_s);
-  if (!done) ROS_WARN("hull: ~clear_bbx: the worker is busy; %s is cleared once it is free",
-                      corners.c_str());
+  const bool done = work_.call(
+      [this, box, corners, ok] {
+        publishPending();
+        if (!hull_.stream().hasHull()) {
+          problem("hull: ~clear_bbx refused: ", "no map yet to clear " + corners + " in");
+          return;
+        }
+        try {
+          const size_t voxels = hull_.clearBox(box);  // into the hull: every later map has it
+          counts_.free_voxels = hull_.freeVoxelCount();
+          publish(ros::Time::now());
+          ROS_INFO("hull: ~clear_bbx: cleared %s (%zu occupied voxels)", corners.c_str(), voxels);
+          *ok = true;
+        } catch (const std::exception& e) {
+          problem("hull: ~clear_bbx refused: ", corners + ": " + e.what());
+        }
+      },
+      kServiceWait_s);
+  if (!done)
+    ROS_WARN("hull: ~clear_bbx: the worker is busy; %s is cleared once it is free",
+             corners.c_str());
   return !done || *ok;
 }
 
@@ -417,6 +378,8 @@ void HullNode::reportDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& st
   counts_.report(pose_wait_.dropped(), &status);
   status.add("last view carve ms", last_carve_ms_.load());
   status.add("last view publish ms", last_publish_ms_.load());
+  status.add("last refinement ms", last_refine_ms_.load());
+  status.add("last refinement's longest slice ms", longest_refine_slice_ms_.load());
   status.add("last view stamp", last_view_stamp_.load());
   const auto warn = [&status](const std::string& text) {
     status.mergeSummary(diagnostic_msgs::DiagnosticStatus::WARN, text);
@@ -425,7 +388,8 @@ void HullNode::reportDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& st
   const std::string unpaired = pairing_.problem(PairingWatch::Clock::now());
   if (!unpaired.empty()) warn(unpaired);
   const std::string image_topic = silhouette_sub_.getTopic();
-  if (counts_.silhouettes == 0 && (ros::WallTime::now() - start_wall_).toSec() > kPairingPatience_s) {
+  if (counts_.silhouettes == 0 &&
+      (ros::WallTime::now() - start_wall_).toSec() > kPairingPatience_s) {
     warn("nothing arrived on " + image_topic + " (and " +
          image_transport::getCameraInfoTopic(image_topic) + ") since the start: check the remaps");
   }

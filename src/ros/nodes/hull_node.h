@@ -9,7 +9,6 @@
 #include <sensor_msgs/Image.h>
 #include <std_srvs/Empty.h>
 #include <tf2_ros/buffer.h>
-#include <tf2_ros/message_filter.h>
 #include <tf2_ros/transform_listener.h>
 
 #include <atomic>
@@ -110,6 +109,7 @@ class HullNode {
   void takeSurfacePoints();
   void mergeSurfacePoints(const PosedPoints& posed);
   void refineIfDue();
+  void continueRefining();
   /// Logs a problem (throttled) and keeps it for /diagnostics.
   void problem(const std::string& prefix, const std::string& why);
   /// outputs_.publish(unpublished_stamp_) when views were carved since the last publication.
@@ -130,7 +130,8 @@ class HullNode {
   // Destroyed bottom up: subscriptions and services first, then the worker, then what it uses.
   ros::NodeHandle nh_, private_nh_;
   HullNodeConfig config_;
-  /// ~skip_views: frame ids (HullStream skips them) and FRAME@SEC.NSEC, one view of a moving camera.
+  /// ~skip_views: frame ids (HullStream skips them) and FRAME@SEC.NSEC, one view of a moving
+  /// camera.
   const std::set<std::string> skip_views_;
   // The worker's own.
   PointCarvedStream hull_;
@@ -146,9 +147,13 @@ class HullNode {
   ThrottledLog log_;
   HullCounts counts_;
   std::atomic<double> last_carve_ms_{0.0}, last_publish_ms_{0.0}, last_view_stamp_{0.0};
+  // The last refinement by surface points: from its first slice to its end, and its longest slice.
+  std::atomic<double> last_refine_ms_{0.0}, longest_refine_slice_ms_{0.0};
+  ros::WallTime refine_start_;     ///< of the refinement in progress (worker)
+  double refine_slices_ms_ = 0.0;  ///< its longest slice so far (worker)
   ros::WallTime start_wall_;
   WorkQueue<Posed> work_;
-  HullOutputs outputs_;  ///< after the worker it posts new subscribers to
+  HullOutputs outputs_;   ///< after the worker it posts new subscribers to
   PairingWatch pairing_;  ///< silhouettes and camera_infos that arrive but do not pair
   ros::WallTimer refine_timer_;
   tf2_ros::Buffer tf_buffer_;

@@ -256,17 +256,17 @@ void MatcherNode::setUpSync() {
         left_info_sub_, right_info_sub_);
     calibrated_approximate_sync_->registerCallback(&MatcherNode::onCalibratedPair, this);
   } else if (settings_.node.calibrated) {
-    calibrated_sync_ = std::make_unique<CalibratedSync>(
-        policies::ExactTime<Image, Image, Info, Info>(queue), *left_sub_, *right_sub_,
-        left_info_sub_, right_info_sub_);
+    calibrated_sync_ =
+        std::make_unique<CalibratedSync>(policies::ExactTime<Image, Image, Info, Info>(queue),
+                                         *left_sub_, *right_sub_, left_info_sub_, right_info_sub_);
     calibrated_sync_->registerCallback(&MatcherNode::onCalibratedPair, this);
   } else if (settings_.node.approximate_sync) {
     approximate_sync_ = std::make_unique<ApproximateSync>(
         policies::ApproximateTime<Image, Image>(queue), *left_sub_, *right_sub_);
     approximate_sync_->registerCallback(&MatcherNode::onPair, this);
   } else {
-    exact_sync_ = std::make_unique<ExactSync>(policies::ExactTime<Image, Image>(queue),
-                                              *left_sub_, *right_sub_);
+    exact_sync_ = std::make_unique<ExactSync>(policies::ExactTime<Image, Image>(queue), *left_sub_,
+                                              *right_sub_);
     exact_sync_->registerCallback(&MatcherNode::onPair, this);
   }
 }
