@@ -32,6 +32,7 @@ set(SIFT_HULL_CORE_GTESTS
   test_silhouettes eval
   test_mesh_render eval
   test_hull eval
+  test_carving_box_file core
   test_free_carving eval
   test_point_carved_stream eval
   test_refine eval

@@ -40,7 +40,7 @@ std::string beforePath(const std::string& path) {
 void writeOutputs(const ArgParser& parser, const HullResult& result,
                   const octomap::OcTree& octree) {
   if (parser.has("out-mesh")) writePly(parser.get("out-mesh"), result.mesh);
-  if (parser.has("out-octree")) writeOctomap(octree, parser.get("out-octree"));
+  if (parser.has("out-octree")) writeOctomap(octree, parser.get("out-octree"), result.box);
   if (parser.has("out-render")) writeRender(parser.get("out-render"), result.mesh);
 }
 

@@ -4,11 +4,12 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "setting_options.h"
 #include "sift_hull/hull/hull_config.h"
+#include "sift_hull/hull/hull_octomap.h"
 #include "sift_hull/hull/hull_pipeline.h"
 #include "sift_hull/hull/hull_stream.h"
 #include "sift_hull/hull/silhouette.h"
-#include "setting_options.h"
 #include "sift_hull/io/view_list.h"
 #include "silhouette_options.h"
 
@@ -70,7 +71,8 @@ HullInput runLengthViewSetFromArgs(const ArgParser& parser) {
 void addHullOptions(ArgParser* parser) {
   addSettingOptions(parser, settingsOf<HullConfig>());
   parser->addOption("box", "XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX",
-                    "bounding box in world units instead of solving the LP");
+                    "bounding box in world units instead of solving the LP; or an OctoMap file "
+                    "written by --out-octree or the hull node's ~save: the box it was carved in");
 }
 
 HullConfig hullConfigFromArgs(const ArgParser& parser) {
@@ -82,6 +84,16 @@ HullConfig hullConfigFromArgs(const ArgParser& parser) {
 
 std::optional<Box3d> boxFromArgs(const ArgParser& parser) {
   if (!parser.has("box")) return std::nullopt;
+  const std::string value = parser.get("box");
+  if (value.find(',') == std::string::npos) {  // a file: the box in its header
+    std::optional<Box3d> carved_in = readCarvingBox(value);
+    if (!carved_in) {
+      throw std::runtime_error(value +
+                               ": its header has no carving_box line (OctoMap files of "
+                               "sift_hull hull --out-octree and the hull node's ~save have one)");
+    }
+    return carved_in;
+  }
   const Setting<HullStreamConfig>* box = settingsOf<HullStreamConfig>().find("box");
   HullStreamConfig config;
   try {

@@ -154,6 +154,31 @@ TEST_F(CommandOutput, PrintsOnlyJsonWithJson) {
   EXPECT_TRUE(nlohmann::json::accept(out)) << out;
 }
 
+TEST_F(CommandOutput, TakesTheBoxFromAnOctreeItWrote) {
+  const std::string dir = test::temporaryDirectory();
+  const std::string hull = "hull --calib " + *scene_ + "/scene_par.txt --images " + *scene_ +
+                           " --silhouettes " + *scene_ + "/masks --max-depth 5 --json";
+  std::string out, err;
+  // A box other than the LP's, so that taking it back is seen.
+  ASSERT_EQ(test::runProgram(hull + " --box -1.1,-1.2,-1.3,1.4,1.5,1.6 --out-octree " + dir +
+                                 "/first.bt",
+                             &out, &err),
+            0)
+      << err;
+  const nlohmann::json first = nlohmann::json::parse(out);
+  ASSERT_EQ(test::runProgram(hull + " --box " + dir + "/first.bt", &out, &err), 0) << err;
+  const nlohmann::json second = nlohmann::json::parse(out);
+  EXPECT_EQ(second["bbox"], first["bbox"]);
+  EXPECT_EQ(second["bbox"]["min"][0].get<double>(), -1.1);
+  EXPECT_EQ(second["occupied_leaves"], first["occupied_leaves"]);
+  // A file without the line, or none at all: bad input (1), named.
+  std::ofstream(dir + "/plain.bt") << "# Octomap OcTree binary file\nid OcTree\ndata\n";
+  EXPECT_EQ(test::runProgram(hull + " --box " + dir + "/plain.bt", &out, &err), 1);
+  EXPECT_NE(err.find("has no carving_box line"), std::string::npos) << err;
+  EXPECT_EQ(test::runProgram(hull + " --box " + dir + "/none.bt", &out, &err), 1);
+  EXPECT_NE(err.find("none.bt: cannot read the file"), std::string::npos) << err;
+}
+
 TEST_F(CommandOutput, TakesTheResolutionInMetresInsteadOfTheDepth) {
   const std::string hull = "hull --calib " + *scene_ + "/scene_par.txt --images " + *scene_ +
                            " --silhouettes " + *scene_ + "/masks --json --resolution-m ";

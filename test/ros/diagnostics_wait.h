@@ -40,6 +40,35 @@ inline std::string warningOf(ros::NodeHandle& nh, const std::string& task, const
   return "";
 }
 
+/// The text of `key` in the /diagnostics status whose name holds `task`, once `accept` takes it,
+/// at most `deadline_s` of wall time; empty after the deadline.
+inline std::string diagnosticText(ros::NodeHandle& nh, const std::string& task,
+                                  const std::string& key,
+                                  const std::function<bool(const std::string&)>& accept,
+                                  double deadline_s = 20.0) {
+  std::mutex mutex;
+  std::string text;
+  bool found = false;
+  ros::Subscriber diagnostics = nh.subscribe<diagnostic_msgs::DiagnosticArray>(
+      "/diagnostics", 20, [&](const diagnostic_msgs::DiagnosticArrayConstPtr& array) {
+        std::lock_guard<std::mutex> lock(mutex);
+        for (const diagnostic_msgs::DiagnosticStatus& status : array->status) {
+          if (status.name.find(task) == std::string::npos) continue;
+          for (const diagnostic_msgs::KeyValue& pair : status.values) {
+            if (pair.key == key) text = pair.value, found = true;
+          }
+        }
+      });
+  const ros::WallTime start = ros::WallTime::now();
+  while ((ros::WallTime::now() - start).toSec() < deadline_s) {
+    ros::WallDuration(0.1).sleep();
+    ros::spinOnce();
+    std::lock_guard<std::mutex> lock(mutex);
+    if (found && accept(text)) return text;
+  }
+  return "";
+}
+
 /// The value of `key` in the /diagnostics status whose name holds `task`, once `accept` takes it,
 /// at most `deadline_s` of wall time; NaN after the deadline.
 inline double diagnosticValue(ros::NodeHandle& nh, const std::string& task, const std::string& key,

@@ -16,10 +16,12 @@
 #include <cstdlib>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 
 #include "bad_inputs.h"
+#include "diagnostics_wait.h"
 #include "common/octomap_volume.h"
 #include "hull_node_fixture.h"
 #include "lib/conversions.h"
@@ -304,6 +306,18 @@ TEST_F(HullSoakTest, SaveRefusesAFifoAtOnceAndWritesARegularFile) {
   EXPECT_GT(published_m3, 0.0);
   // The same leaves: within half the smallest voxel (the two differ only in rounding).
   EXPECT_NEAR(test::occupiedVolume(saved), published_m3, 0.5 * std::pow(saved.getResolution(), 3));
+  // The box the hull was carved in: in the file's header, as /diagnostics gives it; the offline
+  // hull in that box (sift_hull hull --box hull.bt) is the node's to the voxel.
+  const std::optional<Box3d> box = readCarvingBox(dir + "/hull.bt");
+  ASSERT_TRUE(box.has_value()) << "no carving_box line in the saved file";
+  EXPECT_EQ(test::diagnosticText(nh_, "hull", "carving box (m)",
+                                 [](const std::string& text) { return !text.empty(); }),
+            boxText(*box));
+  HullConfig config;
+  config.max_depth = 6;
+  const HullResult offline = buildHull(hullInputOf(views_), config, box);
+  const double offline_m3 = test::occupiedVolume(rc::octomapMessage(*toOctomap(offline.hull), {}));
+  EXPECT_NEAR(published_m3, offline_m3, 0.5 * std::pow(saved.getResolution(), 3));
   ASSERT_NO_FATAL_FAILURE(expectTheOfflineHull());
 }
 

@@ -2,6 +2,7 @@
 
 #include <iosfwd>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -43,8 +44,20 @@ bool isValidClearBox(const Box3d& box_W);
 void clearBox(const Box3d& box_W, octomap::OcTree* tree);
 
 /// Writes OctoMap's binary .bt file (the header OcTree::writeBinary writes, then the binary data).
-/// Throws std::runtime_error naming the path on failure.
-void writeOctomap(const octomap::OcTree& tree, const std::string& path);
+/// With a `carving_box`, the box the hull was carved in (metres, the tree's frame) is a line of the
+/// header, `# carving_box XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX`, exact to the double: a comment to
+/// OctoMap's readers (octovis, octomap_server), the box to readCarvingBox and `sift_hull hull --box
+/// FILE`. Throws std::runtime_error naming the path on failure.
+void writeOctomap(const octomap::OcTree& tree, const std::string& path,
+                  const std::optional<Box3d>& carving_box = std::nullopt);
+
+/// A box as `sift_hull hull --box` takes it: XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX, exact to the double.
+std::string boxText(const Box3d& box_W);
+
+/// The carving box in the header of an OctoMap file writeOctomap wrote; nullopt when the header has
+/// none. Throws std::runtime_error naming the path for a file that cannot be read, is not an
+/// OctoMap file, or whose carving_box line is not six finite numbers with min <= max.
+std::optional<Box3d> readCarvingBox(const std::string& path);
 
 /// OctoMap's binary stream of the tree (OcTree::writeBinaryData's bytes, as octomap_msgs'
 /// binaryMapToMsg puts them into a message) without the progress lines the library prints on

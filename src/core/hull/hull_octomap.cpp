@@ -3,9 +3,13 @@
 #include <octomap/OcTree.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <fstream>
+#include <iomanip>
+#include <limits>
 #include <ostream>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -187,16 +191,67 @@ void clearBox(const Box3d& box_W, octomap::OcTree* tree) {
   pruneFully(tree);
 }
 
-void writeOctomap(const octomap::OcTree& tree, const std::string& path) {
+namespace {
+
+constexpr char kBinaryFileHeader[] = "# Octomap OcTree binary file";
+constexpr char kCarvingBoxKey[] = "# carving_box ";
+
+}  // namespace
+
+void writeOctomap(const octomap::OcTree& tree, const std::string& path,
+                  const std::optional<Box3d>& carving_box) {
   std::ofstream out(path, std::ios::binary);
   // AbstractOccupancyOcTree::writeBinaryConst's header; the first line is what readers check.
-  out << "# Octomap OcTree binary file\n"
-      << "# (feel free to add / change comments, but leave the first line as it is!)\n#\n"
-      << "id " << tree.getTreeType() << "\nsize " << tree.size() << "\nres " << tree.getResolution()
+  out << kBinaryFileHeader << "\n"
+      << "# (feel free to add / change comments, but leave the first line as it is!)\n#\n";
+  if (carving_box) out << kCarvingBoxKey << boxText(*carving_box) << "\n";
+  out << "id " << tree.getTreeType() << "\nsize " << tree.size() << "\nres " << tree.getResolution()
       << "\ndata\n";
   writeOctomapBinaryData(tree, out);
   out.close();
   if (!out) throw std::runtime_error(path + ": cannot write the octree");
+}
+
+std::string boxText(const Box3d& box_W) {
+  std::ostringstream text;
+  text << std::setprecision(std::numeric_limits<double>::max_digits10);
+  for (int i = 0; i < 6; ++i)
+    text << (i > 0 ? "," : "") << (i < 3 ? box_W.min_W[i] : box_W.max_W[i - 3]);
+  return text.str();
+}
+
+std::optional<Box3d> readCarvingBox(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string line;
+  if (!in || !std::getline(in, line)) throw std::runtime_error(path + ": cannot read the file");
+  if (line.compare(0, sizeof kBinaryFileHeader - 1, kBinaryFileHeader) != 0 &&
+      line.compare(0, 22, "# Octomap OcTree file") != 0) {
+    throw std::runtime_error(path + ": not an OctoMap file (its first line is not \"" +
+                             kBinaryFileHeader + "\")");
+  }
+  // The header ends at "data"; OctoMap's own lines are at most a few words.
+  for (int number = 2; number < 1000 && std::getline(in, line) && line != "data"; ++number) {
+    if (line.compare(0, sizeof kCarvingBoxKey - 1, kCarvingBoxKey) != 0) continue;
+    std::istringstream values(line.substr(sizeof kCarvingBoxKey - 1));
+    std::array<double, 6> v{};
+    char comma = ',';
+    bool ok = true;
+    for (size_t i = 0; i < v.size() && ok; ++i) {
+      ok = (i == 0 || ((values >> comma) && comma == ',')) && (values >> v[i]) &&
+           std::isfinite(v[i]);
+    }
+    Box3d box;
+    box.min_W = Eigen::Vector3d(v[0], v[1], v[2]);
+    box.max_W = Eigen::Vector3d(v[3], v[4], v[5]);
+    values >> std::ws;
+    if (!ok || !values.eof() || !(box.min_W.array() <= box.max_W.array()).all()) {
+      throw std::runtime_error(path + ":" + std::to_string(number) +
+                               ": the carving_box line must be six finite comma-separated numbers "
+                               "XMIN,YMIN,ZMIN,XMAX,YMAX,ZMAX with min <= max");
+    }
+    return box;
+  }
+  return std::nullopt;
 }
 
 }  // namespace sift_hull

@@ -50,13 +50,14 @@ void HullOutputs::advertise() {
   const auto centres = [this] {
     return ros_conversions::pointCloudMessage(compact(true).occupied_centres_W, header_);
   };
-  const auto noCentres = [this] { return ros_conversions::occupiedCellsCloud(emptyTree(), header_); };
+  const auto noCentres = [this] {
+    return ros_conversions::occupiedCellsCloud(emptyTree(), header_);
+  };
   const auto noMarkers = [this] { return ros_conversions::deleteAllMarkers(header_); };
   // octomap_binary: the snapshot publish() made from the compact map (no OctoMap nodes needed).
   const auto binary = [this] { return *binarySnapshot(); };
-  add<sift_hull::Octomap>("octomap_binary", false, binary, [this] {
-    return ros_conversions::octomapMessage(emptyTree(), header_);
-  });
+  add<sift_hull::Octomap>("octomap_binary", false, binary,
+                          [this] { return ros_conversions::octomapMessage(emptyTree(), header_); });
   add<sift_hull::Octomap>(
       "octomap_full", true, [this] { return octomapFullMessage(tree(), header_); },
       [this] { return octomapFullMessage(emptyTree(), header_); });
@@ -73,8 +74,8 @@ void HullOutputs::advertise() {
   add<visualization_msgs::Marker>(
       "mesh", true, [this] { return ros_conversions::meshMarker(mesh(), header_); },
       [this] { return ros_conversions::deleteAllMarkers(header_).markers.front(); });
-  add<visualization_msgs::Marker>("carving_box", false, [this] { return boxMarker(); },
-                                  [this] { return boxMarker(); });
+  add<visualization_msgs::Marker>(
+      "carving_box", false, [this] { return boxMarker(); }, [this] { return boxMarker(); });
   for (Output& output : outputs_) output.pub = output.advertise();
 }
 
@@ -103,6 +104,7 @@ void HullOutputs::publish(ros::Time stamp, bool all) {
     std::lock_guard<std::mutex> lock(snapshot_mutex_);
     binary_snapshot_ = std::move(binary);
     full_snapshot_ = std::move(full);
+    box_text_ = published_ ? boxText(hull_->box()) : std::string();
   }
   for (Output& output : outputs_) {
     if (sent(output)) {
@@ -127,6 +129,11 @@ void HullOutputs::send(size_t output) {
 std::shared_ptr<const sift_hull::Octomap> HullOutputs::binarySnapshot() const {
   std::lock_guard<std::mutex> lock(snapshot_mutex_);
   return binary_snapshot_;
+}
+
+std::string HullOutputs::carvingBoxText() const {
+  std::lock_guard<std::mutex> lock(snapshot_mutex_);
+  return box_text_;
 }
 
 std::shared_ptr<const sift_hull::Octomap> HullOutputs::fullSnapshot() const {
@@ -161,7 +168,8 @@ bool HullOutputs::save(const std::string& path, std::string* message) {
     const SavePaths paths = savePaths(path);
     checkRegularTarget(paths.octree);
     checkRegularTarget(paths.mesh);
-    writeReplacing(paths.octree, [this](const std::string& file) { writeOctomap(tree(), file); });
+    writeReplacing(paths.octree,
+                   [this](const std::string& file) { writeOctomap(tree(), file, hull_->box()); });
     writeReplacing(paths.mesh, [this](const std::string& file) { writePly(file, mesh()); });
     *message = "wrote " + paths.octree + " and " + paths.mesh;
     return true;

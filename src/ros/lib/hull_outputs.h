@@ -49,6 +49,9 @@ class HullOutputs {
   /// map until keepFullMap() and a publication.
   std::shared_ptr<const sift_hull::Octomap> binarySnapshot() const;
   std::shared_ptr<const sift_hull::Octomap> fullSnapshot() const;
+  /// The last publication's carving box as `sift_hull hull --box` takes it (boxText); empty
+  /// without a hull.
+  std::string carvingBoxText() const;
 
   /// A hull was published since the start or the last publication without one.
   bool published() const { return published_; }
@@ -68,7 +71,7 @@ class HullOutputs {
     ros::Publisher pub;
     bool lazy = true;
     bool holds_copy = false;  ///< its latched message is the current one
-    bool centres = false;  ///< the occupied centres (the compact map is made with them then)
+    bool centres = false;     ///< the occupied centres (the compact map is made with them then)
     std::function<void()> send;
   };
   template <typename Message>
@@ -93,8 +96,9 @@ class HullOutputs {
   bool centres_wanted_ = false;   ///< a subscriber of this publication wants them
   std::unique_ptr<TriangleMesh> mesh_;
   std::atomic<bool> keep_full_{false};
-  mutable std::mutex snapshot_mutex_;  ///< guards the two below
+  mutable std::mutex snapshot_mutex_;  ///< guards the three below
   std::shared_ptr<const sift_hull::Octomap> binary_snapshot_, full_snapshot_;
+  std::string box_text_;  ///< carvingBoxText(), guarded as the snapshots
 };
 
 }  // namespace sift_hull

@@ -378,6 +378,7 @@ void HullNode::reportDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& st
   counts_.report(pose_wait_.dropped(), &status);
   status.add("last view carve ms", last_carve_ms_.load());
   status.add("last view publish ms", last_publish_ms_.load());
+  status.add("carving box (m)", outputs_.carvingBoxText());  // as sift_hull hull --box takes it
   status.add("last refinement ms", last_refine_ms_.load());
   status.add("last refinement's longest slice ms", longest_refine_slice_ms_.load());
   status.add("last view stamp", last_view_stamp_.load());
