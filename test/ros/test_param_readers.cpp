@@ -288,6 +288,29 @@ TEST(ParameterReaders, AValueOutOfRangeIsRefusedNamingItsParameter) {
             std::string::npos);
 }
 
+TEST(ParameterReaders, AWorldFrameMustBeATf2FrameAndANanTimeoutIsNamed) {
+  ros::NodeHandle empty("/empty_world_frame");
+  empty.setParam("world_frame", std::string());
+  EXPECT_NE(refusal([&] { readHullNodeConfig(empty); }).find("~world_frame must name a frame"),
+            std::string::npos);
+  ros::NodeHandle slash("/slashed_world_frame");
+  slash.setParam("world_frame", std::string("/world"));
+  EXPECT_NE(refusal([&] { readHullNodeConfig(slash); }).find("which tf2 refuses: write 'world'"),
+            std::string::npos)
+      << refusal([&] { readHullNodeConfig(slash); });
+  // The matcher's world frame counts only in calibrated frame to frame.
+  EXPECT_EQ(refusal([&] { readMatcherSettings(slash); }), "");
+  slash.setParam("frame_to_frame", true);
+  slash.setParam("calibrated", true);
+  EXPECT_NE(refusal([&] { readMatcherSettings(slash); }).find("~world_frame '/world'"),
+            std::string::npos);
+  // A number with no range is "a finite number", not "a finite number any".
+  ros::NodeHandle nan("/nan_pose_timeout");
+  nan.setParam("pose_timeout_s", std::nan(""));
+  EXPECT_EQ(refusal([&] { readMatcherSettings(nan); }),
+            "~pose_timeout_s must be a finite number, not nan");
+}
+
 TEST(ParameterReaders, OctomapServersNamesAreReadOrRefusedNamingOurs) {
   ros::NodeHandle frame_id("/octomap_frame_id");
   frame_id.setParam("frame_id", "map");

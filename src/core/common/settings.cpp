@@ -24,12 +24,12 @@ void checkNumber(const SettingInfo& info, double value) {
   const bool in_range = above_min && below_max;
   const bool finite_enough = std::isfinite(value) || (info.allow_infinity && !std::isnan(value));
   if (in_range && finite_enough) return;
-  std::string text = info.name + " must be ";
-  if (!info.allow_infinity) text += "a finite number ";
+  std::string text =
+      info.name + (info.allow_infinity ? " must be a number" : " must be a finite number");
   const std::string range = settingRangeText(info);
   const bool interval = range[0] == '[' || range[0] == '(';
-  throw std::invalid_argument(text + (interval ? "in " : "") + range + ", not " +
-                              numberText(value));
+  if (range != "any") text += (interval ? " in " : " ") + range;  // "any": no range to name
+  throw std::invalid_argument(text + ", not " + numberText(value));
 }
 
 void checkChoice(const SettingInfo& info, const std::string& value) {

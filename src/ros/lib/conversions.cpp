@@ -1,7 +1,5 @@
 #include "lib/conversions.h"
 
-#include "sift_hull/settings_json.h"
-
 #include <cv_bridge/cv_bridge.h>
 #include <sensor_msgs/image_encodings.h>
 #include <tf2_eigen/tf2_eigen.h>
@@ -16,6 +14,7 @@
 #include "sift_hull/hull/hull_octomap.h"
 #include "sift_hull/hull/mesh.h"
 #include "sift_hull/limits.h"
+#include "sift_hull/settings_json.h"
 
 namespace sift_hull {
 namespace ros_conversions {
@@ -153,16 +152,28 @@ geometry_msgs::TransformStamped cameraPoseMessage(const PinholeCamera& camera,
   return pose;
 }
 
+std_msgs::ColorRGBA colour(float r, float g, float b) {
+  std_msgs::ColorRGBA c;
+  c.r = r, c.g = g, c.b = b, c.a = 1.0f;
+  return c;
+}
+
+visualization_msgs::Marker marker(const std_msgs::Header& header, const std::string& ns,
+                                  int32_t type, const std_msgs::ColorRGBA& colour) {
+  visualization_msgs::Marker m;
+  m.header = header;
+  m.ns = ns;
+  m.type = type;
+  m.action = visualization_msgs::Marker::ADD;
+  m.pose.orientation.w = 1.0;
+  m.scale.x = m.scale.y = m.scale.z = 1.0;
+  m.color = colour;
+  return m;
+}
+
 visualization_msgs::Marker meshMarker(const TriangleMesh& mesh, const std_msgs::Header& header) {
-  visualization_msgs::Marker marker;
-  marker.header = header;
-  marker.ns = "hull_mesh";
-  marker.type = visualization_msgs::Marker::TRIANGLE_LIST;
-  marker.action = visualization_msgs::Marker::ADD;
-  marker.pose.orientation.w = 1.0;
-  marker.scale.x = marker.scale.y = marker.scale.z = 1.0;
-  marker.color.r = marker.color.g = marker.color.b = 0.8f;
-  marker.color.a = 1.0f;
+  visualization_msgs::Marker marker = ros_conversions::marker(
+      header, "hull_mesh", visualization_msgs::Marker::TRIANGLE_LIST, colour(0.8f, 0.8f, 0.8f));
   marker.points.reserve(3 * mesh.faces.size());
   for (const Eigen::Vector3i& face : mesh.faces) {
     for (int corner = 0; corner < 3; ++corner) {

@@ -11,9 +11,9 @@
 #include <visualization_msgs/MarkerArray.h>
 
 #include <Eigen/Geometry>
+#include <limits>
 #include <memory>
 #include <opencv2/core.hpp>
-#include <limits>
 #include <string>
 #include <vector>
 
@@ -160,6 +160,13 @@ Box3d boxFromCorners(const geometry_msgs::Point& min, const geometry_msgs::Point
 
 /// "(x, y, z)", for messages.
 std::string pointText(const geometry_msgs::Point& point);
+
+/// A marker of `type` (visualization_msgs::Marker::LINE_LIST, ...) to ADD in namespace `ns` with
+/// `header`, an identity pose, unit scale and opaque `colour`: what the hull node's markers share.
+visualization_msgs::Marker marker(const std_msgs::Header& header, const std::string& ns,
+                                  int32_t type, const std_msgs::ColorRGBA& colour);
+/// An opaque colour.
+std_msgs::ColorRGBA colour(float r, float g, float b);
 
 /// A box's twelve edges as a LINE_LIST marker in the header's frame (namespace "carving_box",
 /// yellow, lines 1 % of the box's longest edge wide).

@@ -177,16 +177,9 @@ std::string pointText(const geometry_msgs::Point& point) {
 }
 
 visualization_msgs::Marker boxMarker(const Box3d& box_W, const std_msgs::Header& header) {
-  visualization_msgs::Marker marker;
-  marker.header = header;
-  marker.ns = "carving_box";
-  marker.type = visualization_msgs::Marker::LINE_LIST;
-  marker.action = visualization_msgs::Marker::ADD;
-  marker.pose.orientation.w = 1.0;
+  visualization_msgs::Marker marker = ros_conversions::marker(
+      header, "carving_box", visualization_msgs::Marker::LINE_LIST, colour(1.0f, 0.85f, 0.0f));
   marker.scale.x = 0.01 * box_W.size().maxCoeff();
-  marker.color.r = 1.0f;
-  marker.color.g = 0.85f;
-  marker.color.a = 1.0f;
   const auto corner = [&box_W](int c) {
     geometry_msgs::Point p;
     p.x = (c & 1) ? box_W.max_W.x() : box_W.min_W.x();

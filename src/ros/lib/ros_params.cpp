@@ -82,6 +82,20 @@ void readFrameId(const ros::NodeHandle& private_nh, HullNodeConfig* config) {
   config->world_frame = frame_id;
 }
 
+/// tf2's rule for a frame id: named, and without the leading '/' tf1 allowed (tf2 refuses every
+/// lookup with one).
+void checkFrameId(const std::string& name, const std::string& frame) {
+  if (frame.empty()) throw std::invalid_argument("~" + name + " must name a frame, not be empty");
+  if (frame[0] == '/') {
+    throw std::invalid_argument("~" + name + " '" + frame +
+                                "' starts with '/', which tf2 refuses: write '" +
+                                frame.substr(frame.find_first_not_of('/') == std::string::npos
+                                                 ? frame.size()
+                                                 : frame.find_first_not_of('/')) +
+                                "'");
+  }
+}
+
 }  // namespace
 
 template <typename Config>
@@ -113,6 +127,7 @@ HullNodeConfig readHullNodeConfig(const ros::NodeHandle& private_nh) {
   HullNodeConfig config;
   readSettings(private_nh, settingsOf<HullNodeConfig>(), &config);
   readFrameId(private_nh, &config);
+  checkFrameId("world_frame", config.world_frame);
   // A threshold given asks for the threshold recipe, unless a method is named too.
   if (private_nh.hasParam("threshold") && !private_nh.hasParam("silhouette_method")) {
     config.recipe.silhouette_method = "threshold";
@@ -135,6 +150,9 @@ HullStreamConfig readHullStreamConfig(const ros::NodeHandle& private_nh) {
 MatcherSettings readMatcherSettings(const ros::NodeHandle& private_nh) {
   MatcherSettings settings;
   readSettings(private_nh, settingsOf<MatcherSettings>(), &settings);
+  if (settings.node.frame_to_frame && settings.node.calibrated) {
+    checkFrameId("world_frame", settings.node.world_frame);
+  }
   return settings;
 }
 
