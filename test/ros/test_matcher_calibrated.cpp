@@ -212,6 +212,104 @@ TEST_F(CalibratedFrameToFrameMatcherTest, ATurnedFrameStartsAKeyframeAndAnOlderO
   EXPECT_EQ(count("frames received", 4), 4.0);
 }
 
+/// The matcher's /diagnostics counts as rises from their values when it was made (the counts go
+/// on across the cases of one node).
+class Rises {
+ public:
+  Rises(ros::NodeHandle& nh, const std::vector<std::string>& keys) : nh_(nh) {
+    for (const std::string& key : keys) {
+      before_[key] = test::diagnosticValue(nh_, "matcher", key, [](double) { return true; });
+    }
+  }
+  /// The rise of `key`, once it has risen by `rise` at least (or at the deadline).
+  double operator()(const std::string& key, double rise) {
+    const double base = before_.at(key);
+    return test::diagnosticValue(nh_, "matcher", key, [&](double v) { return v >= base + rise; }) -
+           base;
+  }
+
+ private:
+  ros::NodeHandle& nh_;
+  std::map<std::string, double> before_;
+};
+
+TEST_F(CalibratedFrameToFrameMatcherTest, ATfStampAtTheEndOfTimeOrAheadIsRefusedAndPosesGoOn) {
+  Rises rises(nh_, {"tf transforms refused", "frames matched with the keyframe"});
+  const ros::Time now = ros::Time::now();
+  tf2_msgs::TFMessage bad;
+  bad.transforms.push_back(ros_conversions::cameraPoseMessage(left_.view.camera, "world", "camera",
+                                                              ros::Time(4294967290u, 0)));
+  bad.transforms.push_back(ros_conversions::cameraPoseMessage(left_.view.camera, "world", "camera",
+                                                              now + ros::Duration(100.0)));
+  tf_pub_.publish(bad);
+  ASSERT_EQ(rises("tf transforms refused", 2), 2.0);
+  // The buffer kept its poses and takes new ones: a keyframe and a moved frame are matched.
+  const ros::Time first = now + ros::Duration(0.1);
+  publishFrame(left_, first);
+  ros::WallDuration(0.2).sleep();
+  const ros::Time moved = first + ros::Duration(0.5);
+  publishFrame(right_, moved);
+  ASSERT_TRUE(waitFor([&] { return last_ && last_->right_header.stamp == moved; }))
+      << "no correspondences after the refused transforms";
+  EXPECT_EQ(last_->header.stamp, first);
+  EXPECT_EQ(rises("frames matched with the keyframe", 1), 1.0);
+}
+
+TEST_F(CalibratedFrameToFrameMatcherTest, AnUnusableFrameNeverBecomesTheKeyframe) {
+  Rises rises(nh_, {"frames received", "frames unusable", "frames matched with the keyframe",
+                    "frames started a keyframe", "frames turned beyond ~max_rotation_deg"});
+  // A turned frame starts the keyframe whatever came before (the counts go on across cases).
+  const PinholeCamera& left = left_.view.camera;
+  const Eigen::Matrix3d turn = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const PinholeCamera upside_down(left.K(), turn * left.R(), turn * left.t());
+  const ros::Time start = ros::Time::now();
+  publishFrame(left_, start, true, &upside_down);
+  ros::WallDuration(0.2).sleep();
+  const ros::Time first = start + ros::Duration(0.2);
+  publishFrame(left_, first);  // turned back: the keyframe
+  ASSERT_EQ(rises("frames received", 2), 2.0);
+  // A frame whose camera_info has no focal length, a 16-bit frame and one stamped a minute
+  // ahead of the clock: refused before their pose is asked for.
+  std_msgs::Header header;
+  header.frame_id = "camera";
+  header.stamp = first + ros::Duration(0.1);
+  sensor_msgs::CameraInfo no_focal =
+      ros_conversions::cameraInfoMessage(right_.view.camera, right_.image.size(), header);
+  no_focal.K[0] = 0.0;
+  info_pub_.publish(no_focal);
+  frame_pub_.publish(bgrImage(right_.image, header.stamp, "camera"));
+  header.stamp = first + ros::Duration(0.2);
+  sensor_msgs::Image deep = bgrImage(right_.image, header.stamp, "camera");
+  deep.encoding = "16UC1";
+  deep.step = deep.width * 2;
+  deep.data.resize(size_t{deep.step} * deep.height);
+  info_pub_.publish(
+      ros_conversions::cameraInfoMessage(right_.view.camera, right_.image.size(), header));
+  frame_pub_.publish(deep);
+  publishFrame(right_, ros::Time::now() + ros::Duration(60.0), false);
+  ASSERT_EQ(rises("frames unusable", 3), 3.0);
+  // The next good frame is matched with the keyframe, not with any of them.
+  const ros::Time moved = first + ros::Duration(0.5);
+  publishFrame(right_, moved);
+  ASSERT_TRUE(waitFor([&] { return last_ && last_->right_header.stamp == moved; }))
+      << "the good frame after the unusable ones was not matched";
+  EXPECT_EQ(last_->header.stamp, first);
+  EXPECT_EQ(rises("frames matched with the keyframe", 1), 1.0);
+  EXPECT_EQ(rises("frames received", 6), 6.0);
+}
+
+TEST_F(CalibratedFrameToFrameMatcherTest, TwoFramesOfOneStampAreEachCounted) {
+  Rises rises(nh_, {"frames received", "frames without pose"});
+  const ros::Time stamp = ros::Time::now();
+  publishFrame(left_, stamp, false);
+  // Apart, so that the synchroniser pairs each image with its own camera_info.
+  ros::WallDuration(0.2).sleep();
+  publishFrame(left_, stamp, false);
+  // One refused at once (its twin waits), the other after ~pose_timeout_s: received = the sum.
+  ASSERT_EQ(rises("frames received", 2), 2.0);
+  EXPECT_EQ(rises("frames without pose", 2), 2.0);
+}
+
 /// ~approximate_sync with ~calibrated: the images and camera_infos pair by the nearest stamps.
 class CalibratedApproximateMatcherTest : public CalibratedMatcherTest {};
 

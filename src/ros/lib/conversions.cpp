@@ -72,19 +72,22 @@ cv::Mat maskFromImage(const sensor_msgs::Image& image, std::string* why_not) {
   return view.clone();
 }
 
+bool holdsEightBitImage(const sensor_msgs::Image& image, std::string* why_not) {
+  namespace enc = sensor_msgs::image_encodings;
+  if (!enc::isColor(image.encoding) && !enc::isMono(image.encoding)) {
+    *why_not = "encoding '" + image.encoding + "' is neither colour nor mono";
+    return false;
+  }
+  if (enc::bitDepth(image.encoding) != 8) {
+    *why_not = "encoding '" + image.encoding + "' is not 8 bits per channel";
+    return false;
+  }
+  return holdsPixels(image, static_cast<size_t>(enc::numChannels(image.encoding)), why_not);
+}
+
 cv::Mat eightBitImage(const sensor_msgs::ImageConstPtr& image, std::string* why_not) {
   namespace enc = sensor_msgs::image_encodings;
-  if (!enc::isColor(image->encoding) && !enc::isMono(image->encoding)) {
-    *why_not = "encoding '" + image->encoding + "' is neither colour nor mono";
-    return {};
-  }
-  if (enc::bitDepth(image->encoding) != 8) {
-    *why_not = "encoding '" + image->encoding + "' is not 8 bits per channel";
-    return {};
-  }
-  if (!holdsPixels(*image, static_cast<size_t>(enc::numChannels(image->encoding)), why_not)) {
-    return {};
-  }
+  if (!holdsEightBitImage(*image, why_not)) return {};
   try {
     return cv_bridge::toCvShare(image, enc::isMono(image->encoding) ? "mono8" : "bgr8")->image;
   } catch (const cv_bridge::Exception& e) {

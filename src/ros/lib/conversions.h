@@ -52,6 +52,10 @@ bool withinPixelLimit(const sensor_msgs::Image& image, size_t max_pixels, std::s
 /// Mat and sets `why_not` for another encoding or pixels the data does not hold (holdsPixels).
 cv::Mat maskFromImage(const sensor_msgs::Image& image, std::string* why_not);
 
+/// Whether eightBitImage takes the image: an 8-bit colour or mono encoding whose pixels the data
+/// holds (holdsPixels); false, with `why_not`, otherwise. Reads the header and sizes only.
+bool holdsEightBitImage(const sensor_msgs::Image& image, std::string* why_not);
+
 /// An 8-bit colour or mono image as BGR or grey, sharing the message's pixels (keep the message
 /// while the Mat is in use). Returns an empty Mat and sets `why_not` for another encoding or
 /// pixels the data does not hold (holdsPixels).

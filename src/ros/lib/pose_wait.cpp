@@ -48,7 +48,15 @@ PoseWait::PoseWait(ros::NodeHandle nh, tf2_ros::Buffer* tf, std::string world_fr
 
 void PoseWait::add(const sensor_msgs::ImageConstPtr& image,
                    const sensor_msgs::CameraInfoConstPtr& info) {
-  waits_.arrived(image->header.frame_id, image->header.stamp.toSec(), PoseWaits::Clock::now());
+  const std::string& frame = image->header.frame_id;
+  if (!waits_.arrived(frame, image->header.stamp.toSec(), PoseWaits::Clock::now())) {
+    ++dropped_;
+    const std::string why = "a second view of '" + frame +
+                            "' with the stamp of one waiting for its pose (one view per frame id "
+                            "and stamp)";
+    dropped_view_(frame, why);
+    return;
+  }
   {
     std::lock_guard<std::mutex> lock(infos_mutex_);
     infos_[image.get()] = info;

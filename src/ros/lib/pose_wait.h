@@ -20,8 +20,9 @@ namespace sift_hull {
 /// The one owner of the wait for a camera's pose: an image paired with its camera_info waits in a
 /// tf2_ros::MessageFilter until tf has the pose of the image's frame in the world frame at its
 /// stamp, and leaves with it (T_W_C, looked up once); or it is dropped, said why and counted once:
-/// tf gave up on it (empty frame id, older than tf keeps, the filter's queue full), or its pose did
-/// not come within `timeout_s` of wall time (reported by a wall timer when it expires; should the
+/// tf gave up on it (empty frame id, older than tf keeps, the filter's queue full), a view of the
+/// same frame id and stamp is waiting already, or its pose did not come within `timeout_s` of wall
+/// time (reported by a wall timer when it expires; should the
 /// pose still come, the view is not taken).
 class PoseWait {
  public:
@@ -39,7 +40,8 @@ class PoseWait {
   /// Drops every view waiting for its pose (~reset): none of them comes out later. Returns how
   /// many there were.
   size_t clear();
-  /// Views dropped without a pose (timed out or given up by tf), each counted once.
+  /// Views dropped without a pose (timed out, given up by tf, or a duplicate of a waiting view's
+  /// frame id and stamp), each counted once.
   size_t dropped() const { return dropped_; }
 
  private:

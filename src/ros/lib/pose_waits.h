@@ -20,10 +20,14 @@ class PoseWaits {
   PoseWaits(double timeout_s, size_t capacity)
       : timeout_(toDuration(timeout_s)), capacity_(capacity) {}
 
-  void arrived(const std::string& frame, double stamp_s, Clock::time_point now) {
+  /// A view starts waiting. False, and nothing changes, when a view of the same frame id and
+  /// stamp is known already (waiting, or expired and not yet forgotten): two such views would be
+  /// one wait, and the second would be carved or lost uncounted.
+  bool arrived(const std::string& frame, double stamp_s, Clock::time_point now) {
     std::lock_guard<std::mutex> lock(mutex_);
-    waits_[{frame, stamp_s}] = {now, false};
+    if (!waits_.emplace(Key{frame, stamp_s}, Wait{now, false}).second) return false;
     while (waits_.size() > capacity_) waits_.erase(oldest());
+    return true;
   }
 
   /// The pose came: forgets the wait; false when it had timed out (the view must not be carved).

@@ -49,7 +49,7 @@ HullNode::HullNode(ros::NodeHandle nh, ros::NodeHandle private_nh, HullNodeConfi
                "a silhouette pairs with the camera_info of an equal stamp once tf has its "
                "camera's pose in ~world_frame (a node making masks must copy its image's header: "
                "stamp and frame_id)"),
-      tf_listener_(tf_buffer_),
+      tf_listener_(&tf_buffer_, "hull: "),
       pose_wait_(
           nh_, &tf_buffer_, config_.world_frame, static_cast<uint32_t>(config_.queue_size),
           config_.pose_timeout_s,
@@ -382,6 +382,7 @@ void HullNode::reportDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& st
   status.add("last refinement ms", last_refine_ms_.load());
   status.add("last refinement's longest slice ms", longest_refine_slice_ms_.load());
   status.add("last view stamp", last_view_stamp_.load());
+  status.add("tf transforms refused", tf_listener_.refused());
   const auto warn = [&status](const std::string& text) {
     status.mergeSummary(diagnostic_msgs::DiagnosticStatus::WARN, text);
     ROS_WARN_THROTTLE(kThrottle_s, "hull: %s", text.c_str());

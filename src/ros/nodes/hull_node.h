@@ -9,7 +9,6 @@
 #include <sensor_msgs/Image.h>
 #include <std_srvs/Empty.h>
 #include <tf2_ros/buffer.h>
-#include <tf2_ros/transform_listener.h>
 
 #include <atomic>
 #include <deque>
@@ -25,6 +24,7 @@
 #include "lib/node_diagnostics.h"
 #include "lib/pairing_watch.h"
 #include "lib/pose_wait.h"
+#include "lib/tf_listener.h"
 #include "lib/throttled_log.h"
 #include "lib/work_queue.h"
 #include "nodes/hull_node_config.h"
@@ -157,7 +157,7 @@ class HullNode {
   PairingWatch pairing_;  ///< silhouettes and camera_infos that arrive but do not pair
   ros::WallTimer refine_timer_;
   tf2_ros::Buffer tf_buffer_;
-  tf2_ros::TransformListener tf_listener_;
+  TfListener tf_listener_;
   PoseWait pose_wait_;
   NodeDiagnostics diagnostics_;  ///< after what it reports on (the pose wait's count)
   // Subscribed last, once every callback is in place.

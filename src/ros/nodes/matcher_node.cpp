@@ -2,6 +2,7 @@
 
 #include <cv_bridge/cv_bridge.h>
 #include <image_transport/camera_common.h>
+#include <malloc.h>
 #include <tf2_eigen/tf2_eigen.h>
 
 #include <algorithm>
@@ -82,7 +83,7 @@ MatcherNode::MatcherNode(ros::NodeHandle nh, ros::NodeHandle private_nh, Matcher
           Pipeline{settings_, pairConfig(settings_), makeFilters(settings_),
                    ros_conversions::settingsJson(settings_.matching, settings_.filters)})),
       transport_(nh_),
-      tf_listener_(tf_buffer_),
+      tf_listener_(&tf_buffer_, "matcher: "),
       work_(settings_.node.max_waiting_pairs, settings_.node.workers,
             [this](Pair& pair) { matchPair(pair); }),
       pairing_(pairedInputs(settings_.node), kPairingPatience_s, pairingHint(settings_.node)),
@@ -94,6 +95,16 @@ MatcherNode::MatcherNode(ros::NodeHandle nh, ros::NodeHandle private_nh, Matcher
   serveReconfigure();
   setUpInputs();
   advertise();
+  trim_timer_ = nh_.createWallTimer(ros::WallDuration(1.0),
+                                    [this](const ros::WallTimerEvent&) { trimAfterWork(); });
+}
+
+void MatcherNode::trimAfterWork() {
+  const WorkCounts counts = work_.counts();
+  const uint64_t handled = counts.done + counts.dropped;
+  if (counts.waiting > 0 || handled == trimmed_after_) return;
+  trimmed_after_ = handled;
+  malloc_trim(0);  // the pairs' buffers (SIFT's pyramids above all) back to the system
 }
 
 void MatcherNode::advertise() {
@@ -157,6 +168,7 @@ void MatcherNode::reportDiagnostics(diagnostic_updater::DiagnosticStatusWrapper&
     status.add("frames cleared waiting for their pose", counts.cleared);
   }
   status.add("last pair ms", last_pair_ms_.load());
+  status.add("tf transforms refused", tf_listener_.refused());
   status.add("images described", features_.misses());
   status.add("features reused", features_.hits());
   const std::string unpaired = pairing_.problem(PairingWatch::Clock::now());

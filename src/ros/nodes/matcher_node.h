@@ -12,7 +12,6 @@
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 #include <tf2_ros/buffer.h>
-#include <tf2_ros/transform_listener.h>
 
 #include <Eigen/Geometry>
 #include <atomic>
@@ -26,6 +25,7 @@
 #include "lib/node_diagnostics.h"
 #include "lib/pairing_watch.h"
 #include "lib/pose_wait.h"
+#include "lib/tf_listener.h"
 #include "lib/throttled_log.h"
 #include "lib/work_queue.h"
 #include "nodes/matcher_node_config.h"
@@ -95,6 +95,8 @@ class MatcherNode {
     sensor_msgs::CameraInfoConstPtr info;
     Eigen::Isometry3d T_W_C = Eigen::Isometry3d::Identity();
   };
+  /// Calibrated frame to frame: how far ahead of the node's clock a frame may be stamped.
+  static constexpr double kMaxFrameAhead_s = 2.0;
   /// Calibrated frame to frame: where each frame went, every one counted once.
   struct FrameCounts {
     size_t received = 0;      ///< frames paired with their camera_info
@@ -103,8 +105,9 @@ class MatcherNode {
     size_t skipped = 0;       ///< baseline to the keyframe below ~min_baseline_m
     size_t turned = 0;        ///< turned beyond ~max_rotation_deg: became the keyframe unmatched
     size_t paired = 0;        ///< matched with the keyframe (then became it)
-    size_t unusable = 0;      ///< pose not finite (logged)
-    size_t cleared = 0;       ///< waiting for their pose when the last listener left
+    size_t unusable = 0;      ///< image, camera_info, stamp (ahead of the clock) or pose unusable
+
+    size_t cleared = 0;  ///< waiting for their pose when the last listener left
   };
 
   /// Advertises the outputs, with the connect callbacks that subscribe the inputs.
@@ -129,6 +132,9 @@ class MatcherNode {
   /// Calibrated frame to frame: a frame and its camera_info, on to pose_wait_.
   void onCalibratedFrame(const sensor_msgs::ImageConstPtr& frame,
                          const sensor_msgs::CameraInfoConstPtr& info);
+  /// Why a calibrated frame cannot be matched (its image, its camera_info, a stamp more than
+  /// kMaxFrameAhead_s ahead of the node's clock); empty when it can.
+  std::string unusableFrame(const Image& frame, const Info& info) const;
   /// A frame with its camera pose: skipped, matched with the keyframe, or made the keyframe.
   void onPosedFrame(const sensor_msgs::ImageConstPtr& frame,
                     const sensor_msgs::CameraInfoConstPtr& info, const Eigen::Isometry3d& T_W_C);
@@ -151,6 +157,9 @@ class MatcherNode {
                const sensor_msgs::ImageConstPtr& right, const StereoCameras* cameras);
   std::shared_ptr<const Pipeline> pipeline() const;
   void reportDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& status);
+  /// Once a second: when pairs were handled since the last time and none waits, returns the
+  /// freed heap to the system (malloc_trim), so that the resident set falls back after a flood.
+  void trimAfterWork();
   bool stereoCameras(const Image& left, const Image& right, const Info& left_info,
                      const Info& right_info, StereoCameras* cameras);
   /// The two cameras from their camera_infos, the right one at T_L_R in the left's frame.
@@ -175,7 +184,7 @@ class MatcherNode {
   ros::Publisher correspondences_pub_, points_pub_, surface_points_pub_;
   image_transport::Publisher matches_image_pub_;
   tf2_ros::Buffer tf_buffer_;
-  tf2_ros::TransformListener tf_listener_;
+  TfListener tf_listener_;
   std::atomic<double> last_pair_ms_{0.0};
   /// Each image's features for the next pair it is in (keyed by its pixels): frame to frame and
   /// the (k, k+1) pairs of a stereo sequence describe an image once.
@@ -191,6 +200,8 @@ class MatcherNode {
   NodeDiagnostics diagnostics_;
   boost::recursive_mutex reconfigure_mutex_;  // the server's, so updateConfig cannot race it
   std::unique_ptr<dynamic_reconfigure::Server<sift_hull::MatcherConfig>> reconfigure_;
+  ros::WallTimer trim_timer_;
+  uint64_t trimmed_after_ = 0;  ///< pairs handled at the last trim (the timer's thread only)
   std::unique_ptr<ImageInput> left_sub_, right_sub_, frame_sub_;
   sensor_msgs::ImageConstPtr previous_frame_;
   std::unique_ptr<ExactSync> exact_sync_;

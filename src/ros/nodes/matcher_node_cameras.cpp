@@ -5,6 +5,7 @@
 #include <tf2_eigen/tf2_eigen.h>
 
 #include <cmath>
+#include <sstream>
 #include <utility>
 
 #include "lib/conversions.h"
@@ -51,11 +52,41 @@ bool MatcherNode::rightPoseFromTf(const Image& left, const Image& right, Eigen::
 void MatcherNode::onCalibratedFrame(const sensor_msgs::ImageConstPtr& frame,
                                     const sensor_msgs::CameraInfoConstPtr& info) {
   pairing_.paired();
+  const std::string why_not = unusableFrame(*frame, *info);
   {
     std::lock_guard<std::mutex> lock(keyframe_mutex_);
     ++frame_counts_.received;
+    // Refused before it can become the keyframe, which would waste the next good frame.
+    if (!why_not.empty()) ++frame_counts_.unusable;
   }
-  pose_wait_->add(frame, info);
+  if (!why_not.empty()) {
+    log_.error("matcher: frame ignored: ", why_not);
+    return;
+  }
+  pose_wait_->add(frame, info);  // no lock held: the pose may come at once (onPosedFrame)
+}
+
+std::string MatcherNode::unusableFrame(const Image& frame, const Info& info) const {
+  std::string why_not;
+  PinholeCamera camera;
+  if (!ros_conversions::withinPixelLimit(frame, pipeline()->settings.sift.max_image_pixels,
+                                         &why_not) ||
+      !ros_conversions::holdsEightBitImage(frame, &why_not) ||
+      !ros_conversions::cameraFromInfo(info, Eigen::Isometry3d::Identity(),
+                                       cv::Size(frame.width, frame.height), &camera, &why_not,
+                                       settings_.node.rectified)) {
+    return why_not;
+  }
+  // A frame stamped ahead of the node's clock would hold the keyframe until then (later frames
+  // are matched only when stamped after it). Not checked before the clock starts (a bag's).
+  const ros::Time now = ros::Time::now();
+  if (!now.isZero() && frame.header.stamp.toSec() > now.toSec() + kMaxFrameAhead_s) {
+    std::ostringstream why;  // no value in it: one throttled message however far ahead
+    why << "stamped more than " << kMaxFrameAhead_s
+        << " s after this node's clock: are the clocks synchronised?";
+    return why.str();
+  }
+  return "";
 }
 
 void MatcherNode::onPosedFrame(const sensor_msgs::ImageConstPtr& frame,
