@@ -61,18 +61,27 @@ class NodeletLifecycleTest : public ::testing::Test {
   void SetUp() override {
     rosout_sub_ = nh_.subscribe("/rosout", 1000, &NodeletLifecycleTest::onLog, this);
     ASSERT_TRUE(ros::service::waitForService("/manager/load_nodelet", ros::Duration(kDeadline_s)));
+    // The manager's errors reach this test only once its /rosout link to the test is up, which
+    // can be after the first load: until one of them arrives, unload a nodelet it does not have,
+    // which it logs as an error naming it.
+    ASSERT_TRUE(waitFor([&] {
+      unloadNodelet("/never_loaded");
+      return managerLogged({"/never_loaded"}, 0.2);
+    })) << "no error of the manager reached this test on /rosout";
   }
 
   /// Whether the manager logged an error or worse holding every one of `parts` within `seconds`.
   bool managerLogged(const std::vector<std::string>& parts, double seconds = kDeadline_s) {
-    return waitFor([&] {
-      std::lock_guard<std::mutex> lock(mutex_);
-      return std::any_of(errors_.begin(), errors_.end(), [&](const std::string& line) {
-        return std::all_of(parts.begin(), parts.end(), [&](const std::string& part) {
-          return line.find(part) != std::string::npos;
-        });
-      });
-    }, seconds);
+    return waitFor(
+        [&] {
+          std::lock_guard<std::mutex> lock(mutex_);
+          return std::any_of(errors_.begin(), errors_.end(), [&](const std::string& line) {
+            return std::all_of(parts.begin(), parts.end(), [&](const std::string& part) {
+              return line.find(part) != std::string::npos;
+            });
+          });
+        },
+        seconds);
   }
 
   void onLog(const rosgraph_msgs::LogConstPtr& log) {
