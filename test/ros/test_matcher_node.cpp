@@ -2,6 +2,8 @@
 // and a precision against the scene's ground truth; bad pairs answered with an error while later
 // good pairs still count. Every wait has a deadline.
 
+#include <cmath>
+
 #include "matcher_node_fixture.h"
 
 namespace sift_hull {
@@ -30,6 +32,10 @@ TEST_F(MatcherNodeTest, MatchesAPairWithTheInputStampsAndGoodPrecision) {
 }
 
 TEST_F(MatcherNodeTest, RefusesBadPairsAndCarriesOn) {
+  const auto any = [](double) { return true; };
+  const double left_unpaired = test::diagnosticValue(nh_, "matcher", "left/image unpaired", any);
+  const double right_unpaired = test::diagnosticValue(nh_, "matcher", "right/image unpaired", any);
+  ASSERT_FALSE(std::isnan(left_unpaired) || std::isnan(right_unpaired)) << "no unpaired counts";
   const cv::Mat black = cv::Mat::zeros(left_.image.size(), CV_8UC3);
   std::vector<ros::Time> bad;
   bad.push_back(publishPair(black, black));             // fewer than two keypoints
@@ -54,6 +60,11 @@ TEST_F(MatcherNodeTest, RefusesBadPairsAndCarriesOn) {
   ros::spinOnce();
   expectNoneAnswered(bad);
   EXPECT_EQ(answered_.size(), 1u);
+  // The image without its partner on each side is counted, once.
+  EXPECT_FALSE(std::isnan(test::diagnosticValue(nh_, "matcher", "left/image unpaired",
+                                                [&](double v) { return v == left_unpaired + 1; })));
+  EXPECT_FALSE(std::isnan(test::diagnosticValue(
+      nh_, "matcher", "right/image unpaired", [&](double v) { return v == right_unpaired + 1; })));
 }
 
 TEST_F(MatcherNodeTest, WarnsWhenImagesArriveButDoNotPair) {

@@ -1,5 +1,6 @@
 // PairingWatch: inputs that arrive without pairing are reported after the patience, with their
-// counts and newest stamps; a pair clears it.
+// counts and newest stamps; a pair clears it. Each input's messages left out of every pair are
+// counted since the start.
 
 #include <gtest/gtest.h>
 
@@ -58,6 +59,22 @@ TEST(PairingWatch, TakesAnInputThatCameBeforeButNotSinceForIdle) {
   for (int i = 1; i <= 10; ++i) watch.arrived(1, 1.0 + i, start + milliseconds(300 * i));
   EXPECT_EQ(watch.problem(start + milliseconds(3000)), "")
       << "camera_info streaming between masks that come now and then";
+}
+
+TEST(PairingWatch, CountsEachInputsMessagesLeftOutOfEveryPair) {
+  PairingWatch watch({"left/image", "right/image"}, 3.0, "HINT");
+  const Clock::time_point now{};
+  for (int i = 0; i < 10; ++i) watch.arrived(0, i, now);  // 10 left images
+  for (int i = 0; i < 7; ++i) watch.arrived(1, i, now);   // 7 right ones, 6 of them paired
+  for (int i = 0; i < 6; ++i) watch.paired();
+  const std::vector<PairingWatch::Total> totals = watch.totals();
+  ASSERT_EQ(totals.size(), 2u);
+  EXPECT_EQ(totals[0].name, "left/image");
+  EXPECT_EQ(totals[0].received, 10u);
+  EXPECT_EQ(totals[0].unpaired, 4u);
+  EXPECT_EQ(totals[1].name, "right/image");
+  EXPECT_EQ(totals[1].received, 7u);
+  EXPECT_EQ(totals[1].unpaired, 1u);
 }
 
 }  // namespace

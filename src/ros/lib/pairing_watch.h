@@ -34,6 +34,7 @@ class PairingWatch {
     std::lock_guard<std::mutex> lock(mutex_);
     if (input >= inputs_.size()) return;
     ++inputs_[input].unpaired;
+    ++inputs_[input].received;
     inputs_[input].ever = true;
     inputs_[input].newest_stamp_s = stamp_s;
     if (!first_unpaired_) first_unpaired_ = now;
@@ -43,7 +44,25 @@ class PairingWatch {
   void paired() {
     std::lock_guard<std::mutex> lock(mutex_);
     for (Input& input : inputs_) input.unpaired = 0;
+    ++pairs_;
     first_unpaired_.reset();
+  }
+
+  /// One input's messages since the start, and how many of them were left out of every pair: the
+  /// synchroniser dropped them (its queue full, or no partner) or still holds them.
+  struct Total {
+    std::string name;
+    size_t received = 0, unpaired = 0;
+  };
+
+  std::vector<Total> totals() const {
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::vector<Total> totals;
+    for (const Input& input : inputs_) {
+      totals.push_back({input.name, input.received,
+                        input.received > pairs_ ? input.received - pairs_ : size_t{0}});
+    }
+    return totals;
   }
 
   /// Empty while the inputs pair (or nothing arrives); else why they do not, e.g. "silhouette (12
@@ -71,8 +90,9 @@ class PairingWatch {
  private:
   struct Input {
     std::string name;
-    size_t unpaired = 0;
-    bool ever = false;  ///< arrived since the start
+    size_t unpaired = 0;  ///< since the last pair
+    size_t received = 0;  ///< since the start
+    bool ever = false;    ///< arrived since the start
     double newest_stamp_s = std::numeric_limits<double>::quiet_NaN();
   };
 
@@ -87,6 +107,7 @@ class PairingWatch {
   const std::string hint_;
   mutable std::mutex mutex_;
   std::vector<Input> inputs_;
+  size_t pairs_ = 0;
   std::optional<Clock::time_point> first_unpaired_;
 };
 

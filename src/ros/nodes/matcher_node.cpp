@@ -167,6 +167,10 @@ void MatcherNode::reportDiagnostics(diagnostic_updater::DiagnosticStatusWrapper&
     status.add("frames unusable", counts.unusable);
     status.add("frames cleared waiting for their pose", counts.cleared);
   }
+  for (const PairingWatch::Total& total : pairing_.totals()) {
+    status.add(total.name + " received", total.received);
+    status.add(total.name + " unpaired", total.unpaired);  // dropped by the synchroniser, waiting
+  }
   status.add("last pair ms", last_pair_ms_.load());
   status.add("tf transforms refused", tf_listener_.refused());
   status.add("images described", features_.misses());

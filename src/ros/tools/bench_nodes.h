@@ -124,10 +124,13 @@ inline std::vector<std::string> nodeArguments(const std::string& name,
 struct MatcherRun {
   int workers = 0;
   double input_hz = 0.0;
+  int width_px = 0, height_px = 0;
   int published = 0, answered = 0;
   double answered_per_s = 0.0, latency_ms = 0.0, dropped = 0.0;
   double described = 0.0, reused = 0.0;  ///< the node's feature cache: images described, reused
   double rss_first_mib = 0.0, rss_last_mib = 0.0, rss_max_mib = 0.0;
+  /// Resident set after the warm-up, and 10 s after the stream was settled (freed memory back).
+  double rss_idle_mib = 0.0, rss_10s_after_mib = 0.0;
 };
 
 struct StereoStream {
@@ -144,10 +147,10 @@ struct SiftCost {
 
 SiftCost measureSift(const StereoStream& stream);
 
-/// The synthetic scene's 16 views at 640x480, as image messages.
-StereoStream stereoStream();
+/// The synthetic scene's 16 views at width x height pixels, as image messages.
+StereoStream stereoStream(int width_px = 640, int height_px = 480);
 
-/// matcher_node with `workers` workers, fed pairs at `input_hz` for `seconds`.
+/// matcher_node with `workers` workers, fed pairs at `input_hz` for `seconds`; then 10 s idle.
 MatcherRun runMatcher(RosHarness& harness, const StereoStream& stream, int workers, double input_hz,
                       double seconds);
 

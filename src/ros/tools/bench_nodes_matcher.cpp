@@ -7,8 +7,10 @@ namespace sift_hull {
 namespace cli {
 namespace bench_nodes {
 
-StereoStream stereoStream() {
-  SceneConfig config;  // 16 views, 640x480
+StereoStream stereoStream(int width_px, int height_px) {
+  SceneConfig config;  // 16 views
+  config.width_px = width_px;
+  config.height_px = height_px;
   StereoStream stream;
   for (const RenderedView& view : renderScene(config)) {
     stream.frames.push_back(ros_conversions::imageMessage(view.image, std_msgs::Header()));
@@ -110,7 +112,8 @@ MatcherRun runMatcher(RosHarness& harness, const StereoStream& stream, int worke
     const ros::Time stamp = feed.publish(k);
     waitUntil([&] { return answers.arrival(stamp).has_value(); });
   }
-  MatcherRun run{workers, input_hz};
+  MatcherRun run{workers, input_hz, stream.images.front().cols, stream.images.front().rows};
+  run.rss_idle_mib = residentMiB(pid);
   const SendTimes sent = streamPairs(feed, pid, seconds, &run);
   run.published = static_cast<int>(sent.size());
   waitUntil(
@@ -125,6 +128,8 @@ MatcherRun runMatcher(RosHarness& harness, const StereoStream& stream, int worke
   run.described = diagnostics.value("images described");
   run.reused = diagnostics.value("features reused");
   summariseAnswers(sent, answers, &run);
+  ros::WallDuration(10.0).sleep();  // what a user sees once the stream has ended
+  run.rss_10s_after_mib = residentMiB(pid);
   harness.stopNode(pid);
   return run;
 }

@@ -1,7 +1,8 @@
 // bench-nodes: the matcher and hull nodes as users run them, in processes of their own against a
 // ROS master of their own, fed over topics by this program: the matcher on a 640x480 stereo
-// stream at several rates (1 worker, the baseline, and 2), the hull node one view at a time at
-// depth 8, and both under a stream faster than they can follow (drops counted, memory sampled).
+// stream at several rates (1 worker, the baseline, and 2) and flooded with 1280x960 pairs, the
+// hull node one view at a time at depth 8, and both under a stream faster than they can follow
+// (drops counted, memory sampled, and 10 s after the matcher's streams).
 
 #include "bench_nodes.h"
 
@@ -11,11 +12,16 @@ namespace {
 
 using namespace bench_nodes;
 
+/// The matcher's stream (the flood's frames are twice as wide and high).
+constexpr int kStreamWidth_px = 640, kStreamHeight_px = 480;
+
 // ---- report ----------------------------------------------------------------------------------
 
 nlohmann::json matcherJson(const MatcherRun& r) {
   return {{"workers", r.workers},
           {"input_hz", r.input_hz},
+          {"width_px", r.width_px},
+          {"height_px", r.height_px},
           {"published", r.published},
           {"answered", r.answered},
           {"answered_per_s", r.answered_per_s},
@@ -25,7 +31,9 @@ nlohmann::json matcherJson(const MatcherRun& r) {
           {"features_reused", r.reused},
           {"rss_first_mib", r.rss_first_mib},
           {"rss_last_mib", r.rss_last_mib},
-          {"rss_max_mib", r.rss_max_mib}};
+          {"rss_max_mib", r.rss_max_mib},
+          {"rss_idle_mib", r.rss_idle_mib},
+          {"rss_10s_after_mib", r.rss_10s_after_mib}};
 }
 
 nlohmann::json hullJson(const HullRun& r) {
@@ -59,7 +67,7 @@ nlohmann::json measurementsJson(const std::vector<MatcherRun>& matcher,
                                 const std::vector<HullRun>& hulls) {
   double best_rate = 0.0, dropped_at_10_hz = 0.0;
   for (const MatcherRun& r : matcher) {
-    if (r.workers != MatcherNodeConfig().workers) continue;
+    if (r.workers != MatcherNodeConfig().workers || r.width_px != kStreamWidth_px) continue;
     best_rate = std::max(best_rate, r.answered_per_s);
     if (r.input_hz <= 10.0) dropped_at_10_hz += r.dropped + (r.published - r.answered);
   }
@@ -111,23 +119,25 @@ std::string markdownReport(const std::vector<MatcherRun>& matcher,
       << " hardware threads. The nodes run as processes "
       << "of their own against a ROS master of their own; this program publishes their input and "
       << "subscribes their output over TCP, as `rosbag play` and rviz would.\n\n"
-      << "Matcher node, 640x480 synthetic stereo pairs (the scene's views k and k+1), its "
+      << "Matcher node, synthetic stereo pairs (the scene's views k and k+1), its "
       << "default filter (" << kDefaultFilter << "), "
       << "one pair at a time waiting (`~max_waiting_pairs` 2). Answered per second counts from "
       << "the first pair sent to the last answer; latency is from sending a pair to receiving its "
       << "correspondences (median); dropped is the node's own count (/diagnostics), described / "
       << "reused its feature cache's (images given to SIFT, images whose features were taken "
       << "from the cache, the warm-up included); memory is "
-      << "the node's resident set after 1 s / at the end / at most.\n\n"
+      << "the node's resident set after the warm-up / at most / 10 s after the stream ended. "
+      << "The last row is a flood: 1280x960 pairs at 30 Hz.\n\n"
       << siftMarkdown(sift)
-      << "| workers | input Hz | sent | answered | answered / s | latency ms | dropped | "
-         "described / reused | memory MiB |\n|---|---|---|---|---|---|---|---|---|\n";
+      << "| frames | workers | input Hz | sent | answered | answered / s | latency ms | dropped | "
+         "described / reused | memory MiB |\n|---|---|---|---|---|---|---|---|---|---|\n";
   for (const MatcherRun& r : matcher) {
-    out << "| " << r.workers << " | " << fixed(r.input_hz, 0) << " | " << r.published << " | "
-        << r.answered << " | " << fixed(r.answered_per_s, 1) << " | " << fixed(r.latency_ms, 0)
-        << " | " << fixed(r.dropped, 0) << " | " << fixed(r.described, 0) << " / "
-        << fixed(r.reused, 0) << " | " << fixed(r.rss_first_mib, 0) << " / "
-        << fixed(r.rss_last_mib, 0) << " / " << fixed(r.rss_max_mib, 0) << " |\n";
+    out << "| " << r.width_px << "x" << r.height_px << " | " << r.workers << " | "
+        << fixed(r.input_hz, 0) << " | " << r.published << " | " << r.answered << " | "
+        << fixed(r.answered_per_s, 1) << " | " << fixed(r.latency_ms, 0) << " | "
+        << fixed(r.dropped, 0) << " | " << fixed(r.described, 0) << " / " << fixed(r.reused, 0)
+        << " | " << fixed(r.rss_idle_mib, 0) << " / " << fixed(r.rss_max_mib, 0) << " / "
+        << fixed(r.rss_10s_after_mib, 0) << " |\n";
   }
   out << "\nHull node, one view at a time (the next sent once /diagnostics counts the view "
       << "processed). Medians over the views that refine an existing hull: carving (`HullStream` "
@@ -164,8 +174,9 @@ std::string markdownReport(const std::vector<MatcherRun>& matcher,
 int runBenchNodes(const std::vector<std::string>& args) {
   ArgParser parser("bench-nodes",
                    "Measures matcher_node and hull_node as separate processes: the matcher on a\n"
-                   "640x480 stereo stream (1 and 2 workers), the hull node one view at a time at\n"
-                   "depth 8, and both under a stream faster than they follow.");
+                   "640x480 stereo stream (1 and 2 workers) and a 1280x960 flood, the hull node\n"
+                   "one view at a time at depth 8, and both under a stream faster than they\n"
+                   "follow.");
   parser.addOption("data", "DIR", "data root (default: $SIFT_HULL_DATA or ../shared/data)");
   parser.addOption("seconds", "S", "length of each matcher stream", "10");
   parser.addOption("write", "MD", "replace the bench-nodes section of this Markdown file");
@@ -184,7 +195,7 @@ int runBenchNodes(const std::vector<std::string>& args) {
   ros::init(argc, nullptr, "bench_nodes", ros::init_options::NoSigintHandler);
   ros::AsyncSpinner spinner(2);
   spinner.start();
-  const StereoStream stream = stereoStream();
+  const StereoStream stream = stereoStream(kStreamWidth_px, kStreamHeight_px);
   nlohmann::json sift;
   if (!parser.flag("hull-only")) sift = siftJson(measureSift(stream));
   std::vector<MatcherRun> matcher;
@@ -194,6 +205,10 @@ int runBenchNodes(const std::vector<std::string>& args) {
         matcher.push_back(runMatcher(harness, stream, workers, hz, seconds));
       }
     }
+  }
+  if (!parser.flag("hull-only")) {  // a flood: frames of four times the pixels, as fast
+    const StereoStream large = stereoStream(2 * kStreamWidth_px, 2 * kStreamHeight_px);
+    matcher.push_back(runMatcher(harness, large, MatcherNodeConfig().workers, 30.0, seconds));
   }
   const std::string root = parser.has("data") ? parser.get("data") : defaultDataRoot();
   const std::vector<HullRun> hulls = benchHulls(harness, root);
