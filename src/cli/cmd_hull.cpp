@@ -173,7 +173,8 @@ int runHull(const std::vector<std::string>& args) {
   const std::optional<Box3d> box = boxFromArgs(parser);
   if (box) checkBox(*box, input, &poor);
   HullResult result = buildHull(input, config, box);
-  if (parser.flag("refine-with-matches") && parser.has("out-render")) {
+  if ((parser.flag("refine-with-matches") || parser.flag("photo-carve")) &&
+      parser.has("out-render")) {
     writeRender(beforePath(parser.get("out-render")), result.mesh);
   }
   const nlohmann::json refined = refineWithMatches(parser, input, &result);

@@ -1,6 +1,6 @@
 // hull --refine-with-matches: the filtered matches of calibrated pairs carve what silhouettes
-// cannot (src/core/pipeline/match_refinement.cpp), and with --gt-scene the result against the
-// renderer's solid.
+// cannot (src/core/pipeline/match_refinement.cpp); hull --photo-carve: the views' dense depth maps
+// carve it (src/core/mvs); and with --gt-scene the result against the renderer's solid.
 
 #include "refine_options.h"
 
@@ -10,10 +10,12 @@
 #include <string>
 
 #include "bench_timing.h"
+#include "setting_options.h"
 #include "sift_hull/eval/hull_evaluation.h"
 #include "sift_hull/filters/filter.h"
 #include "sift_hull/io/images.h"
 #include "sift_hull/io/ply.h"
+#include "sift_hull/mvs/photo_carving.h"
 #include "sift_hull/pipeline/match_refinement.h"
 #include "sift_hull/synthetic/scene.h"
 #include "sift_hull/synthetic/shape.h"
@@ -111,7 +113,17 @@ nlohmann::json solidJson(const SolidComparison& c) {
 
 }  // namespace
 
+PhotoCarveConfig photoConfigFromArgs(const ArgParser& parser) {
+  PhotoCarveConfig config;
+  settingsFromArgs(parser, settingsOf<PhotoCarveConfig>(), &config);
+  return config;
+}
+
 void checkRefineOptions(const ArgParser& parser) {
+  if (parser.flag("photo-carve")) {
+    if (!parser.has("images")) throw UsageError("--photo-carve needs --images");
+    static_cast<void>(photoConfigFromArgs(parser));
+  }
   if (!parser.flag("refine-with-matches")) return;
   if (!parser.has("images")) throw UsageError("--refine-with-matches needs --images");
   std::unique_ptr<MatchFilter> filter;
@@ -188,9 +200,15 @@ void addRefineOptions(ArgParser* parser) {
   parser->addOption("out-points", "PLY",
                     "write the surface points that --refine-with-matches carves with (vertices "
                     "only)");
+  parser->addFlag("photo-carve",
+                  "carve the hull by the views' dense depth maps (a plane sweep of each view "
+                  "against its neighbours within the hull's depth range, on --images), after "
+                  "--refine-with-matches when both are given");
+  addSettingOptions(parser, settingsOf<PhotoCarveConfig>());
   parser->addOption("gt-scene", "DIR",
                     "a scene `sift_hull scene` rendered: compare the hull with its true solid "
-                    "(volume IoU, and with --refine-with-matches before and after, false carving)");
+                    "(volume IoU, and with --refine-with-matches or --photo-carve before and "
+                    "after, false carving)");
 }
 
 namespace {
@@ -235,6 +253,32 @@ nlohmann::json refine(const ArgParser& parser, const HullInput& input, HullResul
   return json;
 }
 
+/// Photo carving of result->hull (sift_hull::photoCarve), carved and meshed again; its part of
+/// `hull --json`.
+nlohmann::json photoCarve(const ArgParser& parser, const HullInput& input, HullResult* result) {
+  const auto start = std::chrono::steady_clock::now();
+  const RefineViews refine_views = refineViews(parser.get("images"), input);
+  const PhotoViews views{refine_views.cameras, refine_views.image, refine_views.mask};
+  const PhotoCarveResult carved =
+      sift_hull::photoCarve(result->hull, views, photoConfigFromArgs(parser));
+  const size_t free_before = result->hull.freeVoxelCount();
+  result->hull.carveFree(carved.free_voxels);
+  result->mesh = result->hull.mesh();
+  result->mesh_check = checkMesh(result->mesh);
+  return {
+      {"carved_voxels", result->hull.freeVoxelCount() - free_before},
+      {"free_voxels_found", carved.free_voxels.size()},
+      {"restored_voxels", carved.restored_voxels},
+      {"sweeps", carved.sweeps},
+      {"depth_pixels", {{"swept", carved.depth_pixels}, {"consistent", carved.consistent_pixels}}},
+      {"time_ms", millisecondsSince(start)},
+      {"stage_ms",
+       {{"depth", carved.depth_ms},
+        {"consistency", carved.consistency_ms},
+        {"voting", carved.voting_ms},
+        {"silhouettes", carved.silhouettes_ms}}}};
+}
+
 }  // namespace
 
 nlohmann::json refineWithMatches(const ArgParser& parser, const HullInput& input,
@@ -255,6 +299,11 @@ nlohmann::json refineWithMatches(const ArgParser& parser, const HullInput& input
   std::optional<SolidSamples> before;
   if (solid) before = sampleAgainstSolid(result->hull, inside, kSolidSamplesPerAxis, cavities);
   if (parser.flag("refine-with-matches")) json = refine(parser, input, result);
+  if (parser.flag("photo-carve")) {
+    const double before_m3 = result->hull.stats().occupied_volume_m3;
+    json["photo_carving"] = photoCarve(parser, input, result);
+    json["photo_carving"]["carved_volume_m3"] = before_m3 - result->hull.stats().occupied_volume_m3;
+  }
   if (solid) {
     const SolidSamples after =
         sampleAgainstSolid(result->hull, inside, kSolidSamplesPerAxis, cavities);

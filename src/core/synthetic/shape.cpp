@@ -241,7 +241,7 @@ bool Shape::hasCuts() const {
 }
 
 std::vector<std::string> Shape::names() {
-  return {"sculpture", "sphere", "box", "torus", "dumbbell", "cup", "ublock"};
+  return {"sculpture", "sphere", "box", "torus", "dumbbell", "cup", "ublock", "bowl"};
 }
 
 Shape Shape::byName(const std::string& name) {
@@ -273,6 +273,11 @@ Shape Shape::byName(const std::string& name) {
     Primitive groove = makePrimitive(T::kBox, {0, 0, 0.25}, {0.15, 1.0, 0.3});
     groove.subtract = true;
     return Shape({makePrimitive(T::kBox, {0, 0, 0}, {0.6, 0.9, 0.45}), groove});
+  }
+  if (name == "bowl") {  // a round dent 0.35 m deep and 1.09 m across in a block's top face
+    Primitive dent = makePrimitive(T::kSphere, {0, 0, 0.65}, {0.6, 0, 0});
+    dent.subtract = true;
+    return Shape({makePrimitive(T::kBox, {0, 0, 0}, {0.7, 0.7, 0.4}), dent});
   }
   throw std::invalid_argument("unknown shape '" + name + "'");
 }

@@ -1,0 +1,60 @@
+#pragma once
+
+// The stages of photo carving (sift_hull/mvs/photo_carving.h), shared by its source files.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <opencv2/core.hpp>
+#include <vector>
+
+#include "sift_hull/geometry/camera.h"
+#include "sift_hull/hull/octree.h"
+#include "sift_hull/mvs/photo_carving.h"
+
+namespace sift_hull {
+namespace detail {
+
+/// A view at the depth maps' scale, in ideal pixels (the lens distortion taken out).
+struct ReducedView {
+  PinholeCamera camera;  ///< scaled K, no distortion
+  cv::Mat grey;          ///< CV_32FC1 in [0, 1]
+  cv::Mat inside;        ///< CV_8UC1, non-zero where a patch lies wholly inside the silhouette
+};
+
+/// Throws std::invalid_argument for an empty image or one of another size than the mask's.
+ReducedView reducedView(const PinholeCamera& camera, const cv::Mat& image, const cv::Mat& mask,
+                        double scale, int patch_radius_px);
+
+/// Each view's neighbours: up to `count` other views whose lines of sight to `centre_W` make the
+/// smallest angles with its own, none beyond max_angle_deg; ties by index.
+std::vector<std::vector<uint32_t>> chooseNeighbours(const std::vector<PinholeCamera>& cameras,
+                                                    const Eigen::Vector3d& centre_W, int count,
+                                                    double max_angle_deg);
+
+/// The hull's depth range at each pixel of a view: the nearest and farthest corner depths of the
+/// occupied leaves whose projected corners' box holds the pixel (NaN where none does).
+struct DepthRange {
+  cv::Mat near_m, far_m;            ///< CV_32FC1
+  double min_m = 0.0, max_m = 0.0;  ///< over the image; 0 when nothing projects into it
+};
+DepthRange hullDepthRange(const std::vector<HullCell>& occupied, const HullCube& cube,
+                          const PinholeCamera& camera, cv::Size size);
+
+/// The plane sweep of view `view` against its neighbours: each pixel's best depth within its
+/// range (refined between planes by a parabola through the scores) and its score, NaN where none
+/// passes the config. Adds the sweeps made to *sweeps.
+void sweepDepth(const std::vector<ReducedView>& views, uint32_t view,
+                const std::vector<uint32_t>& neighbours, const DepthRange& range,
+                const PhotoCarveConfig& config, double voxel_m, cv::Mat* depth_m, cv::Mat* ncc,
+                size_t* sweeps);
+
+/// Keeps a pixel's depth where at least config.photo_min_consistent_views of its neighbours'
+/// depth maps agree with it within config.photo_consistency_voxels.
+cv::Mat consistentDepth(const std::vector<ViewDepth>& depths, uint32_t view,
+                        const PhotoCarveConfig& config, double voxel_m);
+
+/// The occupied leaves of the hull: in cells, and surface cells whose centre is inside.
+std::vector<HullCell> occupiedLeaves(const VisualHull& hull);
+
+}  // namespace detail
+}  // namespace sift_hull

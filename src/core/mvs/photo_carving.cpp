@@ -1,0 +1,320 @@
+// Photo carving (sift_hull/mvs/photo_carving.h): the views' depth maps (depth_maps.cpp), the
+// occupied finest voxels that several views see in front of their depth, and the silhouettes'
+// check: a silhouette pixel whose line of sight, walked voxel by voxel through the hull, would meet
+// only carved voxels keeps the one of them that the fewest views saw empty.
+//
+// Cost: the sweep is views x neighbours x planes warps and box filters of the reduced images; the
+// vote is occupied finest voxels x views projections; the check walks, per view, the pixels of
+// the silhouette that carved voxels project onto, each until its first occupied voxel.
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <mutex>
+#include <stdexcept>
+#include <string>
+#include <tuple>
+#include <unordered_map>
+
+#include "common/parallel.h"
+#include "hull/voxel_key.h"
+#include "mvs/mvs_internal.h"
+
+namespace sift_hull {
+
+template <>
+const SettingTable<PhotoCarveConfig>& settingsOf<PhotoCarveConfig>() {
+  static const SettingTable<PhotoCarveConfig> table = [] {
+    using C = PhotoCarveConfig;
+    SettingTable<C> t;
+    t.add("photo_neighbours", &C::photo_neighbours, "views",
+          "views each view's depth is measured against, the nearest by angle")
+        .range(1, 16);
+    t.add("photo_max_neighbour_angle_deg", &C::photo_max_neighbour_angle_deg, "deg",
+          "neighbours seen at a larger angle from the view's line of sight are not used")
+        .above(1.0, 180.0);
+    t.add("photo_image_scale", &C::photo_image_scale, "",
+          "the depth maps' resolution, as a share of the images' width and height")
+        .above(0.0, 1.0);
+    t.add("photo_patch_radius_px", &C::photo_patch_radius_px, "px",
+          "patches of (2 r + 1)^2 pixels at the depth maps' resolution")
+        .range(1, 10);
+    t.add("photo_best_neighbours", &C::photo_best_neighbours, "views",
+          "a depth's score is the mean NCC of this many best neighbours there")
+        .range(1, 8);
+    t.add("photo_min_ncc", &C::photo_min_ncc, "", "smallest score of a pixel's depth")
+        .range(-1.0, 1.0);
+    t.add("photo_min_patch_std", &C::photo_min_patch_std, "",
+          "patches flatter than this (grey level standard deviation, 0..1) get no depth")
+        .atLeast(0.0);
+    t.add("photo_depth_planes", &C::photo_depth_planes, "planes",
+          "depths swept per view over the hull's depth range")
+        .range(2, 4096);
+    t.add("photo_consistency_voxels", &C::photo_consistency_voxels, "voxels",
+          "a depth agrees with a neighbour's depth map within this many finest voxels")
+        .above(0.0);
+    t.add("photo_min_consistent_views", &C::photo_min_consistent_views, "views",
+          "neighbours whose depth maps must agree with a pixel's depth to keep it")
+        .range(0, 16);
+    t.add("photo_margin_voxels", &C::photo_margin_voxels, "voxels",
+          "a voxel is empty for a view this far in front of its depth")
+        .atLeast(0.0);
+    t.add("photo_min_views", &C::photo_min_views, "views",
+          "views that must see a voxel empty, and more than see the surface there")
+        .atLeast(1);
+    return t;
+  }();
+  return table;
+}
+
+void validate(const PhotoCarveConfig& config) { checkSettings(config, "PhotoCarveConfig"); }
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double msSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+/// A voxel's votes: views that see it in front of their depth, and views that see the surface
+/// there.
+struct Votes {
+  int empty = 0, surface = 0;
+};
+
+Votes votesAt(const Eigen::Vector3d& X_W, const std::vector<ViewDepth>& depths, double margin_m) {
+  Votes votes;
+  for (const ViewDepth& view : depths) {
+    const double depth = view.camera.depth(X_W);
+    if (!(depth > 0.0)) continue;
+    const Eigen::Vector2d px = view.camera.projectIdeal(X_W);
+    const long u = std::lround(px.x()), v = std::lround(px.y());
+    if (u < 0 || v < 0 || u >= view.depth_m.cols || v >= view.depth_m.rows) continue;
+    const float seen = view.depth_m.at<float>(static_cast<int>(v), static_cast<int>(u));
+    if (std::isnan(seen)) continue;
+    if (depth < seen - margin_m) {
+      ++votes.empty;
+    } else if (depth <= seen + margin_m) {
+      ++votes.surface;
+    }
+  }
+  return votes;
+}
+
+/// Where a ray leaves the box [lo, hi] (it is inside).
+double exitOf(const Eigen::Vector3d& origin_W, const Eigen::Vector3d& direction,
+              const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+  double t = std::numeric_limits<double>::infinity();
+  for (int a = 0; a < 3; ++a) {
+    if (direction[a] > 0.0) t = std::min(t, (hi[a] - origin_W[a]) / direction[a]);
+    if (direction[a] < 0.0) t = std::min(t, (lo[a] - origin_W[a]) / direction[a]);
+  }
+  return t;
+}
+
+/// The free voxel a silhouette pixel's line of sight needs back, or no key (~0) when its walk
+/// through the cube meets an occupied voxel that is not free (or meets no voxel of the hull). The
+/// walk goes leaf by leaf, and voxel by voxel through occupied leaves.
+uint64_t neededOnRay(const VisualHull& hull, const Eigen::Vector3d& origin_W,
+                     const Eigen::Vector3d& direction,
+                     const std::unordered_map<uint64_t, int>& free_votes) {
+  constexpr uint64_t kNone = ~uint64_t{0};
+  const HullCube& cube = hull.cube();
+  const double voxel_m = cube.resolution_m;
+  const int cells = 1 << cube.depth;
+  const Eigen::Vector3d lo = cube.origin_W(), hi = lo + Eigen::Vector3d::Constant(cube.edge_m());
+  double t0 = 0.0, t1 = std::numeric_limits<double>::infinity();
+  for (int a = 0; a < 3; ++a) {  // the ray's span inside the cube
+    if (direction[a] == 0.0) {
+      if (origin_W[a] < lo[a] || origin_W[a] > hi[a]) return kNone;
+      continue;
+    }
+    double near = (lo[a] - origin_W[a]) / direction[a], far = (hi[a] - origin_W[a]) / direction[a];
+    if (near > far) std::swap(near, far);
+    t0 = std::max(t0, near), t1 = std::min(t1, far);
+  }
+  const double nudge = 1e-6 * voxel_m;
+  uint64_t weakest = kNone;
+  int weakest_votes = std::numeric_limits<int>::max();
+  for (double t = t0 + nudge; t < t1;) {
+    const Eigen::Vector3d X = origin_W + direction * t;
+    const Eigen::Vector3i voxel =
+        ((X - lo) / voxel_m).array().floor().cast<int>().max(0).min(cells - 1).matrix();
+    const HullCell cell = hull.leafAt(lo + (voxel.cast<double>().array() + 0.5).matrix() * voxel_m);
+    const int edge = 1 << (cube.depth - cell.depth);
+    const Eigen::Vector3d cell_lo = lo + (cell.index * edge).cast<double>() * voxel_m;
+    const double exit = std::min(t1, exitOf(origin_W, direction, cell_lo,
+                                            cell_lo + Eigen::Vector3d::Constant(edge * voxel_m)));
+    const bool occupied = cell.state == CellState::kIn ||
+                          (cell.state == CellState::kSurface && cell.centre_value <= 0.0f);
+    if (occupied) {
+      // Voxel by voxel through the leaf: one that is not free covers the pixel.
+      Eigen::Vector3i at = voxel;
+      Eigen::Vector3i step;
+      Eigen::Vector3d next_t, delta_t;
+      for (int a = 0; a < 3; ++a) {
+        step[a] = direction[a] > 0.0 ? 1 : -1;
+        const double boundary = (at[a] + (step[a] > 0 ? 1 : 0)) * voxel_m + lo[a];
+        delta_t[a] = direction[a] == 0.0 ? std::numeric_limits<double>::infinity()
+                                         : voxel_m / std::abs(direction[a]);
+        next_t[a] = direction[a] == 0.0 ? std::numeric_limits<double>::infinity()
+                                        : (boundary - origin_W[a]) / direction[a];
+      }
+      while (detail::inCube(at, cells)) {
+        const auto found = free_votes.find(detail::voxelKey(at));
+        if (found == free_votes.end()) return kNone;
+        if (found->second <= weakest_votes) weakest = found->first, weakest_votes = found->second;
+        int a = 0;
+        if (next_t[1] < next_t[a]) a = 1;
+        if (next_t[2] < next_t[a]) a = 2;
+        if (next_t[a] >= exit) break;
+        at[a] += step[a];
+        next_t[a] += delta_t[a];
+      }
+    }
+    t = std::max(exit, t) + nudge;
+  }
+  return weakest;
+}
+
+}  // namespace
+
+PhotoCarveResult photoCarve(const VisualHull& hull, const PhotoViews& views,
+                            const PhotoCarveConfig& config) {
+  validate(config);
+  const size_t count = views.cameras.size();
+  if (count < 2) throw std::invalid_argument("photo carving needs two views at least");
+  const HullCube& cube = hull.cube();
+  const double voxel_m = cube.resolution_m;
+  const int threads = hull.config().threads;
+  PhotoCarveResult result;
+  Clock::time_point start = Clock::now();
+  std::vector<detail::ReducedView> reduced(count);
+  std::vector<cv::Mat> masks(count);
+  for (uint32_t v = 0; v < count; ++v) {
+    masks[v] = views.mask(v);
+    const cv::Mat image = views.image(v);
+    const PinholeCamera& camera = views.cameras[v];
+    if (image.empty() || image.size() != masks[v].size()) {
+      throw std::invalid_argument("photo carving: view " + std::to_string(v) +
+                                  ": its image and silhouette differ in size");
+    }
+    reduced[v] = detail::reducedView(camera, image, masks[v], config.photo_image_scale,
+                                     config.photo_patch_radius_px);
+  }
+  const std::vector<HullCell> occupied = detail::occupiedLeaves(hull);
+  const Eigen::Vector3d centre_W = cube.origin_W() + Eigen::Vector3d::Constant(cube.edge_m() / 2);
+  const std::vector<std::vector<uint32_t>> neighbours = detail::chooseNeighbours(
+      views.cameras, centre_W, config.photo_neighbours, config.photo_max_neighbour_angle_deg);
+  result.depths.resize(count);
+  std::vector<size_t> sweeps(count, 0);
+  detail::parallelFor(count, threads, [&](size_t v) {
+    ViewDepth& depth = result.depths[v];
+    depth.camera = reduced[v].camera;
+    depth.neighbours = neighbours[v];
+    if (neighbours[v].empty()) {
+      depth.depth_m = cv::Mat(reduced[v].grey.size(), CV_32FC1, cv::Scalar(NAN));
+      depth.ncc = depth.depth_m.clone();
+      return;
+    }
+    const detail::DepthRange range =
+        detail::hullDepthRange(occupied, cube, depth.camera, reduced[v].grey.size());
+    detail::sweepDepth(reduced, static_cast<uint32_t>(v), neighbours[v], range, config, voxel_m,
+                       &depth.depth_m, &depth.ncc, &sweeps[v]);
+  });
+  for (size_t v = 0; v < count; ++v) {
+    result.sweeps += sweeps[v];
+    result.depth_pixels +=
+        static_cast<size_t>(cv::countNonZero(result.depths[v].depth_m == result.depths[v].depth_m));
+  }
+  result.depth_ms = msSince(start);
+
+  start = Clock::now();
+  std::vector<cv::Mat> kept(count);
+  detail::parallelFor(count, threads, [&](size_t v) {
+    kept[v] = detail::consistentDepth(result.depths, static_cast<uint32_t>(v), config, voxel_m);
+  });
+  for (size_t v = 0; v < count; ++v) {
+    result.depths[v].depth_m = kept[v];
+    result.consistent_pixels += static_cast<size_t>(cv::countNonZero(kept[v] == kept[v]));
+  }
+  result.consistency_ms = msSince(start);
+
+  // Votes of every occupied finest voxel.
+  start = Clock::now();
+  const double margin_m = config.photo_margin_voxels * voxel_m;
+  std::vector<std::pair<Eigen::Vector3i, int>> free;
+  std::mutex free_mutex;
+  detail::parallelFor(occupied.size(), threads, [&](size_t i) {
+    const HullCell& cell = occupied[i];
+    const int edge = 1 << (cube.depth - cell.depth);
+    std::vector<std::pair<Eigen::Vector3i, int>> found;
+    for (int n = 0; n < edge * edge * edge; ++n) {
+      const Eigen::Vector3i voxel =
+          cell.index * edge + Eigen::Vector3i(n % edge, n / edge % edge, n / edge / edge);
+      const Eigen::Vector3d X_W =
+          cube.origin_W() + (voxel.cast<double>().array() + 0.5).matrix() * voxel_m;
+      const Votes votes = votesAt(X_W, result.depths, margin_m);
+      if (votes.empty >= config.photo_min_views && votes.empty > votes.surface) {
+        found.emplace_back(voxel, votes.empty);
+      }
+    }
+    if (found.empty()) return;
+    std::lock_guard<std::mutex> lock(free_mutex);
+    free.insert(free.end(), found.begin(), found.end());
+  });
+  result.voting_ms = msSince(start);
+
+  // The silhouettes' check, view by view in their order.
+  start = Clock::now();
+  std::unordered_map<uint64_t, int> free_votes;
+  for (const auto& [voxel, votes] : free) free_votes.emplace(detail::voxelKey(voxel), votes);
+  for (uint32_t v = 0; v < count && !free_votes.empty(); ++v) {
+    const PinholeCamera& camera = views.cameras[v];
+    const cv::Mat& mask = masks[v];
+    cv::Mat at_risk(mask.size(), CV_8UC1, cv::Scalar(0));
+    const double focal = std::max(camera.K()(0, 0), camera.K()(1, 1));
+    for (const auto& [key, votes] : free_votes) {
+      const Eigen::Vector3d X_W =
+          cube.origin_W() +
+          (detail::voxelOfKey(key).cast<double>().array() + 0.5).matrix() * voxel_m;
+      const double depth = camera.depth(X_W);
+      if (!(depth > 0.0)) continue;
+      const Eigen::Vector2d px = camera.project(X_W);
+      const double reach = 0.87 * voxel_m * focal / depth + 1.5;  // a voxel's half diagonal
+      const int u0 = std::max(0, static_cast<int>(std::floor(px.x() - reach)));
+      const int u1 = std::min(mask.cols - 1, static_cast<int>(std::ceil(px.x() + reach)));
+      const int v0 = std::max(0, static_cast<int>(std::floor(px.y() - reach)));
+      const int v1 = std::min(mask.rows - 1, static_cast<int>(std::ceil(px.y() + reach)));
+      if (u0 <= u1 && v0 <= v1) at_risk(cv::Rect(u0, v0, u1 - u0 + 1, v1 - v0 + 1)).setTo(255);
+    }
+    std::vector<std::vector<uint64_t>> needed(static_cast<size_t>(mask.rows));
+    const Eigen::Vector3d origin_W = camera.centre();
+    detail::parallelFor(static_cast<size_t>(mask.rows), threads, [&](size_t row) {
+      const int r = static_cast<int>(row);
+      for (int u = 0; u < mask.cols; ++u) {
+        if (!mask.at<uint8_t>(r, u) || !at_risk.at<uint8_t>(r, u)) continue;
+        const Eigen::Vector3d direction = camera.rayDirection(Eigen::Vector2d(u, r));
+        if (!direction.allFinite()) continue;
+        const uint64_t key = neededOnRay(hull, origin_W, direction, free_votes);
+        if (key != ~uint64_t{0}) needed[row].push_back(key);
+      }
+    });
+    for (const std::vector<uint64_t>& keys : needed) {
+      for (uint64_t key : keys) result.restored_voxels += free_votes.erase(key);
+    }
+  }
+  for (const auto& [voxel, votes] : free) {
+    if (free_votes.count(detail::voxelKey(voxel))) result.free_voxels.push_back(voxel);
+  }
+  std::sort(result.free_voxels.begin(), result.free_voxels.end(),
+            [](const Eigen::Vector3i& a, const Eigen::Vector3i& b) {
+              return std::tie(a.z(), a.y(), a.x()) < std::tie(b.z(), b.y(), b.x());
+            });
+  result.silhouettes_ms = msSince(start);
+  return result;
+}
+
+}  // namespace sift_hull

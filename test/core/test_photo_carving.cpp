@@ -1,0 +1,134 @@
+// src/core/mvs against the renderer's ground truth: the depth maps of the textured concave scenes
+// agree with the rendered depth, and photo carving removes part of what the silhouettes leave in
+// the cavities without carving the true solid or a silhouette pixel.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <iostream>
+#include <vector>
+
+#include "concave_scene.h"
+#include "sift_hull/eval/hull_evaluation.h"
+#include "sift_hull/mvs/photo_carving.h"
+
+namespace sift_hull {
+namespace {
+
+PhotoViews photoViews(const std::vector<RenderedView>& views) {
+  PhotoViews photo;
+  photo.cameras = camerasOf(views);
+  photo.image = [&views](uint32_t v) { return views.at(v).image; };
+  photo.mask = [&views](uint32_t v) { return views.at(v).mask; };
+  return photo;
+}
+
+/// The tests' scenes are 320x240 already: depth maps at full size.
+PhotoCarveConfig fullSize() {
+  PhotoCarveConfig config;
+  config.photo_image_scale = 1.0;
+  return config;
+}
+
+TEST(PhotoCarving, DepthMapsAgreeWithTheRenderedDepth) {
+  ConcaveScene scene("cup", 7);
+  const PhotoCarveResult result = photoCarve(scene.hull.hull, photoViews(scene.views), fullSize());
+  ASSERT_EQ(result.depths.size(), scene.views.size());
+  const double voxel_m = scene.hull.hull.cube().resolution_m;
+  size_t on_object = 0, kept = 0, close = 0;
+  std::vector<double> errors;
+  for (size_t v = 0; v < scene.views.size(); ++v) {
+    const cv::Mat& truth = scene.views[v].depth;
+    const cv::Mat& depth = result.depths[v].depth_m;
+    ASSERT_EQ(depth.size(), truth.size());
+    for (int y = 0; y < truth.rows; ++y) {
+      for (int x = 0; x < truth.cols; ++x) {
+        const float true_m = truth.at<float>(y, x), seen_m = depth.at<float>(y, x);
+        on_object += std::isfinite(true_m) ? 1 : 0;
+        if (std::isnan(seen_m)) continue;
+        ASSERT_TRUE(std::isfinite(true_m)) << "a depth where the view sees the background";
+        ++kept;
+        errors.push_back(std::abs(seen_m - true_m) / voxel_m);
+        close += errors.back() <= 3.0 ? 1 : 0;
+      }
+    }
+  }
+  ASSERT_GT(kept, 0u);
+  std::nth_element(errors.begin(), errors.begin() + errors.size() / 2, errors.end());
+  std::cout << "kept " << kept << " of " << on_object << " pixels on the object, median error "
+            << errors[errors.size() / 2] << " voxels, within 3 voxels " << double(close) / kept
+            << '\n';
+  EXPECT_GT(static_cast<double>(kept), 0.2 * on_object);
+  EXPECT_LT(errors[errors.size() / 2], 1.0);
+  EXPECT_GT(static_cast<double>(close) / kept, 0.9);
+}
+
+class PhotoCarvedShapes : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(PhotoCarvedShapes, CarvePartOfTheCavityAndNothingOfTheSolidOrTheSilhouettes) {
+  ConcaveScene scene(GetParam(), 7);
+  const SolidPredicate inside = [&](const Eigen::Vector3d& X) { return scene.shape.contains(X); };
+  const Shape filled = scene.shape.withoutCuts();
+  const SolidPredicate cavities = [&](const Eigen::Vector3d& X) {
+    return filled.contains(X) && !scene.shape.contains(X);
+  };
+  VisualHull& hull = scene.hull.hull;
+  const SolidSamples before = sampleAgainstSolid(hull, inside, 96, cavities);
+  const ReprojectionIoU iou_before = reprojectionIoU(hull.mesh(), hull.views());
+  const PhotoCarveResult result = photoCarve(hull, photoViews(scene.views), fullSize());
+  ASSERT_FALSE(result.free_voxels.empty());
+  hull.carveFree(result.free_voxels);
+  const SolidSamples after = sampleAgainstSolid(hull, inside, 96, cavities);
+  const SolidComparison was = compareWithSolid(before), is = compareWithSolid(after);
+  const TriangleMesh mesh = hull.mesh();
+  const ReprojectionIoU iou = reprojectionIoU(mesh, hull.views());
+  std::cout << GetParam() << ": IoU " << was.iou << " -> " << is.iou << ", missing volume cut by "
+            << 1.0 - (1.0 - is.iou) / (1.0 - was.iou) << ", false carving "
+            << falseCarvedFraction(before, after) << ", reprojection IoU min " << iou_before.min
+            << " -> " << iou.min << ", restored " << result.restored_voxels << " voxels\n";
+  // Measured at this size and depth: the missing volume cut by 8 % (cup), 17 % (ublock) and
+  // 60 % (bowl); false carving 0.2 to 0.4 %.
+  EXPECT_GT(is.iou, was.iou + 0.05 * (1.0 - was.iou));
+  EXPECT_LE(falseCarvedFraction(before, after), 0.005);
+  EXPECT_GE(iou.min, iou_before.min - 0.005);
+  EXPECT_TRUE(checkMesh(mesh).watertight);
+}
+
+INSTANTIATE_TEST_SUITE_P(ConcaveShapes, PhotoCarvedShapes,
+                         ::testing::Values("cup", "ublock", "bowl"));
+
+TEST(PhotoCarving, GivesTheSameVoxelsOnAnyNumberOfThreads) {
+  const ConcaveScene one("cup", 6);
+  HullConfig single = ConcaveScene::depth(6), dual = single;
+  PhotoCarveConfig config = fullSize();
+  config.photo_depth_planes = 48;
+  single.threads = 1;
+  dual.threads = 2;
+  const HullResult hull_one = buildHull(hullInputOf(one.views), single);
+  const HullResult hull_two = buildHull(hullInputOf(one.views), dual);
+  const PhotoCarveResult a = photoCarve(hull_one.hull, photoViews(one.views), config);
+  const PhotoCarveResult b = photoCarve(hull_two.hull, photoViews(one.views), config);
+  ASSERT_FALSE(a.free_voxels.empty());
+  EXPECT_EQ(a.free_voxels, b.free_voxels);
+  EXPECT_EQ(a.restored_voxels, b.restored_voxels);
+}
+
+TEST(PhotoCarving, RefusesBadSettingsAndViews) {
+  const ConcaveScene scene("cup", 5);
+  PhotoCarveConfig bad;
+  bad.photo_min_ncc = 2.0;
+  EXPECT_THROW(validate(bad), std::invalid_argument);
+  bad = PhotoCarveConfig();
+  bad.photo_image_scale = 0.0;
+  EXPECT_THROW(photoCarve(scene.hull.hull, photoViews(scene.views), bad), std::invalid_argument);
+  PhotoViews one = photoViews(scene.views);
+  one.cameras.resize(1);
+  EXPECT_THROW(photoCarve(scene.hull.hull, one, {}), std::invalid_argument);
+  PhotoViews small = photoViews(scene.views);
+  small.image = [](uint32_t) { return cv::Mat(10, 10, CV_8UC3, cv::Scalar::all(0)); };
+  EXPECT_THROW(photoCarve(scene.hull.hull, small, {}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace sift_hull
