@@ -31,6 +31,7 @@ const std::map<std::string, std::set<std::string>>& allowedIncludes() {
       {"filters", {"geometry", "features"}},
       {"hull", {"geometry"}},
       {"refine", {"geometry", "hull"}},
+      {"mvs", {"geometry", "hull"}},
       {"draw", {"geometry", "features", "filters"}},
       {"pipeline", {"geometry", "features", "filters", "hull", "refine"}},
       {"io", {"geometry", "features", "filters", "hull"}},

@@ -77,6 +77,38 @@ TEST(RefineCommand, RefusesBadSettingsByName) {
   refused("--min-views 0", "min_views");
 }
 
+TEST(RefineCommand, PhotoCarvingCarvesAndReportsItsStages) {
+  const std::string& s = cupScene();
+  const std::string hull = "hull --calib " + s + "/scene_par.txt --silhouettes " + s +
+                           "/masks --max-depth 6 --photo-carve --json ";
+  std::string out, err;
+  EXPECT_EQ(test::runProgram(hull, &out, &err), 2);
+  EXPECT_NE(err.find("--photo-carve needs --images"), std::string::npos) << err;
+  EXPECT_EQ(test::runProgram(hull + "--images " + s + " --photo-min-views 0", &out, &err), 2);
+  EXPECT_NE(err.find("photo-min-views"), std::string::npos) << err;
+  ASSERT_EQ(test::runProgram(hull + "--images " + s + " --photo-image-scale 1 --gt-scene " + s,
+                             &out, &err),
+            0)
+      << err;
+  const nlohmann::json j = nlohmann::json::parse(out);
+  const nlohmann::json& photo = j["photo_carving"];
+  EXPECT_GT(photo["carved_voxels"].get<int>(), 0) << out;
+  // Views x neighbours (at most 6 within 75 degrees) x planes.
+  EXPECT_EQ(photo["sweeps"].get<int>() % 128, 0) << out;
+  EXPECT_GT(photo["sweeps"].get<int>(), 20 * 3 * 128) << out;
+  EXPECT_LE(photo["sweeps"].get<int>(), 20 * 6 * 128) << out;
+  EXPECT_GT(photo["depth_pixels"]["consistent"].get<int>(), 0) << out;
+  EXPECT_LE(photo["depth_pixels"]["consistent"].get<int>(),
+            photo["depth_pixels"]["swept"].get<int>());
+  EXPECT_GT(photo["time_ms"].get<double>(), 0.0);
+  EXPECT_GT(photo["carved_volume_m3"].get<double>(), 0.0);
+  EXPECT_GT(j["volume_iou_vs_truth"]["after"].get<double>(),
+            j["volume_iou_vs_truth"]["before"].get<double>())
+      << out;
+  EXPECT_LE(j["false_carved_fraction"].get<double>(), 0.005) << out;
+  EXPECT_TRUE(j["mesh"]["watertight"].get<bool>()) << out;
+}
+
 TEST(RefineCommand, AGroundTruthOfAnotherSceneIsRefusedNamingBoth) {
   const std::string& cup = cupScene();
   const std::string other = test::temporaryDirectory() + "/box";

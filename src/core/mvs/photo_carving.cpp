@@ -1,7 +1,7 @@
 // Photo carving (sift_hull/mvs/photo_carving.h): the views' depth maps (depth_maps.cpp), the
 // occupied finest voxels that several views see in front of their depth, and the silhouettes'
 // check: a silhouette pixel whose line of sight, walked voxel by voxel through the hull, would meet
-// only carved voxels keeps the one of them that the fewest views saw empty.
+// only carved voxels keeps the one of them that the fewest views saw empty, with its neighbours.
 //
 // Cost: the sweep is views x neighbours x planes warps and box filters of the reduced images; the
 // vote is occupied finest voxels x views projections; the check walks, per view, the pixels of
@@ -303,7 +303,18 @@ PhotoCarveResult photoCarve(const VisualHull& hull, const PhotoViews& views,
       }
     });
     for (const std::vector<uint64_t>& keys : needed) {
-      for (uint64_t key : keys) result.restored_voxels += free_votes.erase(key);
+      for (uint64_t key : keys) {
+        // With its 26 neighbours: carveFree's closure frees a voxel all of whose corners touch
+        // free voxels, and the mesh grows the free space by a quarter of a voxel.
+        const Eigen::Vector3i centre = detail::voxelOfKey(key);
+        for (int n = 0; n < 27; ++n) {
+          const Eigen::Vector3i voxel =
+              centre + Eigen::Vector3i(n % 3 - 1, n / 3 % 3 - 1, n / 9 - 1);
+          if (detail::inCube(voxel, 1 << cube.depth)) {
+            result.restored_voxels += free_votes.erase(detail::voxelKey(voxel));
+          }
+        }
+      }
     }
   }
   for (const auto& [voxel, votes] : free) {
