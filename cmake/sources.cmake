@@ -50,6 +50,7 @@ set(SIFT_HULL_CORE_SOURCES
   src/core/hull/run_length_mask.cpp
   src/core/hull/silhouette.cpp
   src/core/mvs/depth_maps.cpp
+  src/core/mvs/mesh_colour.cpp
   src/core/mvs/photo_carving.cpp
   src/core/refine/dense_matching.cpp
   src/core/refine/free_space.cpp

@@ -151,7 +151,9 @@ int runHull(const std::vector<std::string>& args) {
                    "octree carving with signed distances, marching cubes.");
   addViewSetOptions(&parser);
   addHullOptions(&parser);
-  parser.addOption("out-mesh", "PLY", "write the mesh (binary PLY, world coordinates)");
+  parser.addOption("out-mesh", "PLY",
+                   "write the mesh (binary PLY, world coordinates; with --images, each vertex "
+                   "coloured by the views that see it)");
   parser.addOption("out-octree", "BT", "write the OctoMap (.bt)");
   parser.addOption("out-render", "PNG",
                    "write shaded renderings of the mesh (with --refine-with-matches also those of "
@@ -177,7 +179,8 @@ int runHull(const std::vector<std::string>& args) {
       parser.has("out-render")) {
     writeRender(beforePath(parser.get("out-render")), result.mesh);
   }
-  const nlohmann::json refined = refineWithMatches(parser, input, &result);
+  nlohmann::json refined = refineWithMatches(parser, input, &result);
+  refined.update(colourMesh(parser, input, &result));
   const double hull_peak_mib = peakMemoryMiB();
   const std::unique_ptr<octomap::OcTree> octree = toOctomap(result.hull);
   const ReprojectionIoU iou = reprojectionIoU(result.mesh, result.hull.views());

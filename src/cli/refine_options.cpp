@@ -15,6 +15,7 @@
 #include "sift_hull/filters/filter.h"
 #include "sift_hull/io/images.h"
 #include "sift_hull/io/ply.h"
+#include "sift_hull/mvs/mesh_colour.h"
 #include "sift_hull/mvs/photo_carving.h"
 #include "sift_hull/pipeline/match_refinement.h"
 #include "sift_hull/synthetic/scene.h"
@@ -314,6 +315,18 @@ nlohmann::json refineWithMatches(const ArgParser& parser, const HullInput& input
     json["cavity_filled_m3"] = {{"before", was.cavity_filled_m3}, {"after", is.cavity_filled_m3}};
   }
   return json;
+}
+
+nlohmann::json colourMesh(const ArgParser& parser, const HullInput& input, HullResult* result) {
+  if (!parser.has("out-mesh") || !parser.has("images")) return nlohmann::json::object();
+  const auto start = std::chrono::steady_clock::now();
+  const RefineViews views = refineViews(parser.get("images"), input);
+  const MeshColouring colouring = sift_hull::colourMesh(&result->mesh, views.cameras, views.image,
+                                                        result->hull.config().threads);
+  return {{"mesh_colours",
+           {{"coloured_vertices", colouring.coloured_vertices},
+            {"unseen_vertices", colouring.unseen_vertices},
+            {"time_ms", millisecondsSince(start)}}}};
 }
 
 }  // namespace cli

@@ -11,6 +11,7 @@
 
 #include "concave_scene.h"
 #include "sift_hull/eval/hull_evaluation.h"
+#include "sift_hull/mvs/mesh_colour.h"
 #include "sift_hull/mvs/photo_carving.h"
 
 namespace sift_hull {
@@ -91,7 +92,7 @@ TEST_P(PhotoCarvedShapes, CarvePartOfTheCavityAndNothingOfTheSolidOrTheSilhouett
   // 60 % (bowl); false carving 0.2 to 0.4 %.
   EXPECT_GT(is.iou, was.iou + 0.05 * (1.0 - was.iou));
   EXPECT_LE(falseCarvedFraction(before, after), 0.005);
-  EXPECT_GE(iou.min, iou_before.min - 0.005);
+  EXPECT_GE(iou.min, iou_before.min - 0.001);  // measured: unchanged
   EXPECT_TRUE(checkMesh(mesh).watertight);
 }
 
@@ -112,6 +113,42 @@ TEST(PhotoCarving, GivesTheSameVoxelsOnAnyNumberOfThreads) {
   ASSERT_FALSE(a.free_voxels.empty());
   EXPECT_EQ(a.free_voxels, b.free_voxels);
   EXPECT_EQ(a.restored_voxels, b.restored_voxels);
+}
+
+TEST(MeshColour, AHeldOutViewSeesTheColoursTheOtherViewsGave) {
+  const ConcaveScene scene("cup", 6);
+  TriangleMesh mesh = scene.hull.hull.mesh();
+  const size_t held_out = scene.views.size() - 1;
+  std::vector<PinholeCamera> cameras = camerasOf(scene.views);
+  cameras.pop_back();
+  const MeshColouring colouring = colourMesh(
+      &mesh, cameras, [&](uint32_t v) { return scene.views.at(v).image; }, 2);
+  ASSERT_EQ(mesh.colours_rgb.size(), mesh.vertices_W.size());
+  EXPECT_EQ(colouring.coloured_vertices + colouring.unseen_vertices, mesh.vertices_W.size());
+  EXPECT_GT(colouring.coloured_vertices, mesh.vertices_W.size() / 2);
+  // Where the held-out view sees a vertex on the true surface (its rendered depth), the colour
+  // the others gave against the photograph's; a grey mesh as the baseline.
+  const RenderedView& view = scene.views[held_out];
+  const double tolerance_m = 2.0 * scene.hull.hull.cube().resolution_m;
+  double error = 0.0, grey_error = 0.0;
+  size_t compared = 0;
+  for (size_t v = 0; v < mesh.vertices_W.size(); ++v) {
+    const Eigen::Vector3d X = mesh.vertices_W[v].cast<double>();
+    const Eigen::Vector2d px = view.view.camera.project(X);
+    const int u = static_cast<int>(std::lround(px.x())), w = static_cast<int>(std::lround(px.y()));
+    if (u < 0 || w < 0 || u >= view.depth.cols || w >= view.depth.rows) continue;
+    if (!(std::abs(view.view.camera.depth(X) - view.depth.at<float>(w, u)) < tolerance_m)) continue;
+    const cv::Vec3b bgr = view.image.at<cv::Vec3b>(w, u);
+    for (int c = 0; c < 3; ++c) {
+      error += std::abs(mesh.colours_rgb[v][c] - bgr[2 - c]);
+      grey_error += std::abs(128 - bgr[2 - c]);
+    }
+    ++compared;
+  }
+  ASSERT_GT(compared, 500u);
+  std::cout << compared << " vertices compared: mean error " << error / (3 * compared)
+            << " grey levels, a grey mesh's " << grey_error / (3 * compared) << '\n';
+  EXPECT_LT(error, 0.2 * grey_error);  // measured: a tenth
 }
 
 TEST(PhotoCarving, RefusesBadSettingsAndViews) {

@@ -40,6 +40,27 @@ TEST(PlyTest, RoundTripIsExact) {
   EXPECT_TRUE(empty.faces.empty());
 }
 
+TEST(PlyTest, ColoursRoundTripAfterTheCoordinatesAndMustBeOnePerVertex) {
+  TriangleMesh mesh = sphereMesh();
+  for (size_t v = 0; v < mesh.vertices_W.size(); ++v) {
+    mesh.colours_rgb.push_back({static_cast<uint8_t>(v), static_cast<uint8_t>(255 - v % 256),
+                                static_cast<uint8_t>(v * 7)});
+  }
+  const std::string path = ::testing::TempDir() + "/test_mesh_colours.ply";
+  writePly(path, mesh);
+  std::ifstream in(path, std::ios::binary);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("property float z\nproperty uchar red\nproperty uchar green\n"
+                      "property uchar blue\nelement face "),
+            std::string::npos);
+  const TriangleMesh read = readPly(path);
+  EXPECT_TRUE(std::equal(mesh.vertices_W.begin(), mesh.vertices_W.end(), read.vertices_W.begin()));
+  EXPECT_EQ(read.colours_rgb, mesh.colours_rgb);
+  EXPECT_TRUE(std::equal(mesh.faces.begin(), mesh.faces.end(), read.faces.begin()));
+  mesh.colours_rgb.pop_back();
+  EXPECT_THROW(writePly(path, mesh), std::runtime_error);
+}
+
 void expectReadFailureNamingPath(const std::string& path) {
   try {
     readPly(path);

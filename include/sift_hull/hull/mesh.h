@@ -1,6 +1,8 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -11,6 +13,8 @@ namespace sift_hull {
 struct TriangleMesh {
   std::vector<Eigen::Vector3f> vertices_W;
   std::vector<Eigen::Vector3i> faces;
+  /// Empty, or each vertex's colour (red, green, blue), as the photographs show it.
+  std::vector<std::array<uint8_t, 3>> colours_rgb;
 };
 
 /// Topology of a mesh. Watertight: every edge has exactly two faces, which traverse it in opposite

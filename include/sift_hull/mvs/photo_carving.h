@@ -17,7 +17,7 @@ namespace sift_hull {
 /// patches with the best of the view's neighbours), kept where the neighbours' depth maps agree
 /// (geometric consistency), then every occupied finest voxel that several views see in front of
 /// their depth is free, except where a silhouette pixel's line of sight would be left with no
-/// occupied voxel.
+/// occupied voxel clear of free ones (the mesh cuts into a voxel next to free space).
 struct PhotoCarveConfig {
   /// Views each view's depth is measured against: the nearest by the angle between their lines
   /// of sight to the hull's centre.

@@ -10,6 +10,7 @@
 #include <iterator>
 #include <limits>
 #include <numeric>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -23,7 +24,10 @@ const char* const kPlyVertexHeader = "element vertex ";
 const char* const kPlyFaceHeader = "element face ";
 const std::array<const char*, 3> kPlyVertexProperties = {"property float x", "property float y",
                                                          "property float z"};
+const std::array<const char*, 3> kPlyColourProperties = {
+    "property uchar red", "property uchar green", "property uchar blue"};
 constexpr size_t kPlyVertexBytes = 3 * 4;
+constexpr size_t kPlyColourBytes = 3;
 constexpr size_t kPlyFaceBytes = 1 + 3 * 4;
 
 void appendLittleEndian(uint32_t value, std::string* bytes) {
@@ -54,6 +58,9 @@ std::string plyHeader(const TriangleMesh& mesh) {
   std::string header = "ply\nformat binary_little_endian 1.0\n";
   header += kPlyVertexHeader + std::to_string(mesh.vertices_W.size()) + "\n";
   for (const char* property : kPlyVertexProperties) header += std::string(property) + "\n";
+  if (!mesh.colours_rgb.empty()) {
+    for (const char* property : kPlyColourProperties) header += std::string(property) + "\n";
+  }
   header += kPlyFaceHeader + std::to_string(mesh.faces.size()) + "\n";
   header += "property list uchar int vertex_indices\nend_header\n";
   return header;
@@ -62,8 +69,12 @@ std::string plyHeader(const TriangleMesh& mesh) {
 std::string plyBody(const TriangleMesh& mesh) {
   std::string body;
   body.reserve(mesh.vertices_W.size() * kPlyVertexBytes + mesh.faces.size() * kPlyFaceBytes);
-  for (const Eigen::Vector3f& vertex : mesh.vertices_W) {
-    for (int axis = 0; axis < 3; ++axis) appendLittleEndian(floatBits(vertex[axis]), &body);
+  for (size_t v = 0; v < mesh.vertices_W.size(); ++v) {
+    for (int axis = 0; axis < 3; ++axis) {
+      appendLittleEndian(floatBits(mesh.vertices_W[v][axis]), &body);
+    }
+    if (mesh.colours_rgb.empty()) continue;
+    for (const uint8_t channel : mesh.colours_rgb[v]) body.push_back(static_cast<char>(channel));
   }
   for (const Eigen::Vector3i& face : mesh.faces) {
     body.push_back(3);
@@ -79,6 +90,7 @@ std::string plyBody(const TriangleMesh& mesh) {
 struct PlyCounts {
   size_t vertices = 0;
   size_t faces = 0;
+  bool colours = false;  ///< red, green, blue after each vertex's coordinates
 };
 
 // Reads a header line, skipping comments; false at the end of the stream.
@@ -113,20 +125,33 @@ PlyCounts readPlyHeader(std::istream& in, const std::string& path) {
   PlyCounts counts;
   counts.vertices = expectCount(in, kPlyVertexHeader, path);
   for (const char* property : kPlyVertexProperties) expectLine(in, property, path);
-  counts.faces = expectCount(in, kPlyFaceHeader, path);
+  std::string line;
+  if (!nextHeaderLine(in, &line)) throwPlyError(path, "the header ends after the vertices");
+  if (line == kPlyColourProperties[0]) {
+    counts.colours = true;
+    expectLine(in, kPlyColourProperties[1], path);
+    expectLine(in, kPlyColourProperties[2], path);
+    if (!nextHeaderLine(in, &line)) throwPlyError(path, "the header ends after the vertices");
+  }
+  std::istringstream face_line(line + "\n");
+  counts.faces = expectCount(face_line, kPlyFaceHeader, path);
   expectLine(in, "property list uchar int vertex_indices", path);
   expectLine(in, "end_header", path);
   return counts;
 }
 
-std::vector<Eigen::Vector3f> decodeVertices(const char* bytes, size_t count) {
-  std::vector<Eigen::Vector3f> vertices(count);
-  for (size_t v = 0; v < count; ++v, bytes += kPlyVertexBytes) {
+void decodeVertices(const char* bytes, size_t count, bool colours, TriangleMesh* mesh) {
+  mesh->vertices_W.resize(count);
+  if (colours) mesh->colours_rgb.resize(count);
+  for (size_t v = 0; v < count; ++v) {
     for (int axis = 0; axis < 3; ++axis) {
-      vertices[v][axis] = bitsToFloat(readLittleEndian(bytes + 4 * axis));
+      mesh->vertices_W[v][axis] = bitsToFloat(readLittleEndian(bytes + 4 * axis));
     }
+    bytes += kPlyVertexBytes;
+    if (!colours) continue;
+    for (int c = 0; c < 3; ++c) mesh->colours_rgb[v][c] = static_cast<uint8_t>(bytes[c]);
+    bytes += kPlyColourBytes;
   }
-  return vertices;
 }
 
 std::vector<Eigen::Vector3i> decodeFaces(const char* bytes, size_t count, size_t vertex_count,
@@ -152,6 +177,10 @@ void writePly(const std::string& path, const TriangleMesh& mesh) {
       throwPlyError(path, "face " + std::to_string(f) + " references a vertex out of range");
     }
   }
+  if (!mesh.colours_rgb.empty() && mesh.colours_rgb.size() != mesh.vertices_W.size()) {
+    throwPlyError(path, "the mesh has " + std::to_string(mesh.colours_rgb.size()) +
+                            " colours for " + std::to_string(mesh.vertices_W.size()) + " vertices");
+  }
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   if (!out) throwPlyError(path, "cannot open for writing");
   const std::string header = plyHeader(mesh);
@@ -168,14 +197,15 @@ TriangleMesh readPly(const std::string& path) {
   const PlyCounts counts = readPlyHeader(in, path);
   const std::string body((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   // Counts come from the file; compare without overflowing before trusting them.
-  const size_t max_count = body.size() / kPlyVertexBytes;
+  const size_t vertex_bytes = kPlyVertexBytes + (counts.colours ? kPlyColourBytes : 0);
+  const size_t max_count = body.size() / std::min(vertex_bytes, kPlyFaceBytes);
   if (counts.vertices > max_count || counts.faces > max_count ||
-      body.size() != counts.vertices * kPlyVertexBytes + counts.faces * kPlyFaceBytes) {
+      body.size() != counts.vertices * vertex_bytes + counts.faces * kPlyFaceBytes) {
     throwPlyError(path, "data size does not match the header's element counts");
   }
   TriangleMesh mesh;
-  mesh.vertices_W = decodeVertices(body.data(), counts.vertices);
-  mesh.faces = decodeFaces(body.data() + counts.vertices * kPlyVertexBytes, counts.faces,
+  decodeVertices(body.data(), counts.vertices, counts.colours, &mesh);
+  mesh.faces = decodeFaces(body.data() + counts.vertices * vertex_bytes, counts.faces,
                            counts.vertices, path);
   return mesh;
 }

@@ -114,9 +114,24 @@ double exitOf(const Eigen::Vector3d& origin_W, const Eigen::Vector3d& direction,
   return t;
 }
 
-/// The free voxel a silhouette pixel's line of sight needs back, or no key (~0) when its walk
-/// through the cube meets an occupied voxel that is not free (or meets no voxel of the hull). The
-/// walk goes leaf by leaf, and voxel by voxel through occupied leaves.
+/// Whether one of a voxel's 26 neighbours is free: then a corner of it touches free space, where
+/// the mesh's free-space field (and carveFree's closure) cuts into it.
+bool touchesFree(const Eigen::Vector3i& voxel, int cells,
+                 const std::unordered_map<uint64_t, int>& free_votes) {
+  for (int n = 0; n < 27; ++n) {
+    const Eigen::Vector3i other = voxel + Eigen::Vector3i(n % 3 - 1, n / 3 % 3 - 1, n / 9 - 1);
+    if (n != 13 && detail::inCube(other, cells) && free_votes.count(detail::voxelKey(other))) {
+      return true;
+    }
+  }
+  return false;
+}
+
+/// The voxel a silhouette pixel's line of sight needs kept with its 26 neighbours, or no key (~0)
+/// when its walk through the cube meets an occupied voxel that is neither free nor next to a free
+/// one (or meets no voxel of the hull): the weakest free voxel on the way, else the first occupied
+/// voxel next to a free one. The walk goes leaf by leaf, and voxel by voxel through occupied
+/// leaves.
 uint64_t neededOnRay(const VisualHull& hull, const Eigen::Vector3d& origin_W,
                      const Eigen::Vector3d& direction,
                      const std::unordered_map<uint64_t, int>& free_votes) {
@@ -136,7 +151,7 @@ uint64_t neededOnRay(const VisualHull& hull, const Eigen::Vector3d& origin_W,
     t0 = std::max(t0, near), t1 = std::min(t1, far);
   }
   const double nudge = 1e-6 * voxel_m;
-  uint64_t weakest = kNone;
+  uint64_t weakest = kNone, first_touching = kNone;
   int weakest_votes = std::numeric_limits<int>::max();
   for (double t = t0 + nudge; t < t1;) {
     const Eigen::Vector3d X = origin_W + direction * t;
@@ -164,8 +179,13 @@ uint64_t neededOnRay(const VisualHull& hull, const Eigen::Vector3d& origin_W,
       }
       while (detail::inCube(at, cells)) {
         const auto found = free_votes.find(detail::voxelKey(at));
-        if (found == free_votes.end()) return kNone;
-        if (found->second <= weakest_votes) weakest = found->first, weakest_votes = found->second;
+        if (found != free_votes.end()) {
+          if (found->second <= weakest_votes) weakest = found->first, weakest_votes = found->second;
+        } else if (!touchesFree(at, cells, free_votes)) {
+          return kNone;
+        } else if (first_touching == kNone) {
+          first_touching = detail::voxelKey(at);
+        }
         int a = 0;
         if (next_t[1] < next_t[a]) a = 1;
         if (next_t[2] < next_t[a]) a = 2;
@@ -176,7 +196,7 @@ uint64_t neededOnRay(const VisualHull& hull, const Eigen::Vector3d& origin_W,
     }
     t = std::max(exit, t) + nudge;
   }
-  return weakest;
+  return weakest != kNone ? weakest : first_touching;
 }
 
 }  // namespace
@@ -283,7 +303,8 @@ PhotoCarveResult photoCarve(const VisualHull& hull, const PhotoViews& views,
       const double depth = camera.depth(X_W);
       if (!(depth > 0.0)) continue;
       const Eigen::Vector2d px = camera.project(X_W);
-      const double reach = 0.87 * voxel_m * focal / depth + 1.5;  // a voxel's half diagonal
+      // The voxel and its neighbours (whose corners it touches): two and a half voxels.
+      const double reach = 2.6 * voxel_m * focal / depth + 1.5;
       const int u0 = std::max(0, static_cast<int>(std::floor(px.x() - reach)));
       const int u1 = std::min(mask.cols - 1, static_cast<int>(std::ceil(px.x() + reach)));
       const int v0 = std::max(0, static_cast<int>(std::floor(px.y() - reach)));
