@@ -159,6 +159,10 @@ int runHull(const std::vector<std::string>& args) {
                    "write shaded renderings of the mesh (with --refine-with-matches also those of "
                    "the silhouettes' hull, as PNG with _before before the extension)");
   addRefineOptions(&parser);
+  parser.addOption("holdout-view", "NAME",
+                   "build everything without this view, render the model coloured by the others "
+                   "into it, and report the colour error against its photograph inside its "
+                   "silhouette, for the silhouettes' hull and for the refined model");
   parser.addFlag("json", "print the result as one JSON object");
   parser.addFlag("allow-poor",
                  "warn instead of failing on a result that cannot be right (no faces, mean IoU "
@@ -168,7 +172,8 @@ int runHull(const std::vector<std::string>& args) {
   const HullConfig config = hullConfigFromArgs(parser);
   checkRefineOptions(parser);
   PoorResults poor(parser.flag("allow-poor"));
-  const HullInput input = runLengthViewSetFromArgs(parser);
+  HullInput input = runLengthViewSetFromArgs(parser);
+  const std::optional<HeldOutView> held_out = holdOutView(parser, &input);
   for (const std::string& warning :
        runLengthSilhouetteWarnings(input.names, input.run_length_masks))
     poor.warn(warning);
@@ -179,8 +184,17 @@ int runHull(const std::vector<std::string>& args) {
       parser.has("out-render")) {
     writeRender(beforePath(parser.get("out-render")), result.mesh);
   }
+  nlohmann::json holdout;
+  const int threads = result.hull.config().threads;
+  if (held_out)
+    holdout = {{"name", held_out->name},
+               {"hull", heldOutError(parser, input, *held_out, result.mesh, threads)}};
   nlohmann::json refined = refineWithMatches(parser, input, &result);
   refined.update(colourMesh(parser, input, &result));
+  if (held_out) {
+    holdout["refined"] = heldOutError(parser, input, *held_out, result.mesh, threads);
+    refined["holdout_view"] = holdout;
+  }
   const double hull_peak_mib = peakMemoryMiB();
   const std::unique_ptr<octomap::OcTree> octree = toOctomap(result.hull);
   const ReprojectionIoU iou = reprojectionIoU(result.mesh, result.hull.views());

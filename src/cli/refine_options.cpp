@@ -4,6 +4,7 @@
 
 #include "refine_options.h"
 
+#include <algorithm>
 #include <chrono>
 #include <memory>
 #include <optional>
@@ -327,6 +328,38 @@ nlohmann::json colourMesh(const ArgParser& parser, const HullInput& input, HullR
            {{"coloured_vertices", colouring.coloured_vertices},
             {"unseen_vertices", colouring.unseen_vertices},
             {"time_ms", millisecondsSince(start)}}}};
+}
+
+std::optional<HeldOutView> holdOutView(const ArgParser& parser, HullInput* input) {
+  if (!parser.has("holdout-view")) return std::nullopt;
+  if (!parser.has("images")) throw UsageError("--holdout-view needs --images");
+  const std::string name = parser.get("holdout-view");
+  const auto found = std::find(input->names.begin(), input->names.end(), name);
+  if (found == input->names.end()) {
+    throw UsageError("--holdout-view " + name + " is not one of the views");
+  }
+  const size_t index = static_cast<size_t>(found - input->names.begin());
+  HeldOutView view{
+      name, input->cameras.at(index),
+      input->masks.empty() ? input->run_length_masks.at(index).decode() : input->masks.at(index)};
+  input->names.erase(input->names.begin() + index);
+  input->cameras.erase(input->cameras.begin() + index);
+  if (input->masks.empty()) {
+    input->run_length_masks.erase(input->run_length_masks.begin() + index);
+  } else {
+    input->masks.erase(input->masks.begin() + index);
+  }
+  return view;
+}
+
+nlohmann::json heldOutError(const ArgParser& parser, const HullInput& input,
+                            const HeldOutView& view, TriangleMesh mesh, int threads) {
+  const RefineViews views = refineViews(parser.get("images"), input);
+  sift_hull::colourMesh(&mesh, views.cameras, views.image, threads);
+  const cv::Mat photo = readImage(parser.get("images") + "/" + view.name);
+  const ColourError error =
+      colourError(renderColouredMesh(mesh, view.camera, photo.size()), photo, view.mask);
+  return {{"mae", error.mae}, {"psnr_db", error.psnr_db}};
 }
 
 }  // namespace cli

@@ -1,6 +1,8 @@
 #pragma once
 
 #include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
 
 #include "args.h"
 #include "sift_hull/hull/hull_pipeline.h"
@@ -28,6 +30,22 @@ nlohmann::json refineWithMatches(const ArgParser& parser, const HullInput& input
 /// (sift_hull::colourMesh). Returns its part of `hull --json` ("mesh_colours"), an empty object
 /// otherwise.
 nlohmann::json colourMesh(const ArgParser& parser, const HullInput& input, HullResult* result);
+
+/// The view --holdout-view names, taken out of the views the hull is built from.
+struct HeldOutView {
+  std::string name;
+  PinholeCamera camera;
+  cv::Mat mask;  ///< CV_8UC1
+};
+
+/// With --holdout-view NAME: that view, removed from *input; throws UsageError without --images
+/// or for a name that is not one of the views.
+std::optional<HeldOutView> holdOutView(const ArgParser& parser, HullInput* input);
+
+/// `mesh` coloured by the views of `input` and rendered into the held-out view: its colour error
+/// against the photograph inside the view's silhouette ({"mae", "psnr_db"}).
+nlohmann::json heldOutError(const ArgParser& parser, const HullInput& input,
+                            const HeldOutView& view, TriangleMesh mesh, int threads);
 
 }  // namespace cli
 }  // namespace sift_hull

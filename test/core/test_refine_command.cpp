@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <iostream>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -107,6 +108,29 @@ TEST(RefineCommand, PhotoCarvingCarvesAndReportsItsStages) {
       << out;
   EXPECT_LE(j["false_carved_fraction"].get<double>(), 0.005) << out;
   EXPECT_TRUE(j["mesh"]["watertight"].get<bool>()) << out;
+}
+
+TEST(RefineCommand, AHeldOutViewMeasuresTheColoursOfTheHullAndOfTheRefinedModel) {
+  const std::string& s = cupScene();
+  const std::string hull = "hull --calib " + s + "/scene_par.txt --images " + s +
+                           " --silhouettes " + s + "/masks --max-depth 6 --json ";
+  std::string out, err;
+  EXPECT_EQ(test::runProgram(hull + "--holdout-view nothing.png", &out, &err), 2);
+  EXPECT_NE(err.find("--holdout-view nothing.png is not one of the views"), std::string::npos)
+      << err;
+  ASSERT_EQ(test::runProgram(hull + "--photo-carve --holdout-view view_0007.png", &out, &err), 0)
+      << err;
+  const nlohmann::json j = nlohmann::json::parse(out);
+  const nlohmann::json& held = j["holdout_view"];
+  EXPECT_EQ(held["name"], "view_0007.png");
+  EXPECT_EQ(j["views"].get<int>(), 19) << "the held-out view was carved";
+  std::cout << held.dump() << '\n';
+  // Measured: 10.3 and 10.0 grey levels, 23.5 and 23.6 dB.
+  for (const char* model : {"hull", "refined"}) {
+    EXPECT_GT(held[model]["psnr_db"].get<double>(), 20.0) << out;
+    EXPECT_LT(held[model]["mae"].get<double>(), 15.0) << out;
+  }
+  EXPECT_LT(held["refined"]["mae"].get<double>(), held["hull"]["mae"].get<double>()) << out;
 }
 
 TEST(RefineCommand, AGroundTruthOfAnotherSceneIsRefusedNamingBoth) {

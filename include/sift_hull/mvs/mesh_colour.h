@@ -25,4 +25,23 @@ struct MeshColouring {
 MeshColouring colourMesh(TriangleMesh* mesh, const std::vector<PinholeCamera>& cameras,
                          const std::function<cv::Mat(uint32_t)>& image, int threads);
 
+/// A coloured mesh as `camera` sees it in an image of `size` (raw pixels): each pixel the colour
+/// of the nearest triangle there, its vertices' colours interpolated.
+struct MeshRendering {
+  cv::Mat bgr;      ///< CV_8UC3, black where no triangle is
+  cv::Mat covered;  ///< CV_8UC1, 255 where a triangle is
+};
+/// Throws std::invalid_argument for a mesh without one colour per vertex.
+MeshRendering renderColouredMesh(const TriangleMesh& mesh, const PinholeCamera& camera,
+                                 cv::Size size);
+
+/// A rendering against a photograph inside a silhouette: the mean absolute error over the three
+/// channels (grey levels) and the PSNR (dB, of the mean squared error); pixels the mesh does not
+/// cover count as black. Throws std::invalid_argument for sizes that differ or an empty mask.
+struct ColourError {
+  double mae = 0.0, psnr_db = 0.0;
+  size_t pixels = 0;
+};
+ColourError colourError(const MeshRendering& rendering, const cv::Mat& photo, const cv::Mat& mask);
+
 }  // namespace sift_hull

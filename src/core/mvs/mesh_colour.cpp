@@ -17,18 +17,25 @@
 namespace sift_hull {
 namespace {
 
-/// The mesh's depth in a view at `scale` of its raw pixels (u' = scale (u + 0.5) - 0.5), +inf
-/// where no triangle covers a pixel.
-cv::Mat zBuffer(const TriangleMesh& mesh, const PinholeCamera& camera, cv::Size size,
-                double scale) {
-  cv::Mat depth(size, CV_32FC1, cv::Scalar(std::numeric_limits<float>::infinity()));
-  std::vector<Eigen::Vector3d> projected(mesh.vertices_W.size());  // u', v', depth
+/// Each vertex in a view at `scale` of its raw pixels (u' = scale (u + 0.5) - 0.5): u', v', depth.
+std::vector<Eigen::Vector3d> projectVertices(const TriangleMesh& mesh, const PinholeCamera& camera,
+                                             double scale) {
+  std::vector<Eigen::Vector3d> projected(mesh.vertices_W.size());
   for (size_t v = 0; v < mesh.vertices_W.size(); ++v) {
     const Eigen::Vector3d X = mesh.vertices_W[v].cast<double>();
     const Eigen::Vector2d px = camera.project(X);
     projected[v] = {scale * (px.x() + 0.5) - 0.5, scale * (px.y() + 0.5) - 0.5, camera.depth(X)};
   }
-  for (const Eigen::Vector3i& face : mesh.faces) {
+  return projected;
+}
+
+/// Calls visit(face index, u, v, barycentric weights, depth) for every pixel centre of `size`
+/// inside a triangle in front of the camera.
+template <typename Visit>
+void rasterise(const TriangleMesh& mesh, const std::vector<Eigen::Vector3d>& projected,
+               cv::Size size, const Visit& visit) {
+  for (size_t f = 0; f < mesh.faces.size(); ++f) {
+    const Eigen::Vector3i& face = mesh.faces[f];
     const Eigen::Vector3d &a = projected[face[0]], &b = projected[face[1]], &c = projected[face[2]];
     if (!(a.z() > 0.0 && b.z() > 0.0 && c.z() > 0.0) || !a.allFinite() || !b.allFinite() ||
         !c.allFinite()) {
@@ -43,18 +50,26 @@ cv::Mat zBuffer(const TriangleMesh& mesh, const PinholeCamera& camera, cv::Size 
     const int v1 =
         std::min(size.height - 1, static_cast<int>(std::floor(std::max({a.y(), b.y(), c.y()}))));
     for (int v = v0; v <= v1; ++v) {
-      float* row = depth.ptr<float>(v);
       for (int u = u0; u <= u1; ++u) {
-        // Barycentric weights of pixel (u, v); inside when all three are >= 0.
         const double wa = ((b.x() - u) * (c.y() - v) - (c.x() - u) * (b.y() - v)) / area;
         const double wb = ((c.x() - u) * (a.y() - v) - (a.x() - u) * (c.y() - v)) / area;
         const double wc = 1.0 - wa - wb;
         if (wa < 0.0 || wb < 0.0 || wc < 0.0) continue;
-        const float z = static_cast<float>(wa * a.z() + wb * b.z() + wc * c.z());
-        if (z < row[u]) row[u] = z;
+        visit(f, u, v, Eigen::Vector3d(wa, wb, wc), wa * a.z() + wb * b.z() + wc * c.z());
       }
     }
   }
+}
+
+/// The mesh's depth in a view at `scale` of its raw pixels, +inf where no triangle covers a pixel.
+cv::Mat zBuffer(const TriangleMesh& mesh, const PinholeCamera& camera, cv::Size size,
+                double scale) {
+  cv::Mat depth(size, CV_32FC1, cv::Scalar(std::numeric_limits<float>::infinity()));
+  rasterise(mesh, projectVertices(mesh, camera, scale), size,
+            [&](size_t, int u, int v, const Eigen::Vector3d&, double z) {
+              float& nearest = depth.at<float>(v, u);
+              nearest = std::min(nearest, static_cast<float>(z));
+            });
   return depth;
 }
 
@@ -183,6 +198,61 @@ MeshColouring colourMesh(TriangleMesh* mesh, const std::vector<PinholeCamera>& c
     ++(seen ? result.coloured_vertices : result.unseen_vertices);
   }
   return result;
+}
+
+MeshRendering renderColouredMesh(const TriangleMesh& mesh, const PinholeCamera& camera,
+                                 cv::Size size) {
+  if (mesh.colours_rgb.size() != mesh.vertices_W.size()) {
+    throw std::invalid_argument("rendering the mesh's colours: it has " +
+                                std::to_string(mesh.colours_rgb.size()) + " colours for " +
+                                std::to_string(mesh.vertices_W.size()) + " vertices");
+  }
+  MeshRendering rendering;
+  rendering.bgr = cv::Mat(size, CV_8UC3, cv::Scalar::all(0));
+  rendering.covered = cv::Mat(size, CV_8UC1, cv::Scalar(0));
+  cv::Mat depth(size, CV_32FC1, cv::Scalar(std::numeric_limits<float>::infinity()));
+  rasterise(mesh, projectVertices(mesh, camera, 1.0), size,
+            [&](size_t f, int u, int v, const Eigen::Vector3d& w, double z) {
+              float& nearest = depth.at<float>(v, u);
+              if (!(z < nearest)) return;
+              nearest = static_cast<float>(z);
+              const Eigen::Vector3i& face = mesh.faces[f];
+              cv::Vec3b& pixel = rendering.bgr.at<cv::Vec3b>(v, u);
+              for (int c = 0; c < 3; ++c) {
+                const double value = w[0] * mesh.colours_rgb[face[0]][c] +
+                                     w[1] * mesh.colours_rgb[face[1]][c] +
+                                     w[2] * mesh.colours_rgb[face[2]][c];
+                pixel[2 - c] = cv::saturate_cast<uint8_t>(value);
+              }
+              rendering.covered.at<uint8_t>(v, u) = 255;
+            });
+  return rendering;
+}
+
+ColourError colourError(const MeshRendering& rendering, const cv::Mat& photo, const cv::Mat& mask) {
+  const cv::Mat bgr = bgrOf(photo);
+  if (bgr.size() != rendering.bgr.size() || mask.size() != bgr.size() || mask.type() != CV_8UC1) {
+    throw std::invalid_argument("colour error: the rendering, photograph and mask differ in size");
+  }
+  ColourError error;
+  double absolute = 0.0, squared = 0.0;
+  for (int v = 0; v < bgr.rows; ++v) {
+    for (int u = 0; u < bgr.cols; ++u) {
+      if (!mask.at<uint8_t>(v, u)) continue;
+      const cv::Vec3b a = rendering.bgr.at<cv::Vec3b>(v, u), b = bgr.at<cv::Vec3b>(v, u);
+      for (int c = 0; c < 3; ++c) {
+        const double d = static_cast<double>(a[c]) - b[c];
+        absolute += std::abs(d);
+        squared += d * d;
+      }
+      ++error.pixels;
+    }
+  }
+  if (error.pixels == 0) throw std::invalid_argument("colour error: the silhouette is empty");
+  error.mae = absolute / (3.0 * error.pixels);
+  const double mse = squared / (3.0 * error.pixels);
+  error.psnr_db = mse > 0.0 ? 10.0 * std::log10(255.0 * 255.0 / mse) : 99.0;
+  return error;
 }
 
 }  // namespace sift_hull
