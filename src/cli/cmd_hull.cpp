@@ -16,6 +16,7 @@
 #include "sift_hull/hull/hull_pipeline.h"
 #include "sift_hull/hull/silhouette.h"
 #include "sift_hull/io/ply.h"
+#include "sift_hull/mvs/mesh_colour.h"
 
 namespace sift_hull {
 namespace cli {
@@ -41,6 +42,9 @@ void writeOutputs(const ArgParser& parser, const HullResult& result,
                   const octomap::OcTree& octree) {
   if (parser.has("out-mesh")) writePly(parser.get("out-mesh"), result.mesh);
   if (parser.has("out-octree")) writeOctomap(octree, parser.get("out-octree"), result.box);
+  if (parser.has("out-color-octree")) {
+    writeColourOctomap(*colourOctomap(octree, result.mesh), parser.get("out-color-octree"));
+  }
   if (parser.has("out-render")) writeRender(parser.get("out-render"), result.mesh);
 }
 
@@ -159,6 +163,9 @@ int runHull(const std::vector<std::string>& args) {
                    "write shaded renderings of the mesh (with --refine-with-matches also those of "
                    "the silhouettes' hull, as PNG with _before before the extension)");
   addRefineOptions(&parser);
+  parser.addOption("out-color-octree", "OT",
+                   "write the octree as OctoMap's ColorOcTree (.ot), its surface voxels coloured "
+                   "by the views (needs --images)");
   parser.addOption("holdout-view", "NAME",
                    "build everything without this view, render the model coloured by the others "
                    "into it, and report the colour error against its photograph inside its "
@@ -171,6 +178,9 @@ int runHull(const std::vector<std::string>& args) {
 
   const HullConfig config = hullConfigFromArgs(parser);
   checkRefineOptions(parser);
+  if (parser.has("out-color-octree") && !parser.has("images")) {
+    throw UsageError("--out-color-octree needs --images");
+  }
   PoorResults poor(parser.flag("allow-poor"));
   HullInput input = runLengthViewSetFromArgs(parser);
   const std::optional<HeldOutView> held_out = holdOutView(parser, &input);

@@ -319,7 +319,9 @@ nlohmann::json refineWithMatches(const ArgParser& parser, const HullInput& input
 }
 
 nlohmann::json colourMesh(const ArgParser& parser, const HullInput& input, HullResult* result) {
-  if (!parser.has("out-mesh") || !parser.has("images")) return nlohmann::json::object();
+  if (!(parser.has("out-mesh") || parser.has("out-color-octree")) || !parser.has("images")) {
+    return nlohmann::json::object();
+  }
   const auto start = std::chrono::steady_clock::now();
   const RefineViews views = refineViews(parser.get("images"), input);
   const MeshColouring colouring = sift_hull::colourMesh(&result->mesh, views.cameras, views.image,

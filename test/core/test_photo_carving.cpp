@@ -3,14 +3,17 @@
 // the cavities without carving the true solid or a silhouette pixel.
 
 #include <gtest/gtest.h>
+#include <octomap/AbstractOcTree.h>
 
 #include <algorithm>
 #include <cmath>
 #include <iostream>
+#include <memory>
 #include <vector>
 
 #include "concave_scene.h"
 #include "sift_hull/eval/hull_evaluation.h"
+#include "sift_hull/hull/hull_octomap.h"
 #include "sift_hull/mvs/mesh_colour.h"
 #include "sift_hull/mvs/photo_carving.h"
 
@@ -149,6 +152,37 @@ TEST(MeshColour, AHeldOutViewSeesTheColoursTheOtherViewsGave) {
   std::cout << compared << " vertices compared: mean error " << error / (3 * compared)
             << " grey levels, a grey mesh's " << grey_error / (3 * compared) << '\n';
   EXPECT_LT(error, 0.2 * grey_error);  // measured: a tenth
+}
+
+TEST(MeshColour, TheColourOctreeHasTheHullsNodesAndTheMeshsColours) {
+  const ConcaveScene scene("cup", 6);
+  TriangleMesh mesh = scene.hull.hull.mesh();
+  const std::unique_ptr<octomap::OcTree> tree = toOctomap(scene.hull.hull);
+  EXPECT_THROW(colourOctomap(*tree, mesh), std::invalid_argument);  // no colours yet
+  colourMesh(
+      &mesh, camerasOf(scene.views), [&](uint32_t v) { return scene.views.at(v).image; }, 2);
+  const std::string path = ::testing::TempDir() + "/cup_colours.ot";
+  writeColourOctomap(*colourOctomap(*tree, mesh), path);
+  std::unique_ptr<octomap::AbstractOcTree> read(octomap::AbstractOcTree::read(path));
+  auto* coloured = dynamic_cast<octomap::ColorOcTree*>(read.get());
+  ASSERT_NE(coloured, nullptr) << path << " is not a ColorOcTree";
+  EXPECT_EQ(coloured->getResolution(), tree->getResolution());
+  size_t occupied = 0, finest = 0, tinted = 0;
+  for (auto leaf = tree->begin_leafs(); leaf != tree->end_leafs(); ++leaf) {
+    occupied += tree->isNodeOccupied(*leaf);
+  }
+  size_t occupied_read = 0;
+  for (auto leaf = coloured->begin_leafs(); leaf != coloured->end_leafs(); ++leaf) {
+    if (!coloured->isNodeOccupied(*leaf)) continue;
+    ++occupied_read;
+    if (leaf.getDepth() != coloured->getTreeDepth()) continue;
+    ++finest;
+    const octomap::ColorOcTreeNode::Color c = leaf->getColor();
+    tinted += !(c.r == 255 && c.g == 255 && c.b == 255);
+  }
+  EXPECT_EQ(occupied_read, occupied);
+  ASSERT_GT(finest, 0u);
+  EXPECT_GT(tinted, finest * 9 / 10) << tinted << " of " << finest << " surface voxels coloured";
 }
 
 TEST(PhotoCarving, RefusesBadSettingsAndViews) {

@@ -85,6 +85,10 @@ TEST(RefineCommand, PhotoCarvingCarvesAndReportsItsStages) {
   std::string out, err;
   EXPECT_EQ(test::runProgram(hull, &out, &err), 2);
   EXPECT_NE(err.find("--photo-carve needs --images"), std::string::npos) << err;
+  const std::string no_images = "hull --calib " + s + "/scene_par.txt --silhouettes " + s +
+                                "/masks --max-depth 5 --out-color-octree x.ot";
+  EXPECT_EQ(test::runProgram(no_images, &out, &err), 2);
+  EXPECT_NE(err.find("--out-color-octree needs --images"), std::string::npos) << err;
   EXPECT_EQ(test::runProgram(hull + "--images " + s + " --photo-min-views 0", &out, &err), 2);
   EXPECT_NE(err.find("photo-min-views"), std::string::npos) << err;
   ASSERT_EQ(test::runProgram(hull + "--images " + s + " --photo-image-scale 1 --gt-scene " + s,

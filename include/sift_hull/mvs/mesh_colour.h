@@ -1,8 +1,13 @@
 #pragma once
 
+#include <octomap/ColorOcTree.h>
+#include <octomap/OcTree.h>
+
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <opencv2/core.hpp>
+#include <string>
 #include <vector>
 
 #include "sift_hull/geometry/camera.h"
@@ -43,5 +48,17 @@ struct ColourError {
   size_t pixels = 0;
 };
 ColourError colourError(const MeshRendering& rendering, const cv::Mat& photo, const cv::Mat& mask);
+
+/// `tree` as OctoMap's ColorOcTree (octovis and rviz's octomap plugin show its colours): the same
+/// nodes and occupancy, each occupied leaf of the finest level coloured by the mean colour of the
+/// coloured mesh's vertices in it and the 26 voxels around it (coarser occupied leaves, the
+/// inside, stay white). Throws std::invalid_argument for a mesh without one colour per vertex.
+std::unique_ptr<octomap::ColorOcTree> colourOctomap(const octomap::OcTree& tree,
+                                                    const TriangleMesh& mesh);
+
+/// Writes OctoMap's .ot file of `tree` with its resolution exact to the double (OctoMap's own
+/// write keeps the stream's six digits, which moves the voxel grid). Throws std::runtime_error
+/// naming the path on failure.
+void writeColourOctomap(const octomap::ColorOcTree& tree, const std::string& path);
 
 }  // namespace sift_hull

@@ -8,9 +8,13 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <fstream>
+#include <iomanip>
 #include <limits>
+#include <sstream>
 #include <stdexcept>
 #include <string>
+#include <unordered_map>
 
 #include "common/parallel.h"
 
@@ -253,6 +257,62 @@ ColourError colourError(const MeshRendering& rendering, const cv::Mat& photo, co
   const double mse = squared / (3.0 * error.pixels);
   error.psnr_db = mse > 0.0 ? 10.0 * std::log10(255.0 * 255.0 / mse) : 99.0;
   return error;
+}
+
+std::unique_ptr<octomap::ColorOcTree> colourOctomap(const octomap::OcTree& tree,
+                                                    const TriangleMesh& mesh) {
+  if (mesh.colours_rgb.size() != mesh.vertices_W.size()) {
+    throw std::invalid_argument("colouring the octree: the mesh has " +
+                                std::to_string(mesh.colours_rgb.size()) + " colours for " +
+                                std::to_string(mesh.vertices_W.size()) + " vertices");
+  }
+  auto coloured = std::make_unique<octomap::ColorOcTree>(tree.getResolution());
+  coloured->setClampingThresMax(tree.getClampingThresMax());
+  coloured->setClampingThresMin(tree.getClampingThresMin());
+  coloured->setProbHit(tree.getProbHit());
+  coloured->setProbMiss(tree.getProbMiss());
+  coloured->setOccupancyThres(tree.getOccupancyThres());
+  std::stringstream stream;
+  tree.writeBinaryData(stream);
+  coloured->readBinaryData(stream);
+  // The vertices' colours summed per finest voxel.
+  std::unordered_map<octomap::OcTreeKey, std::array<double, 4>, octomap::OcTreeKey::KeyHash> sums;
+  for (size_t v = 0; v < mesh.vertices_W.size(); ++v) {
+    octomap::OcTreeKey key;
+    const Eigen::Vector3f& X = mesh.vertices_W[v];
+    if (!coloured->coordToKeyChecked(X.x(), X.y(), X.z(), key)) continue;
+    std::array<double, 4>& sum = sums[key];
+    for (int c = 0; c < 3; ++c) sum[c] += mesh.colours_rgb[v][c];
+    sum[3] += 1.0;
+  }
+  const unsigned finest = coloured->getTreeDepth();
+  for (auto leaf = coloured->begin_leafs(); leaf != coloured->end_leafs(); ++leaf) {
+    if (leaf.getDepth() != finest || !coloured->isNodeOccupied(*leaf)) continue;
+    const octomap::OcTreeKey key = leaf.getKey();
+    std::array<double, 4> total = {0.0, 0.0, 0.0, 0.0};
+    for (int n = 0; n < 27; ++n) {
+      octomap::OcTreeKey around = key;
+      around[0] = static_cast<octomap::key_type>(around[0] + n % 3 - 1);
+      around[1] = static_cast<octomap::key_type>(around[1] + n / 3 % 3 - 1);
+      around[2] = static_cast<octomap::key_type>(around[2] + n / 9 - 1);
+      const auto found = sums.find(around);
+      if (found == sums.end()) continue;
+      for (int c = 0; c < 4; ++c) total[c] += found->second[c];
+    }
+    if (total[3] == 0.0) continue;
+    leaf->setColor(static_cast<uint8_t>(std::lround(total[0] / total[3])),
+                   static_cast<uint8_t>(std::lround(total[1] / total[3])),
+                   static_cast<uint8_t>(std::lround(total[2] / total[3])));
+  }
+  return coloured;
+}
+
+void writeColourOctomap(const octomap::ColorOcTree& tree, const std::string& path) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out << std::setprecision(std::numeric_limits<double>::max_digits10);
+  if (!out || !tree.write(out) || !out.flush()) {
+    throw std::runtime_error(path + ": cannot write the colour octree");
+  }
 }
 
 }  // namespace sift_hull
