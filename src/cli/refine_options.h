@@ -26,9 +26,9 @@ void checkRefineOptions(const ArgParser& parser);
 nlohmann::json refineWithMatches(const ArgParser& parser, const HullInput& input,
                                  HullResult* result);
 
-/// With --out-mesh or --out-color-octree, and --images: each vertex of result->mesh coloured by the views that see it
-/// (sift_hull::colourMesh). Returns its part of `hull --json` ("mesh_colours"), an empty object
-/// otherwise.
+/// With --out-mesh or --out-color-octree, and --images: each vertex of result->mesh coloured by the
+/// views that see it (sift_hull::colourMesh). Returns its part of `hull --json` ("mesh_colours"),
+/// an empty object otherwise.
 nlohmann::json colourMesh(const ArgParser& parser, const HullInput& input, HullResult* result);
 
 /// The view --holdout-view names, taken out of the views the hull is built from.
