@@ -13,6 +13,7 @@
 #include <std_srvs/Empty.h>
 #include <tf2_ros/static_transform_broadcaster.h>
 
+#include <atomic>
 #include <cmath>
 #include <functional>
 #include <mutex>
@@ -71,6 +72,13 @@ class HullNodeTest : public ::testing::Test {
       return silhouette_pub_.getNumSubscribers() > 0 && info_pub_.getNumSubscribers() > 0;
     })) << "the hull node did not subscribe";
     resetHull();  // each case starts from no hull, whatever ran before it
+    // The node's log reaches this test only once its /rosout link to the test is up, which can
+    // be after the first errors of a case: until the line of a reset arrives, reset again.
+    ASSERT_TRUE(waitFor([&] {
+      std_srvs::Empty again;
+      ros::service::call("/hull/reset", again);
+      return waitFor([&] { return heard_reset_.load(); }, 0.2);
+    })) << "no line of the hull node reached this test on /rosout";
   }
 
   /// Calls ~reset and waits for the empty map it publishes.
@@ -125,6 +133,7 @@ class HullNodeTest : public ::testing::Test {
   }
 
   void onLog(const rosgraph_msgs::LogConstPtr& log) {
+    if (log->msg.rfind("hull: reset", 0) == 0) heard_reset_ = true;
     std::lock_guard<std::mutex> lock(errors_mutex_);
     if (log->level == rosgraph_msgs::Log::ERROR) errors_.push_back(log->msg);
   }
@@ -136,7 +145,8 @@ class HullNodeTest : public ::testing::Test {
   ros::Publisher silhouette_pub_, info_pub_;
   ros::Subscriber octomap_sub_, cloud_sub_, rosout_sub_;
   std::mutex errors_mutex_;
-  std::vector<std::string> errors_;  ///< the errors on /rosout since SetUp
+  std::vector<std::string> errors_;       ///< the errors on /rosout since SetUp
+  std::atomic<bool> heard_reset_{false};  ///< a reset's line arrived on /rosout
   std::vector<RenderedView> views_;
   sift_hull::OctomapConstPtr last_octomap_;
   sensor_msgs::PointCloud2ConstPtr last_cloud_;
