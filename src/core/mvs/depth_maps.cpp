@@ -321,10 +321,7 @@ cv::Mat consistentDepth(const std::vector<ViewDepth>& depths, uint32_t view,
 std::vector<HullCell> occupiedLeaves(const VisualHull& hull) {
   std::vector<HullCell> leaves;
   hull.forEachLeaf([&](const HullCell& cell) {
-    if (cell.state == CellState::kIn ||
-        (cell.state == CellState::kSurface && cell.centre_value <= 0.0f)) {
-      leaves.push_back(cell);
-    }
+    if (isOccupied(cell)) leaves.push_back(cell);
   });
   return leaves;
 }

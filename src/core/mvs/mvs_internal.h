@@ -53,7 +53,19 @@ void sweepDepth(const std::vector<ReducedView>& views, uint32_t view,
 cv::Mat consistentDepth(const std::vector<ViewDepth>& depths, uint32_t view,
                         const PhotoCarveConfig& config, double voxel_m);
 
-/// The occupied leaves of the hull: in cells, and surface cells whose centre is inside.
+/// Whether a leaf is occupied: an in cell, or a surface cell whose centre is inside (as
+/// HullStats::occupied_volume_m3 counts them).
+inline bool isOccupied(const HullCell& cell) {
+  return cell.state == CellState::kIn ||
+         (cell.state == CellState::kSurface && cell.centre_value <= 0.0f);
+}
+
+/// The centre of a finest voxel (indices in the cube), metres.
+inline Eigen::Vector3d voxelCentre(const HullCube& cube, const Eigen::Vector3i& voxel) {
+  return cube.origin_W() + (voxel.cast<double>().array() + 0.5).matrix() * cube.resolution_m;
+}
+
+/// The occupied leaves of the hull (isOccupied).
 std::vector<HullCell> occupiedLeaves(const VisualHull& hull);
 
 }  // namespace detail

@@ -157,14 +157,12 @@ uint64_t neededOnRay(const VisualHull& hull, const Eigen::Vector3d& origin_W,
     const Eigen::Vector3d X = origin_W + direction * t;
     const Eigen::Vector3i voxel =
         ((X - lo) / voxel_m).array().floor().cast<int>().max(0).min(cells - 1).matrix();
-    const HullCell cell = hull.leafAt(lo + (voxel.cast<double>().array() + 0.5).matrix() * voxel_m);
+    const HullCell cell = hull.leafAt(detail::voxelCentre(cube, voxel));
     const int edge = 1 << (cube.depth - cell.depth);
     const Eigen::Vector3d cell_lo = lo + (cell.index * edge).cast<double>() * voxel_m;
     const double exit = std::min(t1, exitOf(origin_W, direction, cell_lo,
                                             cell_lo + Eigen::Vector3d::Constant(edge * voxel_m)));
-    const bool occupied = cell.state == CellState::kIn ||
-                          (cell.state == CellState::kSurface && cell.centre_value <= 0.0f);
-    if (occupied) {
+    if (detail::isOccupied(cell)) {
       // Voxel by voxel through the leaf: one that is not free covers the pixel.
       Eigen::Vector3i at = voxel;
       Eigen::Vector3i step;
@@ -274,9 +272,7 @@ PhotoCarveResult photoCarve(const VisualHull& hull, const PhotoViews& views,
     for (int n = 0; n < edge * edge * edge; ++n) {
       const Eigen::Vector3i voxel =
           cell.index * edge + Eigen::Vector3i(n % edge, n / edge % edge, n / edge / edge);
-      const Eigen::Vector3d X_W =
-          cube.origin_W() + (voxel.cast<double>().array() + 0.5).matrix() * voxel_m;
-      const Votes votes = votesAt(X_W, result.depths, margin_m);
+      const Votes votes = votesAt(detail::voxelCentre(cube, voxel), result.depths, margin_m);
       if (votes.empty >= config.photo_min_views && votes.empty > votes.surface) {
         found.emplace_back(voxel, votes.empty);
       }
@@ -297,9 +293,7 @@ PhotoCarveResult photoCarve(const VisualHull& hull, const PhotoViews& views,
     cv::Mat at_risk(mask.size(), CV_8UC1, cv::Scalar(0));
     const double focal = std::max(camera.K()(0, 0), camera.K()(1, 1));
     for (const auto& [key, votes] : free_votes) {
-      const Eigen::Vector3d X_W =
-          cube.origin_W() +
-          (detail::voxelOfKey(key).cast<double>().array() + 0.5).matrix() * voxel_m;
+      const Eigen::Vector3d X_W = detail::voxelCentre(cube, detail::voxelOfKey(key));
       const double depth = camera.depth(X_W);
       if (!(depth > 0.0)) continue;
       const Eigen::Vector2d px = camera.project(X_W);
