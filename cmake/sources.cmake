@@ -52,6 +52,7 @@ set(SIFT_HULL_CORE_SOURCES
   src/core/mvs/depth_maps.cpp
   src/core/mvs/mesh_colour.cpp
   src/core/mvs/photo_carving.cpp
+  src/core/mvs/photo_stream.cpp
   src/core/refine/dense_matching.cpp
   src/core/refine/free_space.cpp
   src/core/refine/point_carved_stream.cpp

@@ -75,6 +75,9 @@ class VisualHull {
   VisualHull& operator=(VisualHull&&) noexcept;
   VisualHull(const VisualHull&) = delete;
   VisualHull& operator=(const VisualHull&) = delete;
+  /// A deep copy (the tree, the free voxels; the views' images are shared, never changed), for
+  /// work on the hull as it is now while this one goes on carving.
+  VisualHull clone() const;
 
   /// Carves with more views. Before any view the whole cube is one in cell. Throws
   /// std::invalid_argument, before carving with any of them, when a view's camera is too far
@@ -128,6 +131,9 @@ class VisualHull {
   TriangleMesh mesh() const;
 
  private:
+  struct CloneTag {};
+  VisualHull(const VisualHull& other, CloneTag);
+
   HullCube cube_;
   HullConfig config_;
   /// The views' local frame (HullView::useFrame): the cube's centre, half its edge.

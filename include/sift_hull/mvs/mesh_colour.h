@@ -51,8 +51,9 @@ ColourError colourError(const MeshRendering& rendering, const cv::Mat& photo, co
 
 /// `tree` as OctoMap's ColorOcTree (octovis and rviz's octomap plugin show its colours): the same
 /// nodes and occupancy, each occupied leaf of the finest level coloured by the mean colour of the
-/// coloured mesh's vertices in it and the 26 voxels around it (coarser occupied leaves, the
-/// inside, stay white). Throws std::invalid_argument for a mesh without one colour per vertex.
+/// coloured mesh's vertices in it, or when none lies in it, of those in the 26 voxels around it
+/// (coarser occupied leaves, the inside, stay white). Throws std::invalid_argument for a mesh
+/// without one colour per vertex.
 std::unique_ptr<octomap::ColorOcTree> colourOctomap(const octomap::OcTree& tree,
                                                     const TriangleMesh& mesh);
 

@@ -80,6 +80,10 @@ class PointCarvedStream {
   /// finite with min <= max, or that touches more than kMaxClearedVoxels occupied voxels.
   size_t clearBox(const Box3d& box_W);
   static constexpr size_t kMaxClearedVoxels = size_t{1} << 20;
+  /// Free-space carving of the hull by voxels found elsewhere (photo carving:
+  /// VisualHull::carveFree); gone, as clearBox's, when the tree starts anew. Requires
+  /// stream().hasHull().
+  void carveFree(const std::vector<Eigen::Vector3i>& voxels);
 
   /// Whether refine() has work: a hull, and a refinement not done (refineFor), points that arrived
   /// since the last refinement, or a tree that started anew while points are kept.

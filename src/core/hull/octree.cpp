@@ -254,6 +254,29 @@ VisualHull::VisualHull(const Box3d& box, const HullConfig& config)
   validate(config);
 }
 
+namespace {
+void copyNode(const OctreeNode& from, OctreeNode* to) {
+  to->state = from.state;
+  to->centre_value = from.centre_value;
+  if (!from.children) return;
+  to->children = std::make_unique<OctreeNode[]>(8);
+  for (int c = 0; c < 8; ++c) copyNode(from.children[c], &to->children[c]);
+}
+}  // namespace
+
+VisualHull::VisualHull(const VisualHull& other, CloneTag)
+    : cube_(other.cube_),
+      config_(other.config_),
+      frame_origin_W_(other.frame_origin_W_),
+      frame_scale_(other.frame_scale_),
+      views_(other.views_),
+      root_(std::make_unique<OctreeNode>()),
+      free_(other.free_) {
+  copyNode(*other.root_, root_.get());
+}
+
+VisualHull VisualHull::clone() const { return VisualHull(*this, CloneTag{}); }
+
 VisualHull::~VisualHull() = default;
 VisualHull::VisualHull(VisualHull&&) noexcept = default;
 VisualHull& VisualHull::operator=(VisualHull&&) noexcept = default;
@@ -392,6 +415,5 @@ std::vector<VoxelBlock> occupiedBlocks(const VisualHull& hull) {
   });
   return blocks;
 }
-
 
 }  // namespace sift_hull

@@ -290,7 +290,9 @@ std::unique_ptr<octomap::ColorOcTree> colourOctomap(const octomap::OcTree& tree,
     if (leaf.getDepth() != finest || !coloured->isNodeOccupied(*leaf)) continue;
     const octomap::OcTreeKey key = leaf.getKey();
     std::array<double, 4> total = {0.0, 0.0, 0.0, 0.0};
-    for (int n = 0; n < 27; ++n) {
+    const auto own = sums.find(key);
+    if (own != sums.end()) total = own->second;  // its own vertices; else those around it
+    for (int n = 0; n < 27 && total[3] == 0.0; ++n) {
       octomap::OcTreeKey around = key;
       around[0] = static_cast<octomap::key_type>(around[0] + n % 3 - 1);
       around[1] = static_cast<octomap::key_type>(around[1] + n / 3 % 3 - 1);

@@ -129,6 +129,11 @@ size_t PointCarvedStream::dropFarPairs() {
   return before - pairs_.size();
 }
 
+void PointCarvedStream::carveFree(const std::vector<Eigen::Vector3i>& voxels) {
+  stream_.carveFree(voxels);
+  free_voxels_ = stream_.hull().freeVoxelCount();
+}
+
 size_t PointCarvedStream::clearBox(const Box3d& box_W) {
   if (!isValidClearBox(box_W)) {
     throw std::invalid_argument("a box to clear must be finite with min <= max on each axis");

@@ -11,6 +11,8 @@
 #include <visualization_msgs/MarkerArray.h>
 
 #include <Eigen/Geometry>
+#include <array>
+#include <cstdint>
 #include <limits>
 #include <memory>
 #include <opencv2/core.hpp>
@@ -30,8 +32,9 @@
 #include "sift_hull/refine/surface_points.h"
 
 namespace octomap {
+class ColorOcTree;
 class OcTree;
-}
+}  // namespace octomap
 
 namespace sift_hull {
 namespace ros_conversions {
@@ -137,6 +140,10 @@ sift_hull::Octomap octomapMessage(const CompactOctomap& map, const std_msgs::Hea
 /// "OcTree", resolution in metres, data as OcTree::writeData writes it, with each node's
 /// log-odds occupancy.
 sift_hull::Octomap octomapFullMessage(const octomap::OcTree& tree, const std_msgs::Header& header);
+/// The same for OctoMap's ColorOcTree: id "ColorOcTree", each node's colour after its occupancy
+/// (octomap_server's colour mode; rviz's octomap plugin shows the colours).
+sift_hull::Octomap octomapFullMessage(const octomap::ColorOcTree& tree,
+                                      const std_msgs::Header& header);
 
 /// The tree a binary or full Octomap message holds, read as octomap_msgs::msgToMap reads it
 /// (OcTree::readBinaryData or OcTree::readData); empty data is an empty tree. Throws
@@ -146,6 +153,12 @@ std::unique_ptr<octomap::OcTree> octreeFromMessage(const sift_hull::Octomap& mes
 
 /// Points (metres, in the header's frame) as an XYZ PointCloud2 (via pcl_conversions).
 sensor_msgs::PointCloud2 pointCloudMessage(const std::vector<Eigen::Vector3d>& points,
+                                           const std_msgs::Header& header);
+
+/// Coloured points as an XYZRGB PointCloud2 (PCL's PointXYZRGB: `rgb` a float holding 0x00RRGGBB),
+/// one colour (red, green, blue) per point; throws std::invalid_argument when the counts differ.
+sensor_msgs::PointCloud2 pointCloudMessage(const std::vector<Eigen::Vector3d>& points,
+                                           const std::vector<std::array<uint8_t, 3>>& colours_rgb,
                                            const std_msgs::Header& header);
 
 /// Occupied leaf centres of the tree, metres, as an XYZ PointCloud2 (via pcl_conversions).

@@ -8,6 +8,7 @@
 #include "lib/conversions.h"
 #include "lib/save_paths.h"
 #include "sift_hull/io/ply.h"
+#include "sift_hull/mvs/mesh_colour.h"
 
 namespace sift_hull {
 
@@ -47,9 +48,7 @@ void HullOutputs::advertise() {
   // No reallocation while a subscriber's connect callback reads an entry (nodelets spin while
   // this runs); such a callback sends nothing anyway until a hull is published.
   outputs_.reserve(8);
-  const auto centres = [this] {
-    return ros_conversions::pointCloudMessage(compact(true).occupied_centres_W, header_);
-  };
+  const auto centres = [this] { return centresCloud(); };
   const auto noCentres = [this] {
     return ros_conversions::occupiedCellsCloud(emptyTree(), header_);
   };
@@ -59,7 +58,7 @@ void HullOutputs::advertise() {
   add<sift_hull::Octomap>("octomap_binary", false, binary,
                           [this] { return ros_conversions::octomapMessage(emptyTree(), header_); });
   add<sift_hull::Octomap>(
-      "octomap_full", true, [this] { return octomapFullMessage(tree(), header_); },
+      "octomap_full", true, [this] { return fullMessage(); },
       [this] { return octomapFullMessage(emptyTree(), header_); });
   add<Cloud>("occupied_cells", true, centres, noCentres);
   outputs_.back().centres = true;
@@ -84,6 +83,7 @@ void HullOutputs::publish(ros::Time stamp, bool all) {
   tree_.reset();
   compact_.reset();
   mesh_.reset();
+  colour_tree_.reset();
   published_ = hull_->hasHull();
   if (published_) empty_resolution_m_ = hull_->hull().cube().resolution_m;
   const auto sent = [all](const Output& output) {
@@ -96,8 +96,7 @@ void HullOutputs::publish(ros::Time stamp, bool all) {
     binary = std::make_shared<sift_hull::Octomap>(
         ros_conversions::octomapMessage(compact(centres_wanted_), header_));
     if (keep_full_) {
-      full = std::make_shared<sift_hull::Octomap>(
-          ros_conversions::octomapFullMessage(tree(), header_));
+      full = std::make_shared<sift_hull::Octomap>(fullMessage());
     }
   }
   {
@@ -144,6 +143,40 @@ std::shared_ptr<const sift_hull::Octomap> HullOutputs::fullSnapshot() const {
 const octomap::OcTree& HullOutputs::tree() {
   if (!tree_) tree_ = toOctomap(hull_->hull());
   return *tree_;
+}
+
+void HullOutputs::setColours(std::shared_ptr<const TriangleMesh> mesh, bool colour_full_map) {
+  colour_mesh_ = std::move(mesh);
+  colour_full_map_ = colour_full_map;
+  colour_tree_.reset();
+}
+
+const octomap::ColorOcTree& HullOutputs::colourTree() {
+  if (!colour_tree_) colour_tree_ = colourOctomap(tree(), *colour_mesh_);
+  return *colour_tree_;
+}
+
+sensor_msgs::PointCloud2 HullOutputs::centresCloud() {
+  const std::vector<Eigen::Vector3d>& centres_W = compact(true).occupied_centres_W;
+  if (!colour_mesh_) return ros_conversions::pointCloudMessage(centres_W, header_);
+  // Each centre the colour of the coloured tree's leaf there (the coarse inner leaves: white).
+  const octomap::ColorOcTree& coloured = colourTree();
+  std::vector<std::array<uint8_t, 3>> colours(centres_W.size(), {255, 255, 255});
+  for (size_t i = 0; i < centres_W.size(); ++i) {
+    const Eigen::Vector3d& c = centres_W[i];
+    const octomap::ColorOcTreeNode* node = coloured.search(c.x(), c.y(), c.z());
+    if (node == nullptr) continue;
+    const octomap::ColorOcTreeNode::Color colour = node->getColor();
+    colours[i] = {colour.r, colour.g, colour.b};
+  }
+  return ros_conversions::pointCloudMessage(centres_W, colours, header_);
+}
+
+sift_hull::Octomap HullOutputs::fullMessage() {
+  if (colour_mesh_ && colour_full_map_) {
+    return ros_conversions::octomapFullMessage(colourTree(), header_);
+  }
+  return ros_conversions::octomapFullMessage(tree(), header_);
 }
 
 const CompactOctomap& HullOutputs::compact(bool centres) {

@@ -1,7 +1,9 @@
 #pragma once
 
+#include <octomap/ColorOcTree.h>
 #include <octomap/OcTree.h>
 #include <ros/ros.h>
+#include <sensor_msgs/PointCloud2.h>
 #include <std_msgs/Header.h>
 #include <visualization_msgs/Marker.h>
 
@@ -42,6 +44,11 @@ class HullOutputs {
   /// hull as it is (the empty map when it has none), the cached tree, compact map and mesh made
   /// anew, and the snapshot. Throws what the conversions throw (a hull beyond OctoMap's keys).
   void publish(ros::Time stamp, bool all = false);
+  /// From the next publication on, the occupied centres' clouds carry the colours of `mesh` (a
+  /// mesh with one colour per vertex, as photo carving makes it; colourOctomap says how a voxel
+  /// gets its colour) in PCL's `rgb` field, and with `colour_full_map` octomap_full is OctoMap's
+  /// ColorOcTree. Null: colourless again.
+  void setColours(std::shared_ptr<const TriangleMesh> mesh, bool colour_full_map);
   /// Keeps the full map (octomap_full) in every snapshot from the next publication on.
   void keepFullMap() { keep_full_ = true; }
   bool keepsFullMap() const { return keep_full_; }
@@ -60,6 +67,9 @@ class HullOutputs {
   /// for after a publication. Require published().
   const octomap::OcTree& tree();
   const TriangleMesh& mesh();
+  /// tree() coloured by the mesh setColours gave, made when first asked for after a publication.
+  /// Requires published() and that mesh.
+  const octomap::ColorOcTree& colourTree();
   /// ~save: the published hull's octree and mesh (savePaths(path)), each a regular file written
   /// through a temporary beside it. False, with why in `message`, before the first hull, for a
   /// path that holds a NUL or names something other than a regular file, or when writing fails.
@@ -79,6 +89,8 @@ class HullOutputs {
            std::function<Message()> empty);
   void send(size_t output);
   const CompactOctomap& compact(bool centres);
+  sensor_msgs::PointCloud2 centresCloud();
+  sift_hull::Octomap fullMessage();
   visualization_msgs::Marker boxMarker();
   octomap::OcTree emptyTree() const { return octomap::OcTree(empty_resolution_m_); }
 
@@ -95,6 +107,9 @@ class HullOutputs {
   bool compact_centres_ = false;  ///< compact_ has the centres
   bool centres_wanted_ = false;   ///< a subscriber of this publication wants them
   std::unique_ptr<TriangleMesh> mesh_;
+  std::shared_ptr<const TriangleMesh> colour_mesh_;  ///< setColours()
+  bool colour_full_map_ = false;
+  std::unique_ptr<octomap::ColorOcTree> colour_tree_;
   std::atomic<bool> keep_full_{false};
   mutable std::mutex snapshot_mutex_;  ///< guards the three below
   std::shared_ptr<const sift_hull::Octomap> binary_snapshot_, full_snapshot_;

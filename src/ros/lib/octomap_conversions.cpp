@@ -1,5 +1,6 @@
 // The conversions of conversions.h between OctoMap trees and messages.
 
+#include <octomap/ColorOcTree.h>
 #include <octomap/OcTree.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
@@ -21,11 +22,11 @@ namespace {
 
 /// An OcTree's message: binary (OctoMap's binary stream) or full, `bytes` its data.
 sift_hull::Octomap mapMessage(const std_msgs::Header& header, bool binary, double resolution_m,
-                              const std::string& bytes) {
+                              const std::string& bytes, const std::string& id = "OcTree") {
   sift_hull::Octomap message;
   message.header = header;
   message.binary = binary;
-  message.id = "OcTree";
+  message.id = id;
   message.resolution = resolution_m;
   message.data.assign(bytes.begin(), bytes.end());
   return message;
@@ -47,6 +48,13 @@ sift_hull::Octomap octomapFullMessage(const octomap::OcTree& tree, const std_msg
   std::stringstream stream;
   tree.writeData(stream);
   return mapMessage(header, false, tree.getResolution(), stream.str());
+}
+
+sift_hull::Octomap octomapFullMessage(const octomap::ColorOcTree& tree,
+                                      const std_msgs::Header& header) {
+  std::stringstream stream;
+  tree.writeData(stream);
+  return mapMessage(header, false, tree.getResolution(), stream.str(), "ColorOcTree");
 }
 
 std::unique_ptr<octomap::OcTree> octreeFromMessage(const sift_hull::Octomap& message) {
@@ -74,6 +82,28 @@ sensor_msgs::PointCloud2 pointCloudMessage(const std::vector<Eigen::Vector3d>& p
   pcl::PointCloud<pcl::PointXYZ> cloud;
   for (const Eigen::Vector3d& point : points) {
     cloud.push_back(pcl::PointXYZ(point.x(), point.y(), point.z()));
+  }
+  sensor_msgs::PointCloud2 message;
+  pcl::toROSMsg(cloud, message);
+  message.header = header;
+  return message;
+}
+
+sensor_msgs::PointCloud2 pointCloudMessage(const std::vector<Eigen::Vector3d>& points,
+                                           const std::vector<std::array<uint8_t, 3>>& colours_rgb,
+                                           const std_msgs::Header& header) {
+  if (colours_rgb.size() != points.size()) {
+    throw std::invalid_argument("a coloured cloud of " + std::to_string(points.size()) +
+                                " points and " + std::to_string(colours_rgb.size()) + " colours");
+  }
+  pcl::PointCloud<pcl::PointXYZRGB> cloud;
+  cloud.reserve(points.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    pcl::PointXYZRGB point(colours_rgb[i][0], colours_rgb[i][1], colours_rgb[i][2]);
+    point.x = static_cast<float>(points[i].x());
+    point.y = static_cast<float>(points[i].y());
+    point.z = static_cast<float>(points[i].z());
+    cloud.push_back(point);
   }
   sensor_msgs::PointCloud2 message;
   pcl::toROSMsg(cloud, message);

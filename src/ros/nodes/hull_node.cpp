@@ -45,7 +45,11 @@ HullNode::HullNode(ros::NodeHandle nh, ros::NodeHandle private_nh, HullNodeConfi
             }),
       outputs_(nh_, config_.world_frame, &hull_.stream(),
                [this](std::function<void()> task) { return work_.post(std::move(task)); }),
-      pairing_({config_.from_image ? "image" : "silhouette", "camera_info"}, kPairingPatience_s,
+      pairing_(config_.photo_carve && !config_.from_image
+                   ? std::vector<std::string>{"silhouette", "camera_info", "image"}
+                   : std::vector<std::string>{config_.from_image ? "image" : "silhouette",
+                                              "camera_info"},
+               kPairingPatience_s,
                "a silhouette pairs with the camera_info of an equal stamp once tf has its "
                "camera's pose in ~world_frame (a node making masks must copy its image's header: "
                "stamp and frame_id)"),
@@ -64,7 +68,12 @@ HullNode::HullNode(ros::NodeHandle nh, ros::NodeHandle private_nh, HullNodeConfi
                      reportDiagnostics(status);
                    }),
       image_transport_(nh_),
-      sync_(config_.queue_size) {
+      sync_(config_.queue_size),
+      photo_sync_(config_.queue_size) {
+  if (config_.photo_carve) {
+    photo_ = std::make_unique<PhotoStream>(config_.photo,
+                                           [this] { work_.post([this] { takePhotoPass(); }); });
+  }
   outputs_.advertise();
   refine_timer_ = nh_.createWallTimer(ros::WallDuration(config_.refine_period_s),
                                       [this](const ros::WallTimerEvent&) {
@@ -84,15 +93,19 @@ HullNode::~HullNode() {
 void HullNode::subscribe() {
   silhouette_sub_.registerCallback(&HullNode::onArrival, this);
   info_sub_.registerCallback(&HullNode::onInfoArrival, this);
-  sync_.connectInput(silhouette_sub_, info_sub_);
-  sync_.registerCallback(&HullNode::onPair, this);
+  const std::string image_topic = nh_.resolveName(config_.from_image ? "image" : "silhouette");
+  if (config_.photo_carve && !config_.from_image) {
+    subscribePhotos(image_topic);
+  } else {
+    sync_.connectInput(silhouette_sub_, info_sub_);
+    sync_.registerCallback(&HullNode::onPair, this);
+  }
   // Surface points are looked up in tf as they come (a matcher publishes them after it has
   // looked up the same poses): one without a pose is counted at once, not kept waiting.
   points_sub_.registerCallback(&HullNode::onSurfacePoints, this);
   points_sub_.subscribe(nh_, "surface_points", static_cast<uint32_t>(config_.queue_size));
   // camera_info beside the image, wherever remapping put it (image_transport's convention);
   // the image through the transport ~image_transport names (raw, compressed, ...).
-  const std::string image_topic = nh_.resolveName(config_.from_image ? "image" : "silhouette");
   info_sub_.subscribe(nh_, image_transport::getCameraInfoTopic(image_topic), config_.queue_size);
   silhouette_sub_.subscribe(
       image_transport_, image_topic, config_.queue_size,
@@ -118,7 +131,8 @@ void HullNode::onPair(const sensor_msgs::ImageConstPtr& silhouette,
 void HullNode::onPosed(const sensor_msgs::ImageConstPtr& silhouette,
                        const sensor_msgs::CameraInfoConstPtr& info,
                        const Eigen::Isometry3d& T_W_C) {
-  pushCounted(&work_, Posed{silhouette, info, T_W_C, generation_},
+  sensor_msgs::ImageConstPtr photo = photo_ ? takePhoto(silhouette) : nullptr;
+  pushCounted(&work_, Posed{silhouette, info, T_W_C, generation_, std::move(photo)},
               "hull: views waiting to be carved (~queue_size)");
 }
 
@@ -182,7 +196,12 @@ void HullNode::integrate(Posed& posed) {
     ++counts_.bad;
     return;
   }
-  const bool changed = carve(view);
+  HullStream::Outcome outcome = HullStream::Outcome::kRefused;
+  const bool changed = carve(view, &outcome);
+  if (photo_ &&
+      (outcome == HullStream::Outcome::kCarved || outcome == HullStream::Outcome::kWaiting)) {
+    keepPhoto(posed, view);
+  }
   const ros::WallTime carved = ros::WallTime::now();
   last_carve_ms_ = (carved - start).toSec() * 1e3;
   last_view_stamp_ = view.stamp.toSec();
@@ -196,21 +215,28 @@ void HullNode::integrate(Posed& posed) {
     malloc_trim(0);  // a flood's buffers back to the system
     last_trim_wall_ = carved;
   }
+  if (drained && photo_) startPhotoPass();
   if (unpublished_stamp_.isZero()) return;
   if (!drained && (ros::WallTime::now() - last_publish_wall_).toSec() < kMaxPublishDelay_s) return;
   publishPending();
   last_publish_ms_ = (ros::WallTime::now() - carved).toSec() * 1e3;
 }
 
-bool HullNode::carve(const View& view) {
+bool HullNode::carve(const View& view, HullStream::Outcome* outcome_out) {
   const std::string& name = view.name;
   const size_t before = hull_.stream().hasHull() ? hull_.stream().hull().views().size() : 0;
   try {
     const HullStream::Outcome outcome = hull_.add(name, view.camera, view.mask);
+    *outcome_out = outcome;
     const HullStream& stream = hull_.stream();
     for (const std::string& refusal : hull_.takeRefusals()) {
       problem("hull: view refused: ", refusal);
       ++counts_.refused;
+      // "view 'NAME': why": no photograph of that frame is used (a moving camera's included).
+      const size_t close = refusal.find("': ");
+      if (photo_ && refusal.rfind("view '", 0) == 0 && close != std::string::npos) {
+        photo_->remove(refusal.substr(6, close - 6));
+      }
     }
     counts_.waiting = stream.waitingViews();
     if (stream.hasHull()) counts_.carved += stream.hull().views().size() - before;
@@ -288,6 +314,14 @@ bool HullNode::reset(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
 void HullNode::resetOnWorker() {
   counts_.reset += hull_.stream().waitingViews();
   hull_.reset();
+  if (photo_) {
+    photo_->reset();
+    outputs_.setColours(nullptr, false);
+    photo_views_ = 0;
+    photo_views_left_out_ = 0;
+    std::lock_guard<std::mutex> lock(photos_mutex_);
+    photos_.clear();
+  }
   counts_.free_voxels = 0;
   counts_.waiting = 0;
   publish(ros::Time::now(), true);  // the empty map and no markers, on every output
@@ -383,6 +417,7 @@ void HullNode::reportDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& st
   status.add("last refinement's longest slice ms", longest_refine_slice_ms_.load());
   status.add("last view stamp", last_view_stamp_.load());
   status.add("tf transforms refused", tf_listener_.refused());
+  if (photo_) reportPhotoDiagnostics(status);
   const auto warn = [&status](const std::string& text) {
     status.mergeSummary(diagnostic_msgs::DiagnosticStatus::WARN, text);
     ROS_WARN_THROTTLE(kThrottle_s, "hull: %s", text.c_str());

@@ -34,6 +34,7 @@
 #include "sift_hull/Save.h"
 #include "sift_hull/SurfacePoints.h"
 #include "sift_hull/hull/bounding_box.h"
+#include "sift_hull/mvs/photo_stream.h"
 #include "sift_hull/refine/point_carved_stream.h"
 
 namespace sift_hull {
@@ -71,12 +72,16 @@ class HullNode {
 
  private:
   using Sync = message_filters::TimeSynchronizer<sensor_msgs::Image, sensor_msgs::CameraInfo>;
+  /// ~photo_carve without from_image: the silhouette, its camera_info and the photograph.
+  using PhotoSync = message_filters::TimeSynchronizer<sensor_msgs::Image, sensor_msgs::CameraInfo,
+                                                      sensor_msgs::Image>;
   /// A posed silhouette waiting to be made a view and carved.
   struct Posed {
     sensor_msgs::ImageConstPtr silhouette;
     sensor_msgs::CameraInfoConstPtr info;
     Eigen::Isometry3d T_W_C;
-    uint64_t generation = 0;  ///< of ~reset, so that views from before one are not carved
+    uint64_t generation = 0;           ///< of ~reset, so that views from before one are not carved
+    sensor_msgs::ImageConstPtr photo;  ///< ~photo_carve without from_image: the photograph
   };
   /// A checked view.
   struct View {
@@ -100,12 +105,27 @@ class HullNode {
   void onPosed(const sensor_msgs::ImageConstPtr& silhouette,
                const sensor_msgs::CameraInfoConstPtr& info, const Eigen::Isometry3d& T_W_C);
   void onSurfacePoints(const sift_hull::SurfacePointsConstPtr& message);
+  // Photo carving (hull_node_photo.cpp).
+  void subscribePhotos(const std::string& silhouette_topic);
+  /// A silhouette, its camera_info and its photograph, paired by stamp: on to PoseWait, the
+  /// photograph kept aside until the silhouette has its pose.
+  void onPhotoTriple(const sensor_msgs::ImageConstPtr& silhouette,
+                     const sensor_msgs::CameraInfoConstPtr& info,
+                     const sensor_msgs::ImageConstPtr& photo);
+  /// The photograph kept aside for `silhouette` (null: none), no longer kept.
+  sensor_msgs::ImageConstPtr takePhoto(const sensor_msgs::ImageConstPtr& silhouette);
+  /// The worker: a carved view's photograph to the photo stream.
+  void keepPhoto(const Posed& posed, const View& view);
+  /// The worker: a finished pass carved into the hull and its colours published; the next pass.
+  void takePhotoPass();
+  void startPhotoPass();
+  void reportPhotoDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& status);
   // Work (the worker thread).
   /// The view the three messages make, or false with the reason logged.
   bool viewOf(const Posed& posed, View* view);
   void integrate(Posed& posed);
-  /// Whether the view changed the hull.
-  bool carve(const View& view);
+  /// Whether the view changed the hull; what the stream made of it in `outcome`.
+  bool carve(const View& view, HullStream::Outcome* outcome);
   void takeSurfacePoints();
   void mergeSurfacePoints(const PosedPoints& posed);
   void refineIfDue();
@@ -159,12 +179,23 @@ class HullNode {
   tf2_ros::Buffer tf_buffer_;
   TfListener tf_listener_;
   PoseWait pose_wait_;
+  // Photo carving (null without ~photo_carve): the passes post their end to the worker.
+  std::unique_ptr<PhotoStream> photo_;
+  std::mutex photos_mutex_;  ///< guards photos_
+  /// Photographs whose silhouettes wait for their pose, oldest first, at most 2 ~queue_size.
+  std::deque<std::pair<sensor_msgs::ImageConstPtr, sensor_msgs::ImageConstPtr>> photos_;
+  std::atomic<uint64_t> photo_passes_applied_{0}, photo_passes_stale_{0}, photo_passes_failed_{0};
+  std::atomic<uint64_t> photo_views_{0}, photo_views_left_out_{0}, photo_carved_voxels_{0};
+  std::atomic<uint64_t> photo_unpaired_{0};
+  std::atomic<double> last_photo_pass_ms_{0.0}, last_photo_apply_ms_{0.0};
   NodeDiagnostics diagnostics_;  ///< after what it reports on (the pose wait's count)
   // Subscribed last, once every callback is in place.
   image_transport::ImageTransport image_transport_;
   image_transport::SubscriberFilter silhouette_sub_;
   message_filters::Subscriber<sensor_msgs::CameraInfo> info_sub_;
   Sync sync_;
+  image_transport::SubscriberFilter photo_sub_;
+  PhotoSync photo_sync_;
   message_filters::Subscriber<sift_hull::SurfacePoints> points_sub_;
   ros::ServiceServer reset_srv_, save_srv_, binary_srv_, full_srv_, clear_bbx_srv_;
 };

@@ -6,6 +6,7 @@
 
 #include "sift_hull/hull/hull_stream.h"
 #include "sift_hull/hull/silhouette.h"
+#include "sift_hull/mvs/photo_stream.h"
 #include "sift_hull/refine/point_carved_stream.h"
 #include "sift_hull/settings.h"
 
@@ -38,6 +39,15 @@ struct HullNodeConfig {
   double refine_period_s = 1.0;
   /// Free-space carving with the surface points (`surface_points`): how many are kept, which.
   PointCarvingConfig carving;
+  /// Photo carving (PhotoStream): the photographs are taken with the silhouettes (`image`, paired
+  /// by stamp with the silhouette and its camera_info; with from_image the images themselves),
+  /// passes of dense depth carve the hull in the background, and the clouds of occupied centres
+  /// carry the photographs' colours.
+  bool photo_carve = false;
+  /// With photo_carve: octomap_full is OctoMap's ColorOcTree (octomap_server's colour mode).
+  bool photo_color_octomap = false;
+  /// The passes' settings (photo_max_views and PhotoCarveConfig's).
+  PhotoStreamConfig photo;
 };
 
 /// Its settings (sift_hull/settings.h); the silhouette recipe and the carving settings are nested

@@ -32,6 +32,12 @@ const SettingTable<HullNodeConfig>& settingsOf<HullNodeConfig>() {
           "wall time between refinements with new surface points")
         .above(0.0);
     t.nest("", &HullNodeConfig::carving, settingsOf<PointCarvingConfig>());
+    t.add("photo_carve", &HullNodeConfig::photo_carve, "",
+          "take the photographs beside the silhouettes (`image`; from_image: the images), carve "
+          "the hull by their depth maps in the background and colour the clouds");
+    t.add("photo_color_octomap", &HullNodeConfig::photo_color_octomap, "",
+          "photo_carve: octomap_full is OctoMap's ColorOcTree");
+    t.nest("", &HullNodeConfig::photo, settingsOf<PhotoStreamConfig>());
     return t;
   }();
   return table;

@@ -1,0 +1,242 @@
+// hull_node with ~photo_carve: the cup's 40 silhouettes with their photographs (the renderer's,
+// 320x240); the passes in the background carve part of the pocket a visual hull keeps out of the
+// octomap, none of the cup, and the occupied centres' cloud carries the photographs' colours
+// (against the colour the renderer's views show at each surface point), octomap_full a
+// ColorOcTree. Every wait has a deadline.
+
+#include <geometry_msgs/TransformStamped.h>
+#include <gtest/gtest.h>
+#include <octomap/ColorOcTree.h>
+#include <octomap/OcTree.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+#include <pcl_conversions/pcl_conversions.h>
+#include <ros/ros.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <tf2_ros/static_transform_broadcaster.h>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <iostream>
+#include <memory>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+#include <vector>
+
+#include "hull_node_fixture.h"
+#include "lib/conversions.h"
+#include "ros_wait.h"
+#include "sift_hull/GetOctomap.h"
+#include "sift_hull/Octomap.h"
+#include "sift_hull/hull/hull_octomap.h"
+#include "sift_hull/hull/hull_stream.h"
+#include "sift_hull/synthetic/scene.h"
+#include "sift_hull/synthetic/shape.h"
+
+namespace sift_hull {
+namespace {
+
+namespace rc = ros_conversions;
+using test::frameOf;
+using test::waitFor;
+
+/// With 20 views the nearest neighbours are too far apart for the pocket's walls to pass the
+/// consistency check (EVALUATION.md, Photo carving): 40 views carve about a third of it.
+constexpr int kCupViews = 40;
+constexpr int kDepth = 7;  ///< as hull_photo.test's ~max_depth
+
+SceneConfig cupScene() {
+  SceneConfig config = test::sphereSceneConfig();
+  config.shape = "cup";
+  config.views = kCupViews;
+  return config;
+}
+
+/// The fraction of `inside` points on a 40^3 grid over [lo, hi] that `occupied` holds.
+double occupiedFraction(const std::function<bool(const Eigen::Vector3d&)>& occupied,
+                        const std::function<bool(const Eigen::Vector3d&)>& inside) {
+  const Eigen::Vector3d lo(-0.75, -0.75, -0.65), hi(0.75, 0.75, 0.65);
+  size_t in = 0, held = 0;
+  const int n = 40;
+  for (int k = 0; k < n; ++k) {
+    for (int j = 0; j < n; ++j) {
+      for (int i = 0; i < n; ++i) {
+        const Eigen::Vector3d X =
+            lo + (hi - lo).cwiseProduct((Eigen::Vector3d(i, j, k).array() + 0.5).matrix() / n);
+        if (!inside(X)) continue;
+        ++in;
+        held += occupied(X) ? 1 : 0;
+      }
+    }
+  }
+  return in == 0 ? 0.0 : static_cast<double>(held) / in;
+}
+
+std::function<bool(const Eigen::Vector3d&)> occupiedIn(const octomap::OcTree& map) {
+  return [&map](const Eigen::Vector3d& X) {
+    const octomap::OcTreeNode* node = map.search(X.x(), X.y(), X.z());
+    return node != nullptr && map.isNodeOccupied(node);
+  };
+}
+
+/// The colour (r, g, b) the views show at X: the per-channel median over the views whose depth
+/// map puts their surface within `tolerance_m` of X's depth; false when no view sees X.
+/// `photos`: the views' images averaged over a voxel's footprint.
+bool seenColour(const std::vector<RenderedView>& views, const std::vector<cv::Mat>& photos,
+                const Eigen::Vector3d& X, double tolerance_m, Eigen::Vector3d* rgb) {
+  std::vector<double> channels[3];
+  for (size_t i = 0; i < views.size(); ++i) {
+    const RenderedView& v = views[i];
+    const PinholeCamera& camera = v.view.camera;
+    const double depth = camera.depth(X);
+    if (!(depth > 0.0)) continue;
+    const Eigen::Vector2d px = camera.project(X);
+    const int u = static_cast<int>(std::lround(px.x())), r = static_cast<int>(std::lround(px.y()));
+    if (u < 0 || r < 0 || u >= v.depth.cols || r >= v.depth.rows) continue;
+    if (!(std::abs(v.depth.at<float>(r, u) - depth) < tolerance_m)) continue;
+    const cv::Vec3b bgr = photos[i].at<cv::Vec3b>(r, u);
+    for (int c = 0; c < 3; ++c) channels[c].push_back(bgr[2 - c]);
+  }
+  if (channels[0].empty()) return false;
+  for (int c = 0; c < 3; ++c) {
+    std::nth_element(channels[c].begin(), channels[c].begin() + channels[c].size() / 2,
+                     channels[c].end());
+    (*rgb)[c] = channels[c][channels[c].size() / 2];
+  }
+  return true;
+}
+
+TEST(HullPhotoTest, PassesCarveTheCupsPocketAndColourTheCloud) {
+  ros::NodeHandle nh;
+  const std::vector<RenderedView> views = renderScene(cupScene());
+  // The visual hull of the same views, as the node builds it without photographs.
+  HullStreamConfig stream_config;
+  stream_config.hull.max_depth = kDepth;
+  HullStream silhouettes_only(stream_config);
+  for (int v = 0; v < kCupViews; ++v) {
+    silhouettes_only.add(frameOf(v), views[v].view.camera, views[v].mask);
+  }
+  ASSERT_TRUE(silhouettes_only.hasHull());
+  const std::unique_ptr<octomap::OcTree> hull_map = toOctomap(silhouettes_only.hull());
+  const Shape cup = Shape::byName("cup");
+  const Shape filled = cup.withoutCuts();
+  const auto pocket = [&](const Eigen::Vector3d& X) {
+    return filled.contains(X) && !cup.contains(X);
+  };
+  const auto solid = [&](const Eigen::Vector3d& X) { return cup.contains(X); };
+  const double pocket_hull = occupiedFraction(occupiedIn(*hull_map), pocket);
+  const double solid_hull = occupiedFraction(occupiedIn(*hull_map), solid);
+  ASSERT_GT(pocket_hull, 0.9) << "the silhouettes' hull should fill the pocket";
+
+  tf2_ros::StaticTransformBroadcaster tf;
+  std::vector<geometry_msgs::TransformStamped> poses;
+  for (int v = 0; v < kCupViews; ++v) {
+    poses.push_back(rc::cameraPoseMessage(views[v].view.camera, "world", frameOf(v), {}));
+  }
+  tf.sendTransform(poses);
+  ros::Publisher silhouette_pub = nh.advertise<sensor_msgs::Image>("silhouette", 50);
+  ros::Publisher image_pub = nh.advertise<sensor_msgs::Image>("image", 50);
+  ros::Publisher info_pub = nh.advertise<sensor_msgs::CameraInfo>("camera_info", 50);
+  sift_hull::OctomapConstPtr last;
+  sensor_msgs::PointCloud2ConstPtr cloud;
+  ros::Subscriber map_sub = nh.subscribe<sift_hull::Octomap>(
+      "octomap_binary", 5, [&](const sift_hull::OctomapConstPtr& m) { last = m; });
+  ros::Subscriber cloud_sub = nh.subscribe<sensor_msgs::PointCloud2>(
+      "octomap_point_cloud_centers", 5,
+      [&](const sensor_msgs::PointCloud2ConstPtr& m) { cloud = m; });
+  ASSERT_TRUE(waitFor([&] {
+    return silhouette_pub.getNumSubscribers() > 0 && image_pub.getNumSubscribers() > 0 &&
+           info_pub.getNumSubscribers() > 0;
+  })) << "the hull node did not subscribe";
+  for (int v = 0; v < kCupViews; ++v) {
+    std_msgs::Header header;
+    header.stamp = ros::Time::now();
+    header.frame_id = frameOf(v);
+    info_pub.publish(rc::cameraInfoMessage(views[v].view.camera, views[v].mask.size(), header));
+    image_pub.publish(rc::imageMessage(views[v].image, header));
+    silhouette_pub.publish(rc::imageMessage(views[v].mask, header));
+    ros::WallDuration(0.05).sleep();
+  }
+  // The passes end one after another: wait until the pocket drops (or the deadline).
+  double pocket_after = 1.0;
+  const bool carved = waitFor(
+      [&] {
+        if (!last) return false;
+        pocket_after = occupiedFraction(occupiedIn(*rc::octreeFromMessage(*last)), pocket);
+        return pocket_after < 0.9 * pocket_hull;
+      },
+      120.0);
+  const double solid_after = occupiedFraction(occupiedIn(*rc::octreeFromMessage(*last)), solid);
+  std::cout << "pocket occupied " << pocket_hull << " -> " << pocket_after << ", cup " << solid_hull
+            << " -> " << solid_after << '\n';
+  EXPECT_TRUE(carved) << "the pocket stays " << pocket_after << " occupied";
+  EXPECT_GT(solid_after, solid_hull - 0.01) << "photo carving carved the cup itself";
+
+  // The cloud: PCL's rgb, each surface point the colour the views show there.
+  // The cloud of the same publication as the map (it may arrive after it).
+  ASSERT_TRUE(waitFor([&] { return cloud && cloud->header.stamp == last->header.stamp; }))
+      << "no cloud of the occupied centres with the map's stamp";
+  ASSERT_TRUE(std::any_of(cloud->fields.begin(), cloud->fields.end(),
+                          [](const sensor_msgs::PointField& f) { return f.name == "rgb"; }))
+      << "the cloud of the occupied centres has no colour";
+  pcl::PointCloud<pcl::PointXYZRGB> points;
+  pcl::fromROSMsg(*cloud, points);
+  const double voxel_m = last->resolution;
+  std::vector<cv::Mat> photos(views.size());  // a voxel spans about a pixel at 4 m: 3x3
+  for (size_t i = 0; i < views.size(); ++i) cv::blur(views[i].image, photos[i], cv::Size(3, 3));
+  // The finest centres next to the surface the views see. Those with no mesh vertex within a
+  // voxel (most lie a voxel inside the surface) are white, as the inside is.
+  std::vector<Eigen::Vector3d> theirs, truth;
+  size_t seen = 0;
+  for (const pcl::PointXYZRGB& p : points) {
+    Eigen::Vector3d rgb;
+    if (!seenColour(views, photos, Eigen::Vector3d(p.x, p.y, p.z), voxel_m, &rgb)) continue;
+    ++seen;
+    if (p.r == 255 && p.g == 255 && p.b == 255) continue;
+    theirs.emplace_back(p.r, p.g, p.b);
+    truth.push_back(rgb);
+  }
+  ASSERT_GT(seen, 1000u) << "too few centres on the surface";
+  EXPECT_GT(theirs.size(), seen * 4 / 5) << "most centres on the surface should be coloured";
+  double error = 0.0, shuffled = 0.0;
+  for (size_t i = 0; i < theirs.size(); ++i) {
+    error += (theirs[i] - truth[i]).cwiseAbs().mean();
+    shuffled += (theirs[i] - truth[(i * 7919 + 13) % truth.size()]).cwiseAbs().mean();
+  }
+  error /= theirs.size();
+  shuffled /= theirs.size();
+  std::cout << theirs.size() << " of " << seen << " centres on the surface coloured: colour error "
+            << error << " grey levels (against other points' colours: " << shuffled << ")\n";
+  EXPECT_LT(error, 20.0);
+  EXPECT_LT(error, 0.5 * shuffled) << "the colours are not those of their places";
+
+  // octomap_full: OctoMap's ColorOcTree with those colours.
+  sift_hull::GetOctomap full;
+  ASSERT_TRUE(ros::service::waitForService("octomap_full", ros::Duration(test::kDeadline_s)));
+  ASSERT_TRUE(ros::service::call("octomap_full", full));
+  EXPECT_EQ(full.response.map.id, "ColorOcTree");
+  octomap::ColorOcTree coloured(full.response.map.resolution);
+  std::stringstream data(std::string(full.response.map.data.begin(), full.response.map.data.end()));
+  coloured.readData(data);
+  size_t tinted = 0, leaves = 0;
+  for (auto it = coloured.begin_leafs(); it != coloured.end_leafs(); ++it) {
+    if (!coloured.isNodeOccupied(*it) || it.getDepth() != coloured.getTreeDepth()) continue;
+    ++leaves;
+    const octomap::ColorOcTreeNode::Color c = it->getColor();
+    tinted += (c.r != 255 || c.g != 255 || c.b != 255) ? 1 : 0;
+  }
+  EXPECT_GT(tinted, leaves / 2) << tinted << " of " << leaves << " finest leaves coloured";
+}
+
+}  // namespace
+}  // namespace sift_hull
+
+int main(int argc, char** argv) {
+  ::testing::InitGoogleTest(&argc, argv);
+  ros::init(argc, argv, "test_hull_photo");
+  ros::NodeHandle nh;
+  return RUN_ALL_TESTS();
+}
