@@ -29,6 +29,7 @@ set(SIFT_HULL_CORE_GTESTS
   test_scene eval
   test_cut_shapes eval
   test_photo_carving eval
+  test_photo_stream eval
   test_scene_backgrounds eval
   test_silhouettes eval
   test_mesh_render eval

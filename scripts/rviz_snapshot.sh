@@ -2,11 +2,13 @@
 # The demo with rviz (config/sift_hull.rviz) on a virtual X display: plays the synthetic scene's
 # bag through both nodes and, once the last view is in, saves a PNG of the rviz window showing the
 # hull, the camera frames, the last silhouette and the matches image. Output: demo_output/ (or $1),
-# the picture at rviz.png there.
+# the picture at rviz.png there. Further arguments go to demo.launch: photo_carve:=true shows the
+# photo-carved hull's coloured cells (config/sift_hull_photo.rviz), after its first pass.
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 source "$here/common.sh"
 out="$(realpath -m "${1:-$repo_root/demo_output}")"
+shift || true
 
 prepare_demo "$out"
 
@@ -33,7 +35,7 @@ trap cleanup EXIT
 
 echo "playing $out/scene.bag through both nodes with rviz on display $display ..."
 rm -rf "$out/nodes"  # its summary.json is the signal below, so none may be left from before
-DISPLAY="$display" run_demo_launch "$out" rviz:=true >"$out/launch.log" 2>&1 &
+DISPLAY="$display" run_demo_launch "$out" rviz:=true "$@" >"$out/launch.log" 2>&1 &
 launch=$!
 # With rviz open the launch stays up after saving; the summary tells that the last view is in.
 for _ in $(seq 300); do
@@ -43,5 +45,12 @@ for _ in $(seq 300); do
 done
 [[ -s "$out/nodes/summary.json" ]] || { echo "no summary after 300 s" >&2; exit 1; }
 sleep "${SIFT_HULL_RVIZ_SETTLE_S:-5}"  # rviz draws the latched hull and mesh
+if [[ " $* " == *" photo_carve:=true "* ]]; then  # and the photo carving's pass, when it ends
+  for _ in $(seq 120); do
+    grep -q "hull: photo carving with" "$out/launch.log" && break
+    sleep 1
+  done
+  sleep 3
+fi
 import -display "$display" -window root "$out/rviz.png"
 echo "rviz snapshot: $out/rviz.png"

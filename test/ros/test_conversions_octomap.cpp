@@ -1,9 +1,16 @@
 // The OctoMap conversions of octomap_server's interface without a ROS master: the full map's round
 // trip with its occupancies, reading messages back (and refusing bad ones), the free cells'
-// markers, the clear box's corners, and the services' md5sums, which must be octomap_msgs'.
+// markers, the coloured full map (ColorOcTree) and centres' cloud (PCL's rgb), the clear box's
+// corners, and the services' md5sums, which must be octomap_msgs'.
 
 #include <gtest/gtest.h>
+#include <octomap/ColorOcTree.h>
 #include <octomap/OcTree.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+#include <pcl_conversions/pcl_conversions.h>
+
+#include <sstream>
 
 #include <cmath>
 #include <memory>
@@ -71,6 +78,49 @@ TEST(OctomapFullMessage, RoundTripKeepsEveryLeafAndItsOccupancy) {
   const sift_hull::Octomap empty = rc::octomapFullMessage(octomap::OcTree(0.2), mapHeader());
   EXPECT_TRUE(empty.data.empty());
   EXPECT_EQ(rc::octreeFromMessage(empty)->getNumLeafNodes(), 0u);
+}
+
+TEST(OctomapFullMessage, OfAColorOcTreeKeepsItsColoursForOctomapsReader) {
+  octomap::ColorOcTree tree(kRes);
+  tree.updateNode(0.05, 0.05, 0.05, true)->setColor(200, 30, 10);
+  tree.updateNode(1.05, 0.05, 0.05, true)->setColor(5, 6, 250);
+  tree.updateNode(0.05, 1.05, 0.05, false);
+  const sift_hull::Octomap message = rc::octomapFullMessage(tree, mapHeader());
+  EXPECT_EQ(message.id, "ColorOcTree");  // what octomap_msgs::msgToMap makes a ColorOcTree of
+  EXPECT_FALSE(message.binary);
+  EXPECT_EQ(message.resolution, kRes);
+  EXPECT_EQ(message.header.frame_id, "map");
+  octomap::ColorOcTree back(message.resolution);
+  std::stringstream data(std::string(message.data.begin(), message.data.end()));
+  back.readData(data);
+  const octomap::ColorOcTreeNode* red = back.search(0.05, 0.05, 0.05);
+  const octomap::ColorOcTreeNode* blue = back.search(1.05, 0.05, 0.05);
+  const octomap::ColorOcTreeNode* free = back.search(0.05, 1.05, 0.05);
+  ASSERT_TRUE(red && blue && free);
+  EXPECT_EQ(red->getColor(), octomap::ColorOcTreeNode::Color(200, 30, 10));
+  EXPECT_EQ(blue->getColor(), octomap::ColorOcTreeNode::Color(5, 6, 250));
+  EXPECT_TRUE(back.isNodeOccupied(red));
+  EXPECT_FALSE(back.isNodeOccupied(free));
+}
+
+TEST(PointCloudMessage, WithColoursIsPclsXyzrgbAndRefusesOtherCounts) {
+  const std::vector<Eigen::Vector3d> points = {{1.0, 2.0, 3.0}, {-1.0, 0.5, 0.25}};
+  const sensor_msgs::PointCloud2 message =
+      rc::pointCloudMessage(points, {{255, 0, 10}, {1, 128, 254}}, mapHeader());
+  EXPECT_EQ(message.header.frame_id, "map");
+  std::vector<std::string> fields;
+  for (const sensor_msgs::PointField& field : message.fields) fields.push_back(field.name);
+  EXPECT_EQ(fields, (std::vector<std::string>{"x", "y", "z", "rgb"}));
+  pcl::PointCloud<pcl::PointXYZRGB> cloud;
+  pcl::fromROSMsg(message, cloud);
+  ASSERT_EQ(cloud.size(), 2u);
+  EXPECT_FLOAT_EQ(cloud[1].x, -1.0f);
+  EXPECT_FLOAT_EQ(cloud[1].z, 0.25f);
+  EXPECT_EQ(cloud[0].r, 255);
+  EXPECT_EQ(cloud[0].b, 10);
+  EXPECT_EQ(cloud[1].g, 128);
+  EXPECT_EQ(cloud[1].rgba & 0xFFFFFFu, 0x0180FEu);  // rviz's RGB8: 0x00RRGGBB
+  EXPECT_THROW(rc::pointCloudMessage(points, {{1, 2, 3}}, mapHeader()), std::invalid_argument);
 }
 
 TEST(OctomapMessage, FromTheCompactMapIsTheTreesMessageAndReadsBack) {

@@ -12,6 +12,8 @@
 #include <pcl/point_types.h>
 #include <pcl_conversions/pcl_conversions.h>
 #include <ros/ros.h>
+#include <rosgraph_msgs/Log.h>
+#include <std_srvs/Empty.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/PointCloud2.h>
@@ -22,6 +24,7 @@
 #include <functional>
 #include <iostream>
 #include <memory>
+#include <mutex>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 #include <vector>
@@ -229,6 +232,77 @@ TEST(HullPhotoTest, PassesCarveTheCupsPocketAndColourTheCloud) {
     tinted += (c.r != 255 || c.g != 255 || c.b != 255) ? 1 : 0;
   }
   EXPECT_GT(tinted, leaves / 2) << tinted << " of " << leaves << " finest leaves coloured";
+}
+
+TEST(HullPhotoTest, PhotographsThatDoNotFitAreLeftOutWithTheirReasonAndTheViewsStillCarve) {
+  ros::NodeHandle nh;
+  const std::vector<RenderedView> views = renderScene(cupScene());
+  tf2_ros::StaticTransformBroadcaster tf;
+  std::vector<geometry_msgs::TransformStamped> poses;
+  for (int v = 0; v < 4; ++v) {
+    poses.push_back(rc::cameraPoseMessage(views[v].view.camera, "world", frameOf(v), {}));
+  }
+  tf.sendTransform(poses);
+  ros::Publisher silhouette_pub = nh.advertise<sensor_msgs::Image>("silhouette", 10);
+  ros::Publisher image_pub = nh.advertise<sensor_msgs::Image>("image", 10);
+  ros::Publisher info_pub = nh.advertise<sensor_msgs::CameraInfo>("camera_info", 10);
+  sift_hull::OctomapConstPtr last;
+  ros::Subscriber map_sub = nh.subscribe<sift_hull::Octomap>(
+      "octomap_binary", 5, [&](const sift_hull::OctomapConstPtr& m) { last = m; });
+  std::mutex mutex;
+  std::vector<std::string> errors;
+  bool heard_reset = false;
+  ros::Subscriber rosout =
+      nh.subscribe<rosgraph_msgs::Log>("/rosout", 100, [&](const rosgraph_msgs::LogConstPtr& log) {
+        std::lock_guard<std::mutex> lock(mutex);
+        if (log->msg.rfind("hull: reset", 0) == 0) heard_reset = true;
+        if (log->level == rosgraph_msgs::Log::ERROR) errors.push_back(log->msg);
+      });
+  ASSERT_TRUE(waitFor([&] {
+    return silhouette_pub.getNumSubscribers() > 0 && image_pub.getNumSubscribers() > 0 &&
+           info_pub.getNumSubscribers() > 0;
+  })) << "the hull node did not subscribe";
+  // From no hull, once the node's /rosout lines reach this test.
+  ASSERT_TRUE(waitFor([&] {
+    std_srvs::Empty reset;
+    ros::service::call("/hull/reset", reset);
+    return waitFor(
+        [&] {
+          std::lock_guard<std::mutex> lock(mutex);
+          return heard_reset;
+        },
+        0.5);
+  })) << "no line of the hull node reached this test on /rosout";
+  ros::Time stamp;
+  for (int v = 0; v < 4; ++v) {
+    std_msgs::Header header;
+    header.stamp = stamp = ros::Time::now();
+    header.frame_id = frameOf(v);
+    cv::Mat photo = views[v].image;
+    if (v == 1) photo = cv::Mat(photo, cv::Rect(0, 0, 100, 80)).clone();  // not the mask's size
+    sensor_msgs::Image image = rc::imageMessage(photo, header);
+    if (v == 2) image.encoding = "32FC1";  // not an 8-bit image (the bytes are 4 per pixel)
+    if (v == 2) image.step = image.width * 4;
+    if (v == 2) image.data.resize(image.step * image.height);
+    info_pub.publish(rc::cameraInfoMessage(views[v].view.camera, views[v].mask.size(), header));
+    image_pub.publish(image);
+    silhouette_pub.publish(rc::imageMessage(views[v].mask, header));
+    ros::WallDuration(0.05).sleep();
+  }
+  const auto logged = [&](const std::string& a, const std::string& b) {
+    std::lock_guard<std::mutex> lock(mutex);
+    return std::any_of(errors.begin(), errors.end(), [&](const std::string& e) {
+      return e.find("photo carving leaves out") != std::string::npos &&
+             e.find(a) != std::string::npos && e.find(b) != std::string::npos;
+    });
+  };
+  EXPECT_TRUE(waitFor([&] { return logged(frameOf(1), "100x80"); }))
+      << "no error for the photograph of another size";
+  EXPECT_TRUE(waitFor([&] { return logged(frameOf(2), "32FC1"); }))
+      << "no error for the photograph that is not 8-bit";
+  // Every view carved all the same: the map of the last.
+  EXPECT_TRUE(waitFor([&] { return last && last->header.stamp >= stamp; }))
+      << "no map with the last view";
 }
 
 }  // namespace
