@@ -45,12 +45,27 @@ for _ in $(seq 300); do
 done
 [[ -s "$out/nodes/summary.json" ]] || { echo "no summary after 300 s" >&2; exit 1; }
 sleep "${SIFT_HULL_RVIZ_SETTLE_S:-5}"  # rviz draws the latched hull and mesh
-if [[ " $* " == *" photo_carve:=true "* ]]; then  # and the photo carving's pass, when it ends
-  for _ in $(seq 120); do
-    grep -q "hull: photo carving with" "$out/launch.log" && break
-    sleep 1
+if [[ " $* " == *" photo_carve:=true "* ]]; then
+  # and the photo carving's pass with every view, once it is carved in (the hull's /diagnostics)
+  set +u
+  source "$workspace/devel/setup.bash"
+  set -u
+  for _ in $(seq 60); do
+    timeout 10 /usr/bin/python3 - <<'PY' && break  # ROS's python3, whatever PATH says
+import sys, rospy
+from diagnostic_msgs.msg import DiagnosticArray
+rospy.init_node("rviz_snapshot_wait", anonymous=True)
+while not rospy.is_shutdown():
+    for status in rospy.wait_for_message("/diagnostics", DiagnosticArray, timeout=5).status:
+        values = {v.key: v.value for v in status.values}
+        if status.name == "hull: hull" and "photo pass running" in values:
+            done = (values["photo pass running"] == "no" and
+                    values["photo views of the last pass applied"] == values["photo views kept"])
+            sys.exit(0 if done else 1)
+PY
+    sleep 2
   done
-  sleep 3
+  sleep 5  # rviz draws the coloured cloud
 fi
 import -display "$display" -window root "$out/rviz.png"
 echo "rviz snapshot: $out/rviz.png"

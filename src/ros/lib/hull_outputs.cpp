@@ -50,6 +50,7 @@ void HullOutputs::advertise() {
   outputs_.reserve(8);
   const auto centres = [this] { return centresCloud(); };
   const auto noCentres = [this] {
+    if (colour_clouds_) return ros_conversions::pointCloudMessage({}, {}, header_);
     return ros_conversions::occupiedCellsCloud(emptyTree(), header_);
   };
   const auto noMarkers = [this] { return ros_conversions::deleteAllMarkers(header_); };
@@ -158,10 +159,13 @@ const octomap::ColorOcTree& HullOutputs::colourTree() {
 
 sensor_msgs::PointCloud2 HullOutputs::centresCloud() {
   const std::vector<Eigen::Vector3d>& centres_W = compact(true).occupied_centres_W;
-  if (!colour_mesh_) return ros_conversions::pointCloudMessage(centres_W, header_);
+  if (!colour_mesh_ && !colour_clouds_) {
+    return ros_conversions::pointCloudMessage(centres_W, header_);
+  }
   // Each centre the colour of the coloured tree's leaf there (the coarse inner leaves: white).
-  const octomap::ColorOcTree& coloured = colourTree();
   std::vector<std::array<uint8_t, 3>> colours(centres_W.size(), {255, 255, 255});
+  if (!colour_mesh_) return ros_conversions::pointCloudMessage(centres_W, colours, header_);
+  const octomap::ColorOcTree& coloured = colourTree();
   for (size_t i = 0; i < centres_W.size(); ++i) {
     const Eigen::Vector3d& c = centres_W[i];
     const octomap::ColorOcTreeNode* node = coloured.search(c.x(), c.y(), c.z());

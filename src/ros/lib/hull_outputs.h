@@ -49,6 +49,10 @@ class HullOutputs {
   /// gets its colour) in PCL's `rgb` field, and with `colour_full_map` octomap_full is OctoMap's
   /// ColorOcTree. Null: colourless again.
   void setColours(std::shared_ptr<const TriangleMesh> mesh, bool colour_full_map);
+  /// The centres' clouds carry `rgb` from the first publication on, white until setColours gives
+  /// colours, so that a subscriber sees one point type throughout (rviz keeps the colour
+  /// transformer the first cloud allowed).
+  void colourClouds() { colour_clouds_ = true; }
   /// Keeps the full map (octomap_full) in every snapshot from the next publication on.
   void keepFullMap() { keep_full_ = true; }
   bool keepsFullMap() const { return keep_full_; }
@@ -109,6 +113,7 @@ class HullOutputs {
   std::unique_ptr<TriangleMesh> mesh_;
   std::shared_ptr<const TriangleMesh> colour_mesh_;  ///< setColours()
   bool colour_full_map_ = false;
+  bool colour_clouds_ = false;
   std::unique_ptr<octomap::ColorOcTree> colour_tree_;
   std::atomic<bool> keep_full_{false};
   mutable std::mutex snapshot_mutex_;  ///< guards the three below

@@ -74,6 +74,7 @@ HullNode::HullNode(ros::NodeHandle nh, ros::NodeHandle private_nh, HullNodeConfi
     photo_ = std::make_unique<PhotoStream>(config_.photo,
                                            [this] { work_.post([this] { takePhotoPass(); }); });
   }
+  if (photo_) outputs_.colourClouds();
   outputs_.advertise();
   refine_timer_ = nh_.createWallTimer(ros::WallDuration(config_.refine_period_s),
                                       [this](const ros::WallTimerEvent&) {

@@ -186,7 +186,8 @@ class HullNode {
   std::deque<std::pair<sensor_msgs::ImageConstPtr, sensor_msgs::ImageConstPtr>> photos_;
   std::atomic<uint64_t> photo_passes_applied_{0}, photo_passes_stale_{0}, photo_passes_failed_{0};
   std::atomic<uint64_t> photo_views_{0}, photo_views_left_out_{0}, photo_carved_voxels_{0};
-  std::atomic<uint64_t> photo_unpaired_{0};
+  std::atomic<uint64_t> photo_unpaired_{0}, last_photo_pass_views_{0};
+  std::atomic<bool> photo_pass_running_{false};
   std::atomic<double> last_photo_pass_ms_{0.0}, last_photo_apply_ms_{0.0};
   NodeDiagnostics diagnostics_;  ///< after what it reports on (the pose wait's count)
   // Subscribed last, once every callback is in place.

@@ -76,11 +76,14 @@ void HullNode::keepPhoto(const Posed& posed, const View& view) {
 
 void HullNode::startPhotoPass() {
   if (!hull_.stream().hasHull()) return;
-  photo_->startIfDue(hull_.stream().hull(), hull_.stream().hullGeneration());
+  if (photo_->startIfDue(hull_.stream().hull(), hull_.stream().hullGeneration())) {
+    photo_pass_running_ = true;
+  }
 }
 
 void HullNode::takePhotoPass() {
   std::unique_ptr<PhotoStream::Pass> pass = photo_->takeDone();
+  photo_pass_running_ = false;
   if (pass && !pass->error.empty()) {
     ++photo_passes_failed_;
     problem("hull: photo carving failed: ", pass->error);
@@ -92,6 +95,7 @@ void HullNode::takePhotoPass() {
     outputs_.setColours(std::make_shared<const TriangleMesh>(std::move(pass->mesh)),
                         config_.photo_color_octomap);
     photo_carved_voxels_ = pass->carving.free_voxels.size();
+    last_photo_pass_views_ = pass->views;
     last_photo_pass_ms_ = pass->total_ms;
     publish(ros::Time::now());
     last_photo_apply_ms_ = (ros::WallTime::now() - start).toSec() * 1e3;
@@ -108,7 +112,9 @@ void HullNode::takePhotoPass() {
 }
 
 void HullNode::reportPhotoDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& status) {
+  status.add("photo pass running", photo_pass_running_.load() ? "yes" : "no");
   status.add("photo passes applied", photo_passes_applied_.load());
+  status.add("photo views of the last pass applied", last_photo_pass_views_.load());
   status.add("photo passes on a tree since replaced", photo_passes_stale_.load());
   status.add("photo passes failed", photo_passes_failed_.load());
   status.add("photo views kept", photo_views_.load());
