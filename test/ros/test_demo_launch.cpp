@@ -1,6 +1,7 @@
 // launch/demo.launch end to end: a synthetic scene's bag played through both nodes (as nodes and
 // as nodelets), the results saved by save_results once the last view is in, and the saved hull
-// compared with the offline `sift_hull hull` of the same views.
+// compared with the offline `sift_hull hull` of the same views; with photo_carve:=true the bag's
+// images reach the hull node and the saved cloud carries colour.
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -11,10 +12,10 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "common/test_data.h"
-#include "tools/free_port.h"
 #include "sift_hull/filters/filter.h"
 #include "sift_hull/hull/mesh.h"
 #include "sift_hull/io/ply.h"
+#include "tools/free_port.h"
 
 namespace sift_hull {
 namespace {
@@ -46,13 +47,15 @@ class DemoLaunch : public ::testing::TestWithParam<bool> {
   }
 
   /// Runs demo.launch with a master of its own on a port no other test uses; returns its exit code.
-  static int runDemoLaunch(const std::string& out_dir, bool nodelets, std::string* log) {
+  static int runDemoLaunch(const std::string& out_dir, bool nodelets, std::string* log,
+                           const std::string& more = "") {
     const int port = freeTcpPort();
     const std::string uri = "http://localhost:" + std::to_string(port);
-    const std::string command =
-        "ROS_MASTER_URI=" + uri + " timeout 150 roslaunch -p " + std::to_string(port) +
-        " sift_hull demo.launch bag:=" + dir_ + "/scene.bag out:=" + out_dir +
-        " max_depth:=" + std::to_string(kDepth) + " nodelets:=" + (nodelets ? "true" : "false");
+    const std::string command = "ROS_MASTER_URI=" + uri + " timeout 150 roslaunch -p " +
+                                std::to_string(port) + " sift_hull demo.launch bag:=" + dir_ +
+                                "/scene.bag out:=" + out_dir +
+                                " max_depth:=" + std::to_string(kDepth) +
+                                " nodelets:=" + (nodelets ? "true" : "false") + more;
     std::string err;
     const int status = test::runCommand(command, log, &err);
     *log += err;
@@ -92,6 +95,27 @@ TEST_P(DemoLaunch, PlaysTheBagThroughBothNodesAndSavesTheResults) {
   const TriangleMesh offline_mesh = readPly(dir_ + "/offline.ply");
   EXPECT_TRUE(checkMesh(node_mesh).watertight);
   EXPECT_NEAR(meshVolume(node_mesh), meshVolume(offline_mesh), 0.05 * meshVolume(offline_mesh));
+}
+
+TEST_F(DemoLaunch, PhotoCarveGivesTheHullNodeTheBagsImagesAndTheSavedCloudItsColours) {
+  const std::string out = dir_ + "/photo";
+  std::string log;
+  ASSERT_EQ(runDemoLaunch(out, false, &log, " photo_carve:=true"), 0) << log;
+  std::ifstream summary_file(out + "/summary.json");
+  ASSERT_TRUE(summary_file) << "no summary.json; roslaunch said:\n" << log;
+  const nlohmann::json summary = nlohmann::json::parse(summary_file);
+  EXPECT_TRUE(summary["complete"].get<bool>()) << summary.dump(2);
+  EXPECT_EQ(log.find("photo carving leaves out"), std::string::npos)
+      << "a view without its photograph:\n"
+      << log;
+  // The PCD's header names its fields: the centres with PCL's rgb.
+  std::ifstream pcd(summary["files"]["point_cloud"].get<std::string>());
+  std::string line;
+  bool rgb = false;
+  while (std::getline(pcd, line) && line.rfind("DATA", 0) != 0) {
+    if (line.rfind("FIELDS", 0) == 0) rgb = line.find(" rgb") != std::string::npos;
+  }
+  EXPECT_TRUE(rgb) << "the saved cloud has no rgb field";
 }
 
 INSTANTIATE_TEST_SUITE_P(NodesAndNodelets, DemoLaunch, ::testing::Bool(),

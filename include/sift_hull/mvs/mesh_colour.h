@@ -52,8 +52,9 @@ ColourError colourError(const MeshRendering& rendering, const cv::Mat& photo, co
 /// `tree` as OctoMap's ColorOcTree (octovis and rviz's octomap plugin show its colours): the same
 /// nodes and occupancy, each occupied leaf of the finest level coloured by the mean colour of the
 /// coloured mesh's vertices in it, or when none lies in it, of those in the 26 voxels around it
-/// (coarser occupied leaves, the inside, stay white). Throws std::invalid_argument for a mesh
-/// without one colour per vertex.
+/// (coarser occupied leaves, the inside, stay white; a pruned block of occupied voxels that holds a
+/// vertex is expanded to the voxels that hold one, with its occupancy). Throws
+/// std::invalid_argument for a mesh without one colour per vertex.
 std::unique_ptr<octomap::ColorOcTree> colourOctomap(const octomap::OcTree& tree,
                                                     const TriangleMesh& mesh);
 

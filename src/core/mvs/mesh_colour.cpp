@@ -285,7 +285,24 @@ std::unique_ptr<octomap::ColorOcTree> colourOctomap(const octomap::OcTree& tree,
     for (int c = 0; c < 3; ++c) sum[c] += mesh.colours_rgb[v][c];
     sum[3] += 1.0;
   }
+  // The tree is pruned: a block of occupied finest leaves (a flat face along the grid) is one
+  // coarser leaf. Each block holding a vertex is expanded down to the voxel that holds it (the
+  // same occupancy), so that its surface voxels get their own colours.
+  // (OcTree::setNodeValue would prune the equal children right back.)
   const unsigned finest = coloured->getTreeDepth();
+  for (const auto& voxel : sums) {
+    octomap::ColorOcTreeNode* node = coloured->getRoot();
+    for (unsigned depth = 0; node != nullptr && depth < finest; ++depth) {
+      const unsigned child =
+          octomap::computeChildIdx(voxel.first, static_cast<int>(finest - 1 - depth));
+      if (!coloured->nodeChildExists(node, child)) {
+        // A leaf: expanded when occupied; an unknown child of an inner node: nothing to colour.
+        if (coloured->nodeHasChildren(node) || !coloured->isNodeOccupied(node)) break;
+        coloured->expandNode(node);
+      }
+      node = coloured->getNodeChild(node, child);
+    }
+  }
   for (auto leaf = coloured->begin_leafs(); leaf != coloured->end_leafs(); ++leaf) {
     if (leaf.getDepth() != finest || !coloured->isNodeOccupied(*leaf)) continue;
     const octomap::OcTreeKey key = leaf.getKey();

@@ -21,8 +21,10 @@ template <>
 const SettingTable<ResultSaverConfig>& settingsOf<ResultSaverConfig>() {
   static const SettingTable<ResultSaverConfig> table = [] {
     SettingTable<ResultSaverConfig> t;
-    t.add("bag", &ResultSaverConfig::bag, "", "the bag being played (written by sift_hull_ros bag); required");
-    t.add("out_dir", &ResultSaverConfig::out_dir, "", "where the results are written (created if missing); required");
+    t.add("bag", &ResultSaverConfig::bag, "",
+          "the bag being played (written by sift_hull_ros bag); required");
+    t.add("out_dir", &ResultSaverConfig::out_dir, "",
+          "where the results are written (created if missing); required");
     t.add("hull_save_service", &ResultSaverConfig::hull_save_service, "",
           "hull_node's save service, called at the end");
     t.add("timeout_s", &ResultSaverConfig::timeout_s, "s",
@@ -139,10 +141,15 @@ std::string ResultSaver::saveHull() const {
 
 std::string ResultSaver::saveCloud() const {
   if (!cloud_) return "";
-  pcl::PointCloud<pcl::PointXYZ> cloud;
-  pcl::fromROSMsg(*cloud_, cloud);
+  // Every field the cloud has: x, y, z, and rgb (PCL's PointXYZRGB) with ~photo_carve.
+  pcl::PCLPointCloud2 cloud;
+  pcl_conversions::toPCL(*cloud_, cloud);
   const std::string path = config_.out_dir + "/occupied_cells.pcd";
-  if (cloud.empty() || pcl::io::savePCDFileBinary(path, cloud) != 0) return "";
+  if (cloud.width * cloud.height == 0 ||
+      pcl::io::savePCDFile(path, cloud, Eigen::Vector4f::Zero(), Eigen::Quaternionf::Identity(),
+                           true) != 0) {
+    return "";
+  }
   return path;
 }
 
