@@ -5,12 +5,11 @@
 
 #include <gtest/gtest.h>
 
-#include <opencv2/imgproc.hpp>
-
 #include <algorithm>
 #include <chrono>
 #include <future>
 #include <memory>
+#include <opencv2/imgproc.hpp>
 #include <set>
 #include <tuple>
 #include <vector>
@@ -154,10 +153,10 @@ TEST(PhotoStream, KeepsAtMostMaxViewsAndRefusesImagesThatDoNotFit) {
   cv::Mat grey;
   cv::cvtColor(view.image, grey, cv::COLOR_BGR2GRAY);
   EXPECT_TRUE(stream.add("b", scene.views[1].view.camera, grey, scene.views[1].mask));
-  EXPECT_TRUE(stream.add("c", scene.views[2].view.camera, scene.views[2].image,
-                         scene.views[2].mask));
-  EXPECT_FALSE(stream.add("d", scene.views[3].view.camera, scene.views[3].image,
-                          scene.views[3].mask));
+  EXPECT_TRUE(
+      stream.add("c", scene.views[2].view.camera, scene.views[2].image, scene.views[2].mask));
+  EXPECT_FALSE(
+      stream.add("d", scene.views[3].view.camera, scene.views[3].image, scene.views[3].mask));
   EXPECT_EQ(stream.keptViews(), 3u);
   EXPECT_EQ(stream.leftOutViews(), 1u);
   PhotoStreamConfig bad = streamConfig();

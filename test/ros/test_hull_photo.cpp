@@ -13,10 +13,10 @@
 #include <pcl_conversions/pcl_conversions.h>
 #include <ros/ros.h>
 #include <rosgraph_msgs/Log.h>
-#include <std_srvs/Empty.h>
 #include <sensor_msgs/CameraInfo.h>
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/PointCloud2.h>
+#include <std_srvs/Empty.h>
 #include <tf2_ros/static_transform_broadcaster.h>
 
 #include <algorithm>
@@ -29,6 +29,7 @@
 #include <sstream>
 #include <vector>
 
+#include "cup_scene.h"
 #include "hull_node_fixture.h"
 #include "lib/conversions.h"
 #include "ros_wait.h"
@@ -44,6 +45,7 @@ namespace {
 
 namespace rc = ros_conversions;
 using test::frameOf;
+using test::occupiedFraction;
 using test::waitFor;
 
 /// With 20 views the nearest neighbours are too far apart for the pocket's walls to pass the
@@ -51,39 +53,38 @@ using test::waitFor;
 constexpr int kCupViews = 40;
 constexpr int kDepth = 7;  ///< as hull_photo.test's ~max_depth
 
-SceneConfig cupScene() {
-  SceneConfig config = test::sphereSceneConfig();
-  config.shape = "cup";
-  config.views = kCupViews;
-  return config;
-}
-
-/// The fraction of `inside` points on a 40^3 grid over [lo, hi] that `occupied` holds.
-double occupiedFraction(const std::function<bool(const Eigen::Vector3d&)>& occupied,
-                        const std::function<bool(const Eigen::Vector3d&)>& inside) {
-  const Eigen::Vector3d lo(-0.75, -0.75, -0.65), hi(0.75, 0.75, 0.65);
-  size_t in = 0, held = 0;
-  const int n = 40;
-  for (int k = 0; k < n; ++k) {
-    for (int j = 0; j < n; ++j) {
-      for (int i = 0; i < n; ++i) {
-        const Eigen::Vector3d X =
-            lo + (hi - lo).cwiseProduct((Eigen::Vector3d(i, j, k).array() + 0.5).matrix() / n);
-        if (!inside(X)) continue;
-        ++in;
-        held += occupied(X) ? 1 : 0;
-      }
-    }
+/// The silhouette, image and camera_info publishers of one test, and the node's octomap_binary.
+struct PhotoInputs {
+  explicit PhotoInputs(ros::NodeHandle nh)
+      : silhouette(nh.advertise<sensor_msgs::Image>("silhouette", 50)),
+        image(nh.advertise<sensor_msgs::Image>("image", 50)),
+        info(nh.advertise<sensor_msgs::CameraInfo>("camera_info", 50)),
+        map_sub(nh.subscribe<sift_hull::Octomap>(
+            "octomap_binary", 5, [this](const sift_hull::OctomapConstPtr& m) { last_map = m; })) {}
+  bool connected() {
+    return waitFor([&] {
+      return silhouette.getNumSubscribers() > 0 && image.getNumSubscribers() > 0 &&
+             info.getNumSubscribers() > 0;
+    });
   }
-  return in == 0 ? 0.0 : static_cast<double>(held) / in;
-}
-
-std::function<bool(const Eigen::Vector3d&)> occupiedIn(const octomap::OcTree& map) {
-  return [&map](const Eigen::Vector3d& X) {
-    const octomap::OcTreeNode* node = map.search(X.x(), X.y(), X.z());
-    return node != nullptr && map.isNodeOccupied(node);
-  };
-}
+  /// View v with its photograph (`photo`: changed first); its stamp.
+  ros::Time send(const RenderedView& view, int v,
+                 const std::function<void(sensor_msgs::Image*)>& photo = {}) {
+    std_msgs::Header header;
+    header.stamp = ros::Time::now();
+    header.frame_id = frameOf(v);
+    sensor_msgs::Image image_message = rc::imageMessage(view.image, header);
+    if (photo) photo(&image_message);
+    info.publish(rc::cameraInfoMessage(view.view.camera, view.mask.size(), header));
+    image.publish(image_message);
+    silhouette.publish(rc::imageMessage(view.mask, header));
+    ros::WallDuration(0.05).sleep();
+    return header.stamp;
+  }
+  ros::Publisher silhouette, image, info;
+  ros::Subscriber map_sub;
+  sift_hull::OctomapConstPtr last_map;
+};
 
 /// The colour (r, g, b) the views show at X: the per-channel median over the views whose depth
 /// map puts their surface within `tolerance_m` of X's depth; false when no view sees X.
@@ -114,7 +115,7 @@ bool seenColour(const std::vector<RenderedView>& views, const std::vector<cv::Ma
 
 TEST(HullPhotoTest, PassesCarveTheCupsPocketAndColourTheCloud) {
   ros::NodeHandle nh;
-  const std::vector<RenderedView> views = renderScene(cupScene());
+  const std::vector<RenderedView> views = renderScene(test::cupScene(kCupViews));
   // The visual hull of the same views, as the node builds it without photographs.
   HullStreamConfig stream_config;
   stream_config.hull.max_depth = kDepth;
@@ -124,55 +125,31 @@ TEST(HullPhotoTest, PassesCarveTheCupsPocketAndColourTheCloud) {
   }
   ASSERT_TRUE(silhouettes_only.hasHull());
   const std::unique_ptr<octomap::OcTree> hull_map = toOctomap(silhouettes_only.hull());
-  const Shape cup = Shape::byName("cup");
-  const Shape filled = cup.withoutCuts();
-  const auto pocket = [&](const Eigen::Vector3d& X) {
-    return filled.contains(X) && !cup.contains(X);
-  };
-  const auto solid = [&](const Eigen::Vector3d& X) { return cup.contains(X); };
-  const double pocket_hull = occupiedFraction(occupiedIn(*hull_map), pocket);
-  const double solid_hull = occupiedFraction(occupiedIn(*hull_map), solid);
+  const test::CupRegions regions;
+  const double pocket_hull = occupiedFraction(*hull_map, regions.pocket);
+  const double solid_hull = occupiedFraction(*hull_map, regions.solid);
   ASSERT_GT(pocket_hull, 0.9) << "the silhouettes' hull should fill the pocket";
 
   tf2_ros::StaticTransformBroadcaster tf;
-  std::vector<geometry_msgs::TransformStamped> poses;
-  for (int v = 0; v < kCupViews; ++v) {
-    poses.push_back(rc::cameraPoseMessage(views[v].view.camera, "world", frameOf(v), {}));
-  }
-  tf.sendTransform(poses);
-  ros::Publisher silhouette_pub = nh.advertise<sensor_msgs::Image>("silhouette", 50);
-  ros::Publisher image_pub = nh.advertise<sensor_msgs::Image>("image", 50);
-  ros::Publisher info_pub = nh.advertise<sensor_msgs::CameraInfo>("camera_info", 50);
-  sift_hull::OctomapConstPtr last;
+  test::sendCameraPoses(&tf, views, kCupViews);
+  PhotoInputs inputs(nh);
   sensor_msgs::PointCloud2ConstPtr cloud;
-  ros::Subscriber map_sub = nh.subscribe<sift_hull::Octomap>(
-      "octomap_binary", 5, [&](const sift_hull::OctomapConstPtr& m) { last = m; });
   ros::Subscriber cloud_sub = nh.subscribe<sensor_msgs::PointCloud2>(
       "octomap_point_cloud_centers", 5,
       [&](const sensor_msgs::PointCloud2ConstPtr& m) { cloud = m; });
-  ASSERT_TRUE(waitFor([&] {
-    return silhouette_pub.getNumSubscribers() > 0 && image_pub.getNumSubscribers() > 0 &&
-           info_pub.getNumSubscribers() > 0;
-  })) << "the hull node did not subscribe";
-  for (int v = 0; v < kCupViews; ++v) {
-    std_msgs::Header header;
-    header.stamp = ros::Time::now();
-    header.frame_id = frameOf(v);
-    info_pub.publish(rc::cameraInfoMessage(views[v].view.camera, views[v].mask.size(), header));
-    image_pub.publish(rc::imageMessage(views[v].image, header));
-    silhouette_pub.publish(rc::imageMessage(views[v].mask, header));
-    ros::WallDuration(0.05).sleep();
-  }
+  ASSERT_TRUE(inputs.connected()) << "the hull node did not subscribe";
+  for (int v = 0; v < kCupViews; ++v) inputs.send(views[v], v);
+  const sift_hull::OctomapConstPtr& last = inputs.last_map;
   // The passes end one after another: wait until the pocket drops (or the deadline).
   double pocket_after = 1.0;
   const bool carved = waitFor(
       [&] {
         if (!last) return false;
-        pocket_after = occupiedFraction(occupiedIn(*rc::octreeFromMessage(*last)), pocket);
+        pocket_after = occupiedFraction(*rc::octreeFromMessage(*last), regions.pocket);
         return pocket_after < 0.9 * pocket_hull;
       },
       120.0);
-  const double solid_after = occupiedFraction(occupiedIn(*rc::octreeFromMessage(*last)), solid);
+  const double solid_after = occupiedFraction(*rc::octreeFromMessage(*last), regions.solid);
   std::cout << "pocket occupied " << pocket_hull << " -> " << pocket_after << ", cup " << solid_hull
             << " -> " << solid_after << '\n';
   EXPECT_TRUE(carved) << "the pocket stays " << pocket_after << " occupied";
@@ -219,7 +196,10 @@ TEST(HullPhotoTest, PassesCarveTheCupsPocketAndColourTheCloud) {
   // octomap_full: OctoMap's ColorOcTree with those colours.
   sift_hull::GetOctomap full;
   ASSERT_TRUE(ros::service::waitForService("octomap_full", ros::Duration(test::kDeadline_s)));
-  ASSERT_TRUE(ros::service::call("octomap_full", full));
+  // The first request asks the worker to keep the full map; under load it may take longer than
+  // the service waits (NODES.md, Services): asked again until it answers.
+  ASSERT_TRUE(waitFor([&] { return ros::service::call("octomap_full", full); }))
+      << "octomap_full did not answer";
   EXPECT_EQ(full.response.map.id, "ColorOcTree");
   octomap::ColorOcTree coloured(full.response.map.resolution);
   std::stringstream data(std::string(full.response.map.data.begin(), full.response.map.data.end()));
@@ -236,19 +216,10 @@ TEST(HullPhotoTest, PassesCarveTheCupsPocketAndColourTheCloud) {
 
 TEST(HullPhotoTest, PhotographsThatDoNotFitAreLeftOutWithTheirReasonAndTheViewsStillCarve) {
   ros::NodeHandle nh;
-  const std::vector<RenderedView> views = renderScene(cupScene());
+  const std::vector<RenderedView> views = renderScene(test::cupScene(kCupViews));
   tf2_ros::StaticTransformBroadcaster tf;
-  std::vector<geometry_msgs::TransformStamped> poses;
-  for (int v = 0; v < 4; ++v) {
-    poses.push_back(rc::cameraPoseMessage(views[v].view.camera, "world", frameOf(v), {}));
-  }
-  tf.sendTransform(poses);
-  ros::Publisher silhouette_pub = nh.advertise<sensor_msgs::Image>("silhouette", 10);
-  ros::Publisher image_pub = nh.advertise<sensor_msgs::Image>("image", 10);
-  ros::Publisher info_pub = nh.advertise<sensor_msgs::CameraInfo>("camera_info", 10);
-  sift_hull::OctomapConstPtr last;
-  ros::Subscriber map_sub = nh.subscribe<sift_hull::Octomap>(
-      "octomap_binary", 5, [&](const sift_hull::OctomapConstPtr& m) { last = m; });
+  test::sendCameraPoses(&tf, views, 4);
+  PhotoInputs inputs(nh);
   std::mutex mutex;
   std::vector<std::string> errors;
   bool heard_reset = false;
@@ -258,10 +229,7 @@ TEST(HullPhotoTest, PhotographsThatDoNotFitAreLeftOutWithTheirReasonAndTheViewsS
         if (log->msg.rfind("hull: reset", 0) == 0) heard_reset = true;
         if (log->level == rosgraph_msgs::Log::ERROR) errors.push_back(log->msg);
       });
-  ASSERT_TRUE(waitFor([&] {
-    return silhouette_pub.getNumSubscribers() > 0 && image_pub.getNumSubscribers() > 0 &&
-           info_pub.getNumSubscribers() > 0;
-  })) << "the hull node did not subscribe";
+  ASSERT_TRUE(inputs.connected()) << "the hull node did not subscribe";
   // From no hull, once the node's /rosout lines reach this test.
   ASSERT_TRUE(waitFor([&] {
     std_srvs::Empty reset;
@@ -275,19 +243,17 @@ TEST(HullPhotoTest, PhotographsThatDoNotFitAreLeftOutWithTheirReasonAndTheViewsS
   })) << "no line of the hull node reached this test on /rosout";
   ros::Time stamp;
   for (int v = 0; v < 4; ++v) {
-    std_msgs::Header header;
-    header.stamp = stamp = ros::Time::now();
-    header.frame_id = frameOf(v);
-    cv::Mat photo = views[v].image;
-    if (v == 1) photo = cv::Mat(photo, cv::Rect(0, 0, 100, 80)).clone();  // not the mask's size
-    sensor_msgs::Image image = rc::imageMessage(photo, header);
-    if (v == 2) image.encoding = "32FC1";  // not an 8-bit image (the bytes are 4 per pixel)
-    if (v == 2) image.step = image.width * 4;
-    if (v == 2) image.data.resize(image.step * image.height);
-    info_pub.publish(rc::cameraInfoMessage(views[v].view.camera, views[v].mask.size(), header));
-    image_pub.publish(image);
-    silhouette_pub.publish(rc::imageMessage(views[v].mask, header));
-    ros::WallDuration(0.05).sleep();
+    stamp = inputs.send(views[v], v, [&](sensor_msgs::Image* image) {
+      if (v == 1) {  // not the silhouette's size
+        std_msgs::Header header = image->header;
+        *image = rc::imageMessage(cv::Mat(views[v].image, cv::Rect(0, 0, 100, 80)).clone(), header);
+      }
+      if (v == 2) {  // not an 8-bit image (the bytes are 4 per pixel)
+        image->encoding = "32FC1";
+        image->step = image->width * 4;
+        image->data.resize(image->step * image->height);
+      }
+    });
   }
   const auto logged = [&](const std::string& a, const std::string& b) {
     std::lock_guard<std::mutex> lock(mutex);
@@ -301,7 +267,7 @@ TEST(HullPhotoTest, PhotographsThatDoNotFitAreLeftOutWithTheirReasonAndTheViewsS
   EXPECT_TRUE(waitFor([&] { return logged(frameOf(2), "32FC1"); }))
       << "no error for the photograph that is not 8-bit";
   // Every view carved all the same: the map of the last.
-  EXPECT_TRUE(waitFor([&] { return last && last->header.stamp >= stamp; }))
+  EXPECT_TRUE(waitFor([&] { return inputs.last_map && inputs.last_map->header.stamp >= stamp; }))
       << "no map with the last view";
 }
 

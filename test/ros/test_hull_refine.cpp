@@ -19,6 +19,7 @@
 #include <limits>
 #include <memory>
 
+#include "cup_scene.h"
 #include "hull_node_fixture.h"
 #include "lib/conversions.h"
 #include "ros_wait.h"
@@ -42,34 +43,7 @@ constexpr int kPartners = 4;
 
 using test::frameOf;
 
-/// The hull rostests' scene (320x240, views on a sphere) with the cup and 20 views.
-SceneConfig cupScene() {
-  SceneConfig config = test::sphereSceneConfig();
-  config.shape = "cup";
-  config.views = kCupViews;
-  return config;
-}
-
-/// The fraction of `inside` points on a grid over the cube [lo, hi] that the map holds occupied.
-double occupiedFraction(const octomap::OcTree& map, const Eigen::Vector3d& lo,
-                        const Eigen::Vector3d& hi,
-                        const std::function<bool(const Eigen::Vector3d&)>& inside) {
-  size_t in = 0, occupied = 0;
-  const int n = 40;
-  for (int k = 0; k < n; ++k) {
-    for (int j = 0; j < n; ++j) {
-      for (int i = 0; i < n; ++i) {
-        const Eigen::Vector3d X =
-            lo + (hi - lo).cwiseProduct((Eigen::Vector3d(i, j, k).array() + 0.5).matrix() / n);
-        if (!inside(X)) continue;
-        ++in;
-        const octomap::OcTreeNode* node = map.search(X.x(), X.y(), X.z());
-        occupied += node != nullptr && map.isNodeOccupied(node) ? 1 : 0;
-      }
-    }
-  }
-  return in == 0 ? 0.0 : static_cast<double>(occupied) / in;
-}
+using test::occupiedFraction;
 
 /// View v's depth-map points (every `step`-th pixel) that view w sees too, as w would.
 sift_hull::SurfacePoints exactPairPoints(const RenderedView& v, const RenderedView& w, int step) {
@@ -98,13 +72,9 @@ sift_hull::SurfacePoints exactPairPoints(const RenderedView& v, const RenderedVi
 
 TEST(HullRefineTest, SurfacePointsCarveTheCupsPocketFromTheOctomapAndNothingOfTheCup) {
   ros::NodeHandle nh;
-  const std::vector<RenderedView> views = renderScene(cupScene());
+  const std::vector<RenderedView> views = renderScene(test::cupScene(kCupViews));
   tf2_ros::StaticTransformBroadcaster tf;
-  std::vector<geometry_msgs::TransformStamped> poses;
-  for (int v = 0; v < kCupViews; ++v) {
-    poses.push_back(rc::cameraPoseMessage(views[v].view.camera, "world", frameOf(v), {}));
-  }
-  tf.sendTransform(poses);
+  test::sendCameraPoses(&tf, views, kCupViews);
   ros::Publisher silhouette_pub = nh.advertise<sensor_msgs::Image>("silhouette", 50);
   ros::Publisher info_pub = nh.advertise<sensor_msgs::CameraInfo>("camera_info", 50);
   ros::Publisher points_pub = nh.advertise<sift_hull::SurfacePoints>("surface_points", 50);
@@ -132,16 +102,11 @@ TEST(HullRefineTest, SurfacePointsCarveTheCupsPocketFromTheOctomapAndNothingOfTh
   }
   ASSERT_TRUE(waitFor([&] { return last && last->header.stamp >= stamp; }, 60.0))
       << "no octomap of the silhouettes";
-  const Shape cup = Shape::byName("cup");
-  const Shape filled = cup.withoutCuts();
-  const auto pocket = [&](const Eigen::Vector3d& X) {
-    return filled.contains(X) && !cup.contains(X);
-  };
-  const auto solid = [&](const Eigen::Vector3d& X) { return cup.contains(X); };
-  const Eigen::Vector3d lo(-0.75, -0.75, -0.65), hi(0.75, 0.75, 0.65);
+  const test::CupRegions regions;
+  const test::Region &pocket = regions.pocket, &solid = regions.solid;
   const std::unique_ptr<octomap::OcTree> carved_by_silhouettes = rc::octreeFromMessage(*last);
-  const double pocket_before = occupiedFraction(*carved_by_silhouettes, lo, hi, pocket);
-  const double solid_before = occupiedFraction(*carved_by_silhouettes, lo, hi, solid);
+  const double pocket_before = occupiedFraction(*carved_by_silhouettes, pocket);
+  const double solid_before = occupiedFraction(*carved_by_silhouettes, solid);
   EXPECT_GT(pocket_before, 0.9) << "the silhouettes' hull should fill the pocket";
   EXPECT_GT(solid_before, 0.98);
 
@@ -183,11 +148,11 @@ TEST(HullRefineTest, SurfacePointsCarveTheCupsPocketFromTheOctomapAndNothingOfTh
   const bool carved = waitFor(
       [&] {
         if (!last) return false;
-        pocket_after = occupiedFraction(*rc::octreeFromMessage(*last), lo, hi, pocket);
+        pocket_after = occupiedFraction(*rc::octreeFromMessage(*last), pocket);
         return pocket_after < 0.8 * pocket_before;
       },
       90.0);
-  solid_after = occupiedFraction(*rc::octreeFromMessage(*last), lo, hi, solid);
+  solid_after = occupiedFraction(*rc::octreeFromMessage(*last), solid);
   std::cout << "pocket occupied " << pocket_before << " -> " << pocket_after << ", cup "
             << solid_before << " -> " << solid_after << '\n';
   EXPECT_TRUE(carved) << "the pocket stays " << pocket_after << " occupied";

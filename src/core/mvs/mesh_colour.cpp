@@ -15,6 +15,7 @@
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
+#include <unordered_set>
 
 #include "common/parallel.h"
 
@@ -259,6 +260,17 @@ ColourError colourError(const MeshRendering& rendering, const cv::Mat& photo, co
   return error;
 }
 
+namespace {
+/// The key of voxel n (0 .. 26) of the 3x3x3 block around `key`.
+octomap::OcTreeKey neighbourKey(const octomap::OcTreeKey& key, int n) {
+  octomap::OcTreeKey around = key;
+  around[0] = static_cast<octomap::key_type>(around[0] + n % 3 - 1);
+  around[1] = static_cast<octomap::key_type>(around[1] + n / 3 % 3 - 1);
+  around[2] = static_cast<octomap::key_type>(around[2] + n / 9 - 1);
+  return around;
+}
+}  // namespace
+
 std::unique_ptr<octomap::ColorOcTree> colourOctomap(const octomap::OcTree& tree,
                                                     const TriangleMesh& mesh) {
   if (mesh.colours_rgb.size() != mesh.vertices_W.size()) {
@@ -286,15 +298,19 @@ std::unique_ptr<octomap::ColorOcTree> colourOctomap(const octomap::OcTree& tree,
     sum[3] += 1.0;
   }
   // The tree is pruned: a block of occupied finest leaves (a flat face along the grid) is one
-  // coarser leaf. Each block holding a vertex is expanded down to the voxel that holds it (the
-  // same occupancy), so that its surface voxels get their own colours.
+  // coarser leaf. Each block holding a vertex or one of the 26 voxels around a vertex is expanded
+  // down to that voxel (the same occupancy), so that the surface voxels get their own colours. (A
+  // vertex on a cell's face may fall in the free voxel beside the occupied one.)
   // (OcTree::setNodeValue would prune the equal children right back.)
   const unsigned finest = coloured->getTreeDepth();
+  std::unordered_set<octomap::OcTreeKey, octomap::OcTreeKey::KeyHash> near_vertices;
   for (const auto& voxel : sums) {
+    for (int n = 0; n < 27; ++n) near_vertices.insert(neighbourKey(voxel.first, n));
+  }
+  for (const octomap::OcTreeKey& key : near_vertices) {
     octomap::ColorOcTreeNode* node = coloured->getRoot();
     for (unsigned depth = 0; node != nullptr && depth < finest; ++depth) {
-      const unsigned child =
-          octomap::computeChildIdx(voxel.first, static_cast<int>(finest - 1 - depth));
+      const unsigned child = octomap::computeChildIdx(key, static_cast<int>(finest - 1 - depth));
       if (!coloured->nodeChildExists(node, child)) {
         // A leaf: expanded when occupied; an unknown child of an inner node: nothing to colour.
         if (coloured->nodeHasChildren(node) || !coloured->isNodeOccupied(node)) break;
@@ -310,11 +326,7 @@ std::unique_ptr<octomap::ColorOcTree> colourOctomap(const octomap::OcTree& tree,
     const auto own = sums.find(key);
     if (own != sums.end()) total = own->second;  // its own vertices; else those around it
     for (int n = 0; n < 27 && total[3] == 0.0; ++n) {
-      octomap::OcTreeKey around = key;
-      around[0] = static_cast<octomap::key_type>(around[0] + n % 3 - 1);
-      around[1] = static_cast<octomap::key_type>(around[1] + n / 3 % 3 - 1);
-      around[2] = static_cast<octomap::key_type>(around[2] + n / 9 - 1);
-      const auto found = sums.find(around);
+      const auto found = sums.find(neighbourKey(key, n));
       if (found == sums.end()) continue;
       for (int c = 0; c < 4; ++c) total[c] += found->second[c];
     }
