@@ -97,9 +97,7 @@ RefineViews refineViews(const std::string& folder, const HullInput& input) {
   views.image = [folder, &input](uint32_t view) {
     return readImage(folder + "/" + input.names.at(view));
   };
-  views.mask = [&input](uint32_t view) {
-    return input.masks.empty() ? input.run_length_masks.at(view).decode() : input.masks.at(view);
-  };
+  views.mask = [&input](uint32_t view) { return input.mask(view); };
   return views;
 }
 
@@ -341,9 +339,7 @@ std::optional<HeldOutView> holdOutView(const ArgParser& parser, HullInput* input
     throw UsageError("--holdout-view " + name + " is not one of the views");
   }
   const size_t index = static_cast<size_t>(found - input->names.begin());
-  HeldOutView view{
-      name, input->cameras.at(index),
-      input->masks.empty() ? input->run_length_masks.at(index).decode() : input->masks.at(index)};
+  HeldOutView view{name, input->cameras.at(index), input->mask(index)};
   input->names.erase(input->names.begin() + index);
   input->cameras.erase(input->cameras.begin() + index);
   if (input->masks.empty()) {
@@ -356,8 +352,12 @@ std::optional<HeldOutView> holdOutView(const ArgParser& parser, HullInput* input
 
 nlohmann::json heldOutError(const ArgParser& parser, const HullInput& input,
                             const HeldOutView& view, TriangleMesh mesh, int threads) {
-  const RefineViews views = refineViews(parser.get("images"), input);
-  sift_hull::colourMesh(&mesh, views.cameras, views.image, threads);
+  // The refined model's mesh is coloured already when --out-mesh asked for it (colourMesh above,
+  // by the same views): coloured again only otherwise.
+  if (mesh.colours_rgb.size() != mesh.vertices_W.size()) {
+    const RefineViews views = refineViews(parser.get("images"), input);
+    sift_hull::colourMesh(&mesh, views.cameras, views.image, threads);
+  }
   const cv::Mat photo = readImage(parser.get("images") + "/" + view.name);
   const ColourError error =
       colourError(renderColouredMesh(mesh, view.camera, photo.size()), photo, view.mask);

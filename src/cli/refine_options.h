@@ -42,7 +42,8 @@ struct HeldOutView {
 /// or for a name that is not one of the views.
 std::optional<HeldOutView> holdOutView(const ArgParser& parser, HullInput* input);
 
-/// `mesh` coloured by the views of `input` and rendered into the held-out view: its colour error
+/// `mesh` coloured by the views of `input` (unless it has a colour per vertex already, which
+/// colourMesh gave it from the same views) and rendered into the held-out view: its colour error
 /// against the photograph inside the view's silhouette ({"mae", "psnr_db"}).
 nlohmann::json heldOutError(const ArgParser& parser, const HullInput& input,
                             const HeldOutView& view, TriangleMesh mesh, int threads);

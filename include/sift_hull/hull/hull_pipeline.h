@@ -24,6 +24,10 @@ struct HullInput {
 
   /// Number of views: of `masks`, else of `run_length_masks`.
   size_t viewCount() const { return masks.empty() ? run_length_masks.size() : masks.size(); }
+  /// View `view`'s silhouette: from `masks`, else decoded from `run_length_masks`.
+  cv::Mat mask(size_t view) const {
+    return masks.empty() ? run_length_masks.at(view).decode() : masks.at(view);
+  }
 };
 
 /// Wall-clock times of the stages of buildHull, in milliseconds: the masks' run-length encoding

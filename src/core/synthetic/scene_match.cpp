@@ -73,7 +73,7 @@ void requireViewsOfScene(const SceneData& scene, const std::string& scene_direct
                                number(max_gap_px) + " px): another scene?");
     }
     if (input.viewCount() == 0) continue;  // cameras only
-    const cv::Mat mask = input.masks.empty() ? input.run_length_masks[i].decode() : input.masks[i];
+    const cv::Mat mask = input.mask(i);
     const double iou = maskIoU(mask, loadMask(scene_directory + "/" + kMaskDirectory + "/" + name));
     if (!(iou >= kMinMaskIoU)) {
       throw std::runtime_error(refusal + name + "': its silhouette overlaps the scene's mask by " +
