@@ -51,6 +51,7 @@ set(SIFT_HULL_CORE_SOURCES
   src/core/hull/silhouette.cpp
   src/core/mvs/depth_maps.cpp
   src/core/mvs/mesh_colour.cpp
+  src/core/mvs/patch_match.cpp
   src/core/mvs/photo_carving.cpp
   src/core/mvs/photo_stream.cpp
   src/core/refine/dense_matching.cpp

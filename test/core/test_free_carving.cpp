@@ -152,6 +152,58 @@ TEST_F(FreeCarving, AnyOrderOfViewsAndVoxelsGivesTheSameTree) {
   EXPECT_TRUE(checkMesh(carved_first.mesh()).watertight);
 }
 
+TEST_F(FreeCarving, SurfaceCellsTheMeshLeavesEmptyAreFreeInTheMaps) {
+  VisualHull hull(box_, depth(6));
+  hull.addViews(views_);
+  EXPECT_TRUE(hull.hollowVoxels().empty());  // no free voxels: nothing to decide
+  // The top of the ball cut off: the walls beside the cut, where it meets the silhouettes'
+  // surface, have corners outside by f_iso and corners on free voxels.
+  const HullCube& cube = hull.cube();
+  Box3d top = box_;
+  top.min_W.z() = box_.max_W.z() - 0.3 * (box_.max_W.z() - box_.min_W.z());
+  hull.carveFree(occupiedVoxelsIn(hull, top, 1u << 20));
+  const std::vector<Eigen::Vector3i> hollow = hull.hollowVoxels();
+  ASSERT_FALSE(hollow.empty());
+  const TriangleMesh mesh = hull.mesh();
+  const std::unique_ptr<octomap::OcTree> tree = toOctomap(hull);
+  for (const Eigen::Vector3i& voxel : hollow) {
+    // A finest surface cell: occupied in the tree of the silhouettes, free in the maps now.
+    const Eigen::Vector3d lo = cube.origin_W() + voxel.cast<double>() * cube.resolution_m;
+    const HullCell cell = hull.leafAt(lo + Eigen::Vector3d::Constant(0.5 * cube.resolution_m));
+    ASSERT_EQ(cell.state, CellState::kSurface);
+    ASSERT_EQ(cell.depth, cube.depth);
+    const Eigen::Vector3d c = lo + Eigen::Vector3d::Constant(0.5 * cube.resolution_m);
+    const octomap::OcTreeNode* node = tree->search(c.x(), c.y(), c.z());
+    ASSERT_NE(node, nullptr);
+    EXPECT_FALSE(tree->isNodeOccupied(node));
+    // ... and the mesh has no vertex on its edges: marching cubes found no surface in it.
+    const double inset = 1e-6 * cube.resolution_m;
+    for (const Eigen::Vector3f& vertex_f : mesh.vertices_W) {
+      const Eigen::Vector3d vertex = vertex_f.cast<double>();
+      const bool within = ((vertex - lo).array() > inset).all() &&
+                          ((vertex - lo).array() < cube.resolution_m - inset).all();
+      ASSERT_FALSE(within) << "a mesh vertex inside hollow voxel " << voxel.transpose();
+    }
+  }
+  // The occupied blocks leave them out; the compact writer agrees with toOctomap byte for byte.
+  size_t occupied_voxels = 0;
+  for (const VoxelBlock& block : occupiedBlocks(hull)) {
+    occupied_voxels +=
+        static_cast<size_t>(block.edge_voxels) * block.edge_voxels * block.edge_voxels;
+  }
+  std::vector<VoxelBlock> occupied, carved;
+  leafBlocks(hull, &occupied, &carved);
+  EXPECT_EQ(occupied.size(), occupiedBlocks(hull).size());
+  size_t all_voxels = occupied_voxels;
+  for (const VoxelBlock& block : carved) {
+    all_voxels += static_cast<size_t>(block.edge_voxels) * block.edge_voxels * block.edge_voxels;
+  }
+  EXPECT_EQ(all_voxels, size_t{1} << (3 * cube.depth));  // every voxel once
+  std::stringstream reference;
+  writeOctomapBinaryData(*tree, reference);
+  EXPECT_TRUE(compactOctomap(hull).binary_data == reference.str());
+}
+
 TEST_F(FreeCarving, AVoxelEnclosedByFreeOnesIsFreeAndResetForgetsThemAll) {
   VisualHull hull(box_, depth(6));
   hull.addViews(views_);

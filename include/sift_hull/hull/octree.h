@@ -107,6 +107,12 @@ class VisualHull {
   /// The free voxels so far (those given and those the closure added), in no particular order.
   std::vector<Eigen::Vector3i> freeVoxels() const;
   size_t freeVoxelCount() const { return free_.size(); }
+  /// The finest surface cells beside free voxels where mesh()'s field, max(f_iso, f_free), is
+  /// positive at all eight corners: marching cubes leaves them without surface, and the maps
+  /// (occupiedBlocks, toOctomap, compactOctomap) call them free as the mesh does. Empty without
+  /// free voxels. Cost: the surface cells' 26 neighbours looked up, f_iso at the open corners of
+  /// those beside free voxels.
+  std::vector<Eigen::Vector3i> hollowVoxels() const;
 
   const HullCube& cube() const { return cube_; }
   const HullConfig& config() const { return config_; }
@@ -148,13 +154,18 @@ class VisualHull {
   void addFreeField(const std::vector<Eigen::Vector3d>& points_W, std::vector<float>* values) const;
 };
 
-/// Occupied cells for maps: in cells of any size and surface cells at the finest level, each as
+/// Occupied cells for maps: in cells of any size and surface cells at the finest level (but
+/// VisualHull::hollowVoxels), each as
 /// (min corner in voxels relative to the world origin, edge in voxels).
 struct VoxelBlock {
   Eigen::Vector3i min_voxels;
   int edge_voxels;
 };
 std::vector<VoxelBlock> occupiedBlocks(const VisualHull& hull);
+/// Every leaf as a block: occupied (occupiedBlocks') or carved (out cells of any size and the
+/// finest cells of VisualHull::hollowVoxels).
+void leafBlocks(const VisualHull& hull, std::vector<VoxelBlock>* occupied,
+                std::vector<VoxelBlock>* carved);
 
 /// The finest voxels (indices in the cube, as carveFree takes them) of the in and surface leaves
 /// that a world box touches. Throws std::invalid_argument, before listing them, when there are

@@ -29,22 +29,24 @@ struct PhotoCarveConfig {
   /// Patches of (2 r + 1)^2 pixels at that resolution.
   int photo_patch_radius_px = 2;
   /// A pixel's score at a depth is the mean NCC of its best this many neighbours there.
-  int photo_best_neighbours = 2;
+  int photo_best_neighbours = 1;
   /// Smallest score of a pixel's depth.
   double photo_min_ncc = 0.5;
   /// Patches flatter than this (standard deviation of the grey level, 0..1) get no depth.
   double photo_min_patch_std = 0.02;
   /// Depths swept per view, evenly in inverse depth over the hull's depth range in that view.
   int photo_depth_planes = 128;
+  /// Rounds of slanted-plane PatchMatch after the sweep (0: the sweep's fronto-parallel depths).
+  int photo_patch_match_rounds = 4;
   /// A depth agrees with a neighbour's depth map within this many finest voxels.
   double photo_consistency_voxels = 2.0;
   /// Neighbours whose depth maps must agree with a pixel's depth for it to be kept.
   int photo_min_consistent_views = 1;
   /// A voxel centre must lie this many finest voxels in front of a view's depth to be empty for it.
-  double photo_margin_voxels = 2.0;
+  double photo_margin_voxels = 1.0;
   /// Views that must see a voxel empty (and more of them than see the surface there) before it
   /// is free.
-  int photo_min_views = 3;
+  int photo_min_views = 2;
 };
 /// Its settings: names, units, ranges, help (sift_hull/settings.h).
 template <>

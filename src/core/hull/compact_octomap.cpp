@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <string>
+#include <unordered_set>
 #include <utility>
 #include <vector>
 
@@ -37,8 +38,20 @@ struct Cover {
   const OctreeNode* slot[8];
 };
 
-inline uint8_t leafCode(const OctreeNode& node) {
-  return node.state == CellState::kOut ? kFree : kOccupied;
+/// The finest leaves of the voxels VisualHull::hollowVoxels lists (free in the maps).
+std::unordered_set<const OctreeNode*> hollowLeaves(const VisualHull& hull) {
+  std::unordered_set<const OctreeNode*> leaves;
+  const int depth = hull.cube().depth;
+  for (const Eigen::Vector3i& voxel : hull.hollowVoxels()) {
+    const OctreeNode* node = &hull.rootNode();
+    for (int level = 0; level < depth && node->children; ++level) {
+      const int shift = depth - level - 1;
+      node = &node->children[((voxel.x() >> shift) & 1) | (((voxel.y() >> shift) & 1) << 1) |
+                             (((voxel.z() >> shift) & 1) << 2)];
+    }
+    leaves.insert(node);
+  }
+  return leaves;
 }
 
 /// The cube's depth from which its subtrees are written in parallel.
@@ -52,7 +65,8 @@ class OctomapWriter {
         threads_(hull.config().threads),
         origin_key_(hull.cube().origin_voxels + Eigen::Vector3i::Constant(kKeyOffset)),
         centres_(centres),
-        map_(map) {
+        map_(map),
+        hollow_(hollowLeaves(hull)) {
     toKeys({hull.cube().origin_voxels, 1 << depth_});  // throws beyond OctoMap's key range
     tabulateLevels();
   }
@@ -87,6 +101,11 @@ class OctomapWriter {
   };
 
   int cubeLevel() const { return kKeyDepth - depth_; }
+
+  uint8_t leafCode(const OctreeNode& node) const {
+    if (node.state == CellState::kOut) return kFree;
+    return !hollow_.empty() && hollow_.count(&node) ? kFree : kOccupied;
+  }
 
   /// A node of the split level while listing (none written) or joining (its written subtree).
   uint8_t split(const Eigen::Vector3i& min_key, const Cover& cover, CompactOctomap* out) {
@@ -261,6 +280,7 @@ class OctomapWriter {
   const Eigen::Vector3i origin_key_;  ///< the key of the cube's first voxel
   const bool centres_;                ///< whether the occupied leaves' centres are wanted
   CompactOctomap* map_;
+  const std::unordered_set<const OctreeNode*> hollow_;
   Stage stage_ = Stage::kJoin;
   int split_level_ = -1;  ///< none: written in one walk
   std::vector<std::pair<Eigen::Vector3i, Cover>> splits_;

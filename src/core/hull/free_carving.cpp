@@ -143,6 +143,52 @@ void VisualHull::addFreeField(const std::vector<Eigen::Vector3d>& points_W,
   }
 }
 
+std::vector<Eigen::Vector3i> VisualHull::hollowVoxels() const {
+  std::vector<Eigen::Vector3i> hollow;
+  if (free_.empty()) return hollow;
+  const int cells = 1 << cube_.depth;
+  // The finest surface cells with a corner on a free voxel, and their other corners.
+  std::vector<Eigen::Vector3i> candidates;
+  std::vector<Eigen::Vector3i> open_corners;  // corners not touching free voxels, per candidate
+  std::vector<uint8_t> open_masks;
+  for (const Eigen::Vector3i& voxel : surfaceCells().cells) {
+    bool near_free = false;
+    for (const Eigen::Vector3i& offset : neighbourOffsets()) {
+      const Eigen::Vector3i other = voxel + offset;
+      if (inCube(other, cells) && free_.count(detail::voxelKey(other)) > 0) {
+        near_free = true;
+        break;
+      }
+    }
+    if (!near_free) continue;
+    uint8_t open = 0;
+    for (int c = 0; c < 8; ++c) {
+      if (!cornerTouchesFree(free_, voxel + cornerOffset(c), cells)) {
+        open |= static_cast<uint8_t>(1u << c);
+        open_corners.push_back(voxel + cornerOffset(c));
+      }
+    }
+    candidates.push_back(voxel);
+    open_masks.push_back(open);
+  }
+  // f_iso at the open corners, sampled as mesh() samples them.
+  std::vector<Eigen::Vector3d> points_W;
+  points_W.reserve(open_corners.size());
+  for (const Eigen::Vector3i& corner : open_corners) {
+    points_W.push_back(cube_.origin_W() + corner.cast<double>() * cube_.resolution_m);
+  }
+  std::vector<float> values;
+  sampleField(points_W, &values);
+  size_t next = 0;
+  for (size_t i = 0; i < candidates.size(); ++i) {
+    bool outside = true;
+    for (int c = 0; c < 8; ++c) {
+      if (open_masks[i] >> c & 1u) outside = values[next++] > 0.0f && outside;
+    }
+    if (outside) hollow.push_back(candidates[i]);
+  }
+  return hollow;
+}
 
 namespace {
 
@@ -161,8 +207,10 @@ std::vector<Eigen::Vector3i> occupiedVoxelsIn(const VisualHull& hull, const Box3
                                               size_t max_voxels) {
   const HullCube& cube = hull.cube();
   const int cells = 1 << cube.depth;
-  const Eigen::Vector3d lo_f = ((box_W.min_W - cube.origin_W()) / cube.resolution_m).array().floor();
-  const Eigen::Vector3d hi_f = ((box_W.max_W - cube.origin_W()) / cube.resolution_m).array().floor();
+  const Eigen::Vector3d lo_f =
+      ((box_W.min_W - cube.origin_W()) / cube.resolution_m).array().floor();
+  const Eigen::Vector3d hi_f =
+      ((box_W.max_W - cube.origin_W()) / cube.resolution_m).array().floor();
   const Eigen::Vector3d last(cells - 1, cells - 1, cells - 1);
   // Clamped in double first: a box far outside the cube must not overflow an int.
   const Eigen::Vector3i lo = lo_f.cwiseMax(Eigen::Vector3d::Zero()).cwiseMin(last).cast<int>();

@@ -132,8 +132,10 @@ KeyBox touchedKeys(const octomap::OcTree& tree, const Box3d& box_W) {
 std::unique_ptr<octomap::OcTree> toOctomap(const VisualHull& hull) {
   auto tree = std::make_unique<BlockOcTree>(hull.cube().resolution_m);
   const float occupied = tree->getClampingThresMaxLog(), free = tree->getClampingThresMinLog();
-  for (const VoxelBlock& block : occupiedBlocks(hull)) tree->insertBlock(toKeys(block), occupied);
-  for (const VoxelBlock& block : carvedBlocks(hull)) tree->insertBlock(toKeys(block), free);
+  std::vector<VoxelBlock> occupied_blocks, carved_blocks;
+  leafBlocks(hull, &occupied_blocks, &carved_blocks);
+  for (const VoxelBlock& block : occupied_blocks) tree->insertBlock(toKeys(block), occupied);
+  for (const VoxelBlock& block : carved_blocks) tree->insertBlock(toKeys(block), free);
   tree->updateInnerOccupancy();
   pruneFully(tree.get());
   return tree;

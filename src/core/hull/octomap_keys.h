@@ -48,17 +48,5 @@ inline KeyBox toKeys(const VoxelBlock& block) {
   return keys;
 }
 
-/// The carved cells: out cells of any size, as blocks like occupiedBlocks'.
-inline std::vector<VoxelBlock> carvedBlocks(const VisualHull& hull) {
-  std::vector<VoxelBlock> blocks;
-  const HullCube& cube = hull.cube();
-  hull.forEachLeaf([&](const HullCell& cell) {
-    if (cell.state != CellState::kOut) return;
-    const int edge = 1 << (cube.depth - cell.depth);
-    blocks.push_back({cube.origin_voxels + cell.index * edge, edge});
-  });
-  return blocks;
-}
-
 }  // namespace octomap_keys
 }  // namespace sift_hull

@@ -11,6 +11,7 @@
 #include "common/parallel.h"
 #include "hull/field_sampling.h"
 #include "hull/octree_node.h"
+#include "hull/voxel_key.h"
 #include "sift_hull/hull/reduced_distance_map.h"
 #include "sift_hull/limits.h"
 
@@ -406,14 +407,22 @@ TriangleMesh VisualHull::mesh() const {
 }
 
 std::vector<VoxelBlock> occupiedBlocks(const VisualHull& hull) {
-  std::vector<VoxelBlock> blocks;
+  std::vector<VoxelBlock> occupied, carved;
+  leafBlocks(hull, &occupied, &carved);
+  return occupied;
+}
+
+void leafBlocks(const VisualHull& hull, std::vector<VoxelBlock>* occupied,
+                std::vector<VoxelBlock>* carved) {
+  std::unordered_set<uint64_t> hollow;
+  for (const Eigen::Vector3i& voxel : hull.hollowVoxels()) hollow.insert(detail::voxelKey(voxel));
   const HullCube& cube = hull.cube();
   hull.forEachLeaf([&](const HullCell& cell) {
-    if (cell.state == CellState::kOut) return;
     const int edge = 1 << (cube.depth - cell.depth);
-    blocks.push_back({cube.origin_voxels + cell.index * edge, edge});
+    const bool out = cell.state == CellState::kOut ||
+                     (edge == 1 && !hollow.empty() && hollow.count(detail::voxelKey(cell.index)));
+    (out ? carved : occupied)->push_back({cube.origin_voxels + cell.index * edge, edge});
   });
-  return blocks;
 }
 
 }  // namespace sift_hull

@@ -271,11 +271,10 @@ void sweepDepth(const std::vector<ReducedView>& views, uint32_t view,
       }
     }
   }
-  const float min_ncc = static_cast<float>(config.photo_min_ncc);
   for (int v = 0; v < size.height; ++v) {
     for (int u = 0; u < size.width; ++u) {
       const float s = best_score.at<float>(v, u);
-      if (!(s >= min_ncc) || ref_var.at<float>(v, u) <= min_var) continue;
+      if (best_plane.at<int>(v, u) < 0 || ref_var.at<float>(v, u) <= min_var) continue;
       // A parabola through the scores of the planes on either side, in inverse depth.
       double offset = 0.0;
       const float before = best_prev.at<float>(v, u), after = best_next.at<float>(v, u);

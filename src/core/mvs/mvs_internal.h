@@ -41,12 +41,21 @@ DepthRange hullDepthRange(const std::vector<HullCell>& occupied, const HullCube&
                           const PinholeCamera& camera, cv::Size size);
 
 /// The plane sweep of view `view` against its neighbours: each pixel's best depth within its
-/// range (refined between planes by a parabola through the scores) and its score, NaN where none
-/// passes the config. Adds the sweeps made to *sweeps.
+/// range (refined between planes by a parabola through the scores) and its score, NaN where no
+/// plane is scored (outside the silhouette, a flat patch, no neighbour sees it). Adds the sweeps
+/// made to *sweeps.
 void sweepDepth(const std::vector<ReducedView>& views, uint32_t view,
                 const std::vector<uint32_t>& neighbours, const DepthRange& range,
                 const PhotoCarveConfig& config, double voxel_m, cv::Mat* depth_m, cv::Mat* ncc,
                 size_t* sweeps);
+
+/// Slanted-plane PatchMatch from the sweep's depths (patch_match.cpp):
+/// config.photo_patch_match_rounds rounds refine *depth_m and *ncc in place, pixel by pixel inside
+/// the silhouette.
+void patchMatchDepth(const std::vector<ReducedView>& views, uint32_t view,
+                     const std::vector<uint32_t>& neighbours, const DepthRange& range,
+                     const PhotoCarveConfig& config, double voxel_m, cv::Mat* depth_m,
+                     cv::Mat* ncc);
 
 /// Keeps a pixel's depth where at least config.photo_min_consistent_views of its neighbours'
 /// depth maps agree with it within config.photo_consistency_voxels.

@@ -51,6 +51,9 @@ const SettingTable<PhotoCarveConfig>& settingsOf<PhotoCarveConfig>() {
     t.add("photo_depth_planes", &C::photo_depth_planes, "planes",
           "depths swept per view over the hull's depth range")
         .range(2, 4096);
+    t.add("photo_patch_match_rounds", &C::photo_patch_match_rounds, "rounds",
+          "rounds of slanted-plane PatchMatch after the sweep (0: fronto-parallel depths only)")
+        .range(0, 16);
     t.add("photo_consistency_voxels", &C::photo_consistency_voxels, "voxels",
           "a depth agrees with a neighbour's depth map within this many finest voxels")
         .above(0.0);
@@ -241,6 +244,11 @@ PhotoCarveResult photoCarve(const VisualHull& hull, const PhotoViews& views,
         detail::hullDepthRange(occupied, cube, depth.camera, reduced[v].grey.size());
     detail::sweepDepth(reduced, static_cast<uint32_t>(v), neighbours[v], range, config, voxel_m,
                        &depth.depth_m, &depth.ncc, &sweeps[v]);
+    detail::patchMatchDepth(reduced, static_cast<uint32_t>(v), neighbours[v], range, config,
+                            voxel_m, &depth.depth_m, &depth.ncc);
+    const cv::Mat weak = ~(depth.ncc >= config.photo_min_ncc);  // NaN scores compare false
+    depth.depth_m.setTo(NAN, weak);
+    depth.ncc.setTo(NAN, weak);
   });
   for (size_t v = 0; v < count; ++v) {
     result.sweeps += sweeps[v];
