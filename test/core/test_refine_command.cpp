@@ -9,6 +9,7 @@
 
 #include "common/test_data.h"
 #include "sift_hull/io/ply.h"
+#include "sift_hull/mvs/photo_carving.h"
 
 namespace sift_hull {
 namespace {
@@ -99,9 +100,10 @@ TEST(RefineCommand, PhotoCarvingCarvesAndReportsItsStages) {
   const nlohmann::json& photo = j["photo_carving"];
   EXPECT_GT(photo["carved_voxels"].get<int>(), 0) << out;
   // Views x neighbours (at most 6 within 75 degrees) x planes.
-  EXPECT_EQ(photo["sweeps"].get<int>() % 128, 0) << out;
-  EXPECT_GT(photo["sweeps"].get<int>(), 20 * 3 * 128) << out;
-  EXPECT_LE(photo["sweeps"].get<int>(), 20 * 6 * 128) << out;
+  const int planes = PhotoCarveConfig{}.photo_depth_planes;
+  EXPECT_EQ(photo["sweeps"].get<int>() % planes, 0) << out;
+  EXPECT_GT(photo["sweeps"].get<int>(), 20 * 3 * planes) << out;
+  EXPECT_LE(photo["sweeps"].get<int>(), 20 * 6 * planes) << out;
   EXPECT_GT(photo["depth_pixels"]["consistent"].get<int>(), 0) << out;
   EXPECT_LE(photo["depth_pixels"]["consistent"].get<int>(),
             photo["depth_pixels"]["swept"].get<int>());

@@ -35,7 +35,7 @@ struct PhotoCarveConfig {
   /// Patches flatter than this (standard deviation of the grey level, 0..1) get no depth.
   double photo_min_patch_std = 0.02;
   /// Depths swept per view, evenly in inverse depth over the hull's depth range in that view.
-  int photo_depth_planes = 128;
+  int photo_depth_planes = 64;
   /// Rounds of slanted-plane PatchMatch after the sweep (0: the sweep's fronto-parallel depths).
   int photo_patch_match_rounds = 4;
   /// A depth agrees with a neighbour's depth map within this many finest voxels.

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <limits>
 #include <mutex>
+#include <opencv2/imgproc.hpp>
 #include <stdexcept>
 #include <string>
 #include <tuple>
@@ -117,18 +118,77 @@ double exitOf(const Eigen::Vector3d& origin_W, const Eigen::Vector3d& direction,
   return t;
 }
 
-/// Whether one of a voxel's 26 neighbours is free: then a corner of it touches free space, where
-/// the mesh's free-space field (and carveFree's closure) cuts into it.
-bool touchesFree(const Eigen::Vector3i& voxel, int cells,
-                 const std::unordered_map<uint64_t, int>& free_votes) {
-  for (int n = 0; n < 27; ++n) {
-    const Eigen::Vector3i other = voxel + Eigen::Vector3i(n % 3 - 1, n / 3 % 3 - 1, n / 9 - 1);
-    if (n != 13 && detail::inCube(other, cells) && free_votes.count(detail::voxelKey(other))) {
-      return true;
+/// The free voxels and their votes, for the silhouettes' check: a bit per voxel of the cube for
+/// "free" and one for "one of its 26 neighbours is free" (then a corner of it touches free space,
+/// where the mesh's free-space field and carveFree's closure cut into it), 2^(3 depth - 2) bytes
+/// (4 MB at depth 8), so that the walks test bits; the votes in a hash map.
+class FreeSet {
+ public:
+  FreeSet(int depth, const std::vector<std::pair<Eigen::Vector3i, int>>& free)
+      : depth_(depth),
+        cells_(1 << depth),
+        free_bits_((size_t{1} << (3 * depth)) / 64 + 1, 0),
+        touch_bits_(free_bits_.size(), 0) {
+    for (const auto& [voxel, votes] : free) {
+      if (!detail::inCube(voxel, cells_)) continue;
+      votes_.emplace(detail::voxelKey(voxel), votes);
+      set(&free_bits_, voxel, true);
+    }
+    for (const auto& [voxel, votes] : free) {
+      for (int n = 0; n < 27; ++n) {
+        const Eigen::Vector3i other = voxel + offset(n);
+        if (n != 13 && detail::inCube(other, cells_)) set(&touch_bits_, other, true);
+      }
     }
   }
-  return false;
-}
+
+  bool empty() const { return votes_.empty(); }
+  const std::unordered_map<uint64_t, int>& votes() const { return votes_; }
+  bool isFree(const Eigen::Vector3i& voxel) const { return test(free_bits_, voxel); }
+  bool touchesFree(const Eigen::Vector3i& voxel) const { return test(touch_bits_, voxel); }
+  int votesOf(const Eigen::Vector3i& voxel) const { return votes_.at(detail::voxelKey(voxel)); }
+
+  /// Makes a voxel occupied again: 1 if it was free, else 0.
+  size_t erase(const Eigen::Vector3i& voxel) {
+    if (!detail::inCube(voxel, cells_) || !isFree(voxel)) return 0;
+    votes_.erase(detail::voxelKey(voxel));
+    set(&free_bits_, voxel, false);
+    for (int n = 0; n < 27; ++n) {  // its neighbours may touch free voxels no longer
+      const Eigen::Vector3i other = voxel + offset(n);
+      if (n == 13 || !detail::inCube(other, cells_)) continue;
+      bool touches = false;
+      for (int m = 0; m < 27 && !touches; ++m) {
+        const Eigen::Vector3i next = other + offset(m);
+        touches = m != 13 && detail::inCube(next, cells_) && isFree(next);
+      }
+      set(&touch_bits_, other, touches);
+    }
+    return 1;
+  }
+
+ private:
+  static Eigen::Vector3i offset(int n) { return {n % 3 - 1, n / 3 % 3 - 1, n / 9 - 1}; }
+  size_t bit(const Eigen::Vector3i& voxel) const {
+    return (static_cast<size_t>(voxel.z()) << (2 * depth_)) |
+           (static_cast<size_t>(voxel.y()) << depth_) | static_cast<size_t>(voxel.x());
+  }
+  bool test(const std::vector<uint64_t>& bits, const Eigen::Vector3i& voxel) const {
+    const size_t b = bit(voxel);
+    return (bits[b >> 6] >> (b & 63)) & 1u;
+  }
+  void set(std::vector<uint64_t>* bits, const Eigen::Vector3i& voxel, bool on) const {
+    const size_t b = bit(voxel);
+    if (on) {
+      (*bits)[b >> 6] |= uint64_t{1} << (b & 63);
+    } else {
+      (*bits)[b >> 6] &= ~(uint64_t{1} << (b & 63));
+    }
+  }
+
+  int depth_, cells_;
+  std::vector<uint64_t> free_bits_, touch_bits_;
+  std::unordered_map<uint64_t, int> votes_;
+};
 
 /// The voxel a silhouette pixel's line of sight needs kept with its 26 neighbours, or no key (~0)
 /// when its walk through the cube meets an occupied voxel that is neither free nor next to a free
@@ -136,8 +196,7 @@ bool touchesFree(const Eigen::Vector3i& voxel, int cells,
 /// voxel next to a free one. The walk goes leaf by leaf, and voxel by voxel through occupied
 /// leaves.
 uint64_t neededOnRay(const VisualHull& hull, const Eigen::Vector3d& origin_W,
-                     const Eigen::Vector3d& direction,
-                     const std::unordered_map<uint64_t, int>& free_votes) {
+                     const Eigen::Vector3d& direction, const FreeSet& free) {
   constexpr uint64_t kNone = ~uint64_t{0};
   const HullCube& cube = hull.cube();
   const double voxel_m = cube.resolution_m;
@@ -179,10 +238,10 @@ uint64_t neededOnRay(const VisualHull& hull, const Eigen::Vector3d& origin_W,
                                         : (boundary - origin_W[a]) / direction[a];
       }
       while (detail::inCube(at, cells)) {
-        const auto found = free_votes.find(detail::voxelKey(at));
-        if (found != free_votes.end()) {
-          if (found->second <= weakest_votes) weakest = found->first, weakest_votes = found->second;
-        } else if (!touchesFree(at, cells, free_votes)) {
+        if (free.isFree(at)) {
+          const int votes = free.votesOf(at);
+          if (votes <= weakest_votes) weakest = detail::voxelKey(at), weakest_votes = votes;
+        } else if (!free.touchesFree(at)) {
           return kNone;
         } else if (first_touching == kNone) {
           first_touching = detail::voxelKey(at);
@@ -293,25 +352,36 @@ PhotoCarveResult photoCarve(const VisualHull& hull, const PhotoViews& views,
 
   // The silhouettes' check, view by view in their order.
   start = Clock::now();
-  std::unordered_map<uint64_t, int> free_votes;
-  for (const auto& [voxel, votes] : free) free_votes.emplace(detail::voxelKey(voxel), votes);
-  for (uint32_t v = 0; v < count && !free_votes.empty(); ++v) {
+  FreeSet free_set(cube.depth, free);
+  for (uint32_t v = 0; v < count && !free_set.empty(); ++v) {
     const PinholeCamera& camera = views.cameras[v];
     const cv::Mat& mask = masks[v];
+    // The pixels free voxels project onto, grown by the largest reach of a voxel and its
+    // neighbours (whose corners it touches: two and a half voxels) in this view.
     cv::Mat at_risk(mask.size(), CV_8UC1, cv::Scalar(0));
     const double focal = std::max(camera.K()(0, 0), camera.K()(1, 1));
-    for (const auto& [key, votes] : free_votes) {
+    double reach = 0.0;
+    for (const auto& [key, votes] : free_set.votes()) {
       const Eigen::Vector3d X_W = detail::voxelCentre(cube, detail::voxelOfKey(key));
       const double depth = camera.depth(X_W);
       if (!(depth > 0.0)) continue;
       const Eigen::Vector2d px = camera.project(X_W);
-      // The voxel and its neighbours (whose corners it touches): two and a half voxels.
-      const double reach = 2.6 * voxel_m * focal / depth + 1.5;
-      const int u0 = std::max(0, static_cast<int>(std::floor(px.x() - reach)));
-      const int u1 = std::min(mask.cols - 1, static_cast<int>(std::ceil(px.x() + reach)));
-      const int v0 = std::max(0, static_cast<int>(std::floor(px.y() - reach)));
-      const int v1 = std::min(mask.rows - 1, static_cast<int>(std::ceil(px.y() + reach)));
-      if (u0 <= u1 && v0 <= v1) at_risk(cv::Rect(u0, v0, u1 - u0 + 1, v1 - v0 + 1)).setTo(255);
+      const double r = 2.6 * voxel_m * focal / depth + 1.5;
+      // A voxel whose square of reach meets the image marks the pixel nearest its centre.
+      if (!(px.x() + r >= 0.0 && px.y() + r >= 0.0 && px.x() - r <= mask.cols - 1 &&
+            px.y() - r <= mask.rows - 1)) {
+        continue;
+      }
+      reach = std::max(reach, r);
+      const int u = static_cast<int>(std::clamp(std::lround(px.x()), 0L, mask.cols - 1L));
+      const int v = static_cast<int>(std::clamp(std::lround(px.y()), 0L, mask.rows - 1L));
+      at_risk.at<uint8_t>(v, u) = 255;
+    }
+    if (reach > 0.0) {
+      // Beyond the image the clamped centre stands in for the voxel: the reach from it covers
+      // at least what the voxel's square covers inside the image.
+      const int side = 2 * static_cast<int>(std::ceil(reach)) + 1;
+      cv::dilate(at_risk, at_risk, cv::getStructuringElement(cv::MORPH_RECT, {side, side}));
     }
     std::vector<std::vector<uint64_t>> needed(static_cast<size_t>(mask.rows));
     const Eigen::Vector3d origin_W = camera.centre();
@@ -321,7 +391,7 @@ PhotoCarveResult photoCarve(const VisualHull& hull, const PhotoViews& views,
         if (!mask.at<uint8_t>(r, u) || !at_risk.at<uint8_t>(r, u)) continue;
         const Eigen::Vector3d direction = camera.rayDirection(Eigen::Vector2d(u, r));
         if (!direction.allFinite()) continue;
-        const uint64_t key = neededOnRay(hull, origin_W, direction, free_votes);
+        const uint64_t key = neededOnRay(hull, origin_W, direction, free_set);
         if (key != ~uint64_t{0}) needed[row].push_back(key);
       }
     });
@@ -333,15 +403,13 @@ PhotoCarveResult photoCarve(const VisualHull& hull, const PhotoViews& views,
         for (int n = 0; n < 27; ++n) {
           const Eigen::Vector3i voxel =
               centre + Eigen::Vector3i(n % 3 - 1, n / 3 % 3 - 1, n / 9 - 1);
-          if (detail::inCube(voxel, 1 << cube.depth)) {
-            result.restored_voxels += free_votes.erase(detail::voxelKey(voxel));
-          }
+          result.restored_voxels += free_set.erase(voxel);
         }
       }
     }
   }
   for (const auto& [voxel, votes] : free) {
-    if (free_votes.count(detail::voxelKey(voxel))) result.free_voxels.push_back(voxel);
+    if (free_set.isFree(voxel)) result.free_voxels.push_back(voxel);
   }
   std::sort(result.free_voxels.begin(), result.free_voxels.end(),
             [](const Eigen::Vector3i& a, const Eigen::Vector3i& b) {
