@@ -5,7 +5,8 @@
 //
 // Cost: the sweep is views x neighbours x planes warps and box filters of the reduced images; the
 // vote is occupied finest voxels x views projections; the check walks, per view, the pixels of
-// the silhouette that carved voxels project onto, each until its first occupied voxel.
+// the silhouette that carved voxels project onto, voxel by voxel over bit sets of the cube (three
+// bits a voxel), each until its first occupied voxel that is neither free nor next to a free one.
 
 #include <algorithm>
 #include <chrono>
@@ -107,28 +108,31 @@ Votes votesAt(const Eigen::Vector3d& X_W, const std::vector<ViewDepth>& depths, 
   return votes;
 }
 
-/// Where a ray leaves the box [lo, hi] (it is inside).
-double exitOf(const Eigen::Vector3d& origin_W, const Eigen::Vector3d& direction,
-              const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
-  double t = std::numeric_limits<double>::infinity();
-  for (int a = 0; a < 3; ++a) {
-    if (direction[a] > 0.0) t = std::min(t, (hi[a] - origin_W[a]) / direction[a]);
-    if (direction[a] < 0.0) t = std::min(t, (lo[a] - origin_W[a]) / direction[a]);
-  }
-  return t;
-}
-
 /// The free voxels and their votes, for the silhouettes' check: a bit per voxel of the cube for
-/// "free" and one for "one of its 26 neighbours is free" (then a corner of it touches free space,
-/// where the mesh's free-space field and carveFree's closure cut into it), 2^(3 depth - 2) bytes
-/// (4 MB at depth 8), so that the walks test bits; the votes in a hash map.
+/// "occupied" (in an occupied leaf), "free" and "one of its 26 neighbours is free" (then a corner
+/// of it touches free space, where the mesh's free-space field and carveFree's closure cut into
+/// it), 3 2^(3 depth - 3) bytes (6 MB at depth 8, 48 MB at depth 9), so that the walks test bits;
+/// the votes in a hash map.
 class FreeSet {
  public:
-  FreeSet(int depth, const std::vector<std::pair<Eigen::Vector3i, int>>& free)
+  FreeSet(int depth, const std::vector<HullCell>& occupied,
+          const std::vector<std::pair<Eigen::Vector3i, int>>& free)
       : depth_(depth),
         cells_(1 << depth),
         free_bits_((size_t{1} << (3 * depth)) / 64 + 1, 0),
-        touch_bits_(free_bits_.size(), 0) {
+        touch_bits_(free_bits_.size(), 0),
+        occupied_bits_(free_bits_.size(), 0) {
+    for (const HullCell& cell : occupied) {
+      const int edge = 1 << (depth - cell.depth);
+      const Eigen::Vector3i first = cell.index * edge;
+      for (int z = 0; z < edge; ++z) {
+        for (int y = 0; y < edge; ++y) {
+          for (int x = 0; x < edge; ++x) {
+            set(&occupied_bits_, first + Eigen::Vector3i(x, y, z), true);
+          }
+        }
+      }
+    }
     for (const auto& [voxel, votes] : free) {
       if (!detail::inCube(voxel, cells_)) continue;
       votes_.emplace(detail::voxelKey(voxel), votes);
@@ -145,6 +149,8 @@ class FreeSet {
   bool empty() const { return votes_.empty(); }
   const std::unordered_map<uint64_t, int>& votes() const { return votes_; }
   bool isFree(const Eigen::Vector3i& voxel) const { return test(free_bits_, voxel); }
+  /// In an occupied leaf of the hull (free or not).
+  bool isOccupied(const Eigen::Vector3i& voxel) const { return test(occupied_bits_, voxel); }
   bool touchesFree(const Eigen::Vector3i& voxel) const { return test(touch_bits_, voxel); }
   int votesOf(const Eigen::Vector3i& voxel) const { return votes_.at(detail::voxelKey(voxel)); }
 
@@ -186,19 +192,17 @@ class FreeSet {
   }
 
   int depth_, cells_;
-  std::vector<uint64_t> free_bits_, touch_bits_;
+  std::vector<uint64_t> free_bits_, touch_bits_, occupied_bits_;
   std::unordered_map<uint64_t, int> votes_;
 };
 
 /// The voxel a silhouette pixel's line of sight needs kept with its 26 neighbours, or no key (~0)
 /// when its walk through the cube meets an occupied voxel that is neither free nor next to a free
 /// one (or meets no voxel of the hull): the weakest free voxel on the way, else the first occupied
-/// voxel next to a free one. The walk goes leaf by leaf, and voxel by voxel through occupied
-/// leaves.
-uint64_t neededOnRay(const VisualHull& hull, const Eigen::Vector3d& origin_W,
+/// voxel next to a free one. The walk goes voxel by voxel (Amanatides and Woo) over the bits.
+uint64_t neededOnRay(const HullCube& cube, const Eigen::Vector3d& origin_W,
                      const Eigen::Vector3d& direction, const FreeSet& free) {
   constexpr uint64_t kNone = ~uint64_t{0};
-  const HullCube& cube = hull.cube();
   const double voxel_m = cube.resolution_m;
   const int cells = 1 << cube.depth;
   const Eigen::Vector3d lo = cube.origin_W(), hi = lo + Eigen::Vector3d::Constant(cube.edge_m());
@@ -212,49 +216,39 @@ uint64_t neededOnRay(const VisualHull& hull, const Eigen::Vector3d& origin_W,
     if (near > far) std::swap(near, far);
     t0 = std::max(t0, near), t1 = std::min(t1, far);
   }
-  const double nudge = 1e-6 * voxel_m;
+  if (!(t0 < t1)) return kNone;
+  const Eigen::Vector3d X = origin_W + direction * (t0 + 1e-6 * voxel_m);
+  Eigen::Vector3i at =
+      ((X - lo) / voxel_m).array().floor().cast<int>().max(0).min(cells - 1).matrix();
+  Eigen::Vector3i step;
+  Eigen::Vector3d next_t, delta_t;
+  for (int a = 0; a < 3; ++a) {
+    step[a] = direction[a] > 0.0 ? 1 : -1;
+    const double boundary = (at[a] + (step[a] > 0 ? 1 : 0)) * voxel_m + lo[a];
+    delta_t[a] = direction[a] == 0.0 ? std::numeric_limits<double>::infinity()
+                                     : voxel_m / std::abs(direction[a]);
+    next_t[a] = direction[a] == 0.0 ? std::numeric_limits<double>::infinity()
+                                    : (boundary - origin_W[a]) / direction[a];
+  }
   uint64_t weakest = kNone, first_touching = kNone;
   int weakest_votes = std::numeric_limits<int>::max();
-  for (double t = t0 + nudge; t < t1;) {
-    const Eigen::Vector3d X = origin_W + direction * t;
-    const Eigen::Vector3i voxel =
-        ((X - lo) / voxel_m).array().floor().cast<int>().max(0).min(cells - 1).matrix();
-    const HullCell cell = hull.leafAt(detail::voxelCentre(cube, voxel));
-    const int edge = 1 << (cube.depth - cell.depth);
-    const Eigen::Vector3d cell_lo = lo + (cell.index * edge).cast<double>() * voxel_m;
-    const double exit = std::min(t1, exitOf(origin_W, direction, cell_lo,
-                                            cell_lo + Eigen::Vector3d::Constant(edge * voxel_m)));
-    if (detail::isOccupied(cell)) {
-      // Voxel by voxel through the leaf: one that is not free covers the pixel.
-      Eigen::Vector3i at = voxel;
-      Eigen::Vector3i step;
-      Eigen::Vector3d next_t, delta_t;
-      for (int a = 0; a < 3; ++a) {
-        step[a] = direction[a] > 0.0 ? 1 : -1;
-        const double boundary = (at[a] + (step[a] > 0 ? 1 : 0)) * voxel_m + lo[a];
-        delta_t[a] = direction[a] == 0.0 ? std::numeric_limits<double>::infinity()
-                                         : voxel_m / std::abs(direction[a]);
-        next_t[a] = direction[a] == 0.0 ? std::numeric_limits<double>::infinity()
-                                        : (boundary - origin_W[a]) / direction[a];
-      }
-      while (detail::inCube(at, cells)) {
-        if (free.isFree(at)) {
-          const int votes = free.votesOf(at);
-          if (votes <= weakest_votes) weakest = detail::voxelKey(at), weakest_votes = votes;
-        } else if (!free.touchesFree(at)) {
-          return kNone;
-        } else if (first_touching == kNone) {
-          first_touching = detail::voxelKey(at);
-        }
-        int a = 0;
-        if (next_t[1] < next_t[a]) a = 1;
-        if (next_t[2] < next_t[a]) a = 2;
-        if (next_t[a] >= exit) break;
-        at[a] += step[a];
-        next_t[a] += delta_t[a];
+  while (detail::inCube(at, cells)) {
+    if (free.isOccupied(at)) {
+      if (free.isFree(at)) {
+        const int votes = free.votesOf(at);
+        if (votes <= weakest_votes) weakest = detail::voxelKey(at), weakest_votes = votes;
+      } else if (!free.touchesFree(at)) {
+        return kNone;
+      } else if (first_touching == kNone) {
+        first_touching = detail::voxelKey(at);
       }
     }
-    t = std::max(exit, t) + nudge;
+    int a = 0;
+    if (next_t[1] < next_t[a]) a = 1;
+    if (next_t[2] < next_t[a]) a = 2;
+    if (next_t[a] >= t1) break;
+    at[a] += step[a];
+    next_t[a] += delta_t[a];
   }
   return weakest != kNone ? weakest : first_touching;
 }
@@ -352,7 +346,7 @@ PhotoCarveResult photoCarve(const VisualHull& hull, const PhotoViews& views,
 
   // The silhouettes' check, view by view in their order.
   start = Clock::now();
-  FreeSet free_set(cube.depth, free);
+  FreeSet free_set(cube.depth, occupied, free);
   for (uint32_t v = 0; v < count && !free_set.empty(); ++v) {
     const PinholeCamera& camera = views.cameras[v];
     const cv::Mat& mask = masks[v];
@@ -391,7 +385,7 @@ PhotoCarveResult photoCarve(const VisualHull& hull, const PhotoViews& views,
         if (!mask.at<uint8_t>(r, u) || !at_risk.at<uint8_t>(r, u)) continue;
         const Eigen::Vector3d direction = camera.rayDirection(Eigen::Vector2d(u, r));
         if (!direction.allFinite()) continue;
-        const uint64_t key = neededOnRay(hull, origin_W, direction, free_set);
+        const uint64_t key = neededOnRay(cube, origin_W, direction, free_set);
         if (key != ~uint64_t{0}) needed[row].push_back(key);
       }
     });
