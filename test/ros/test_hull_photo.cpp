@@ -146,7 +146,7 @@ TEST(HullPhotoTest, PassesCarveTheCupsPocketAndColourTheCloud) {
       [&] {
         if (!last) return false;
         pocket_after = occupiedFraction(*rc::octreeFromMessage(*last), regions.pocket);
-        return pocket_after < 0.9 * pocket_hull;
+        return pocket_after < 0.6 * pocket_hull;
       },
       120.0);
   const double solid_after = occupiedFraction(*rc::octreeFromMessage(*last), regions.solid);

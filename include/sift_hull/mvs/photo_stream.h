@@ -65,8 +65,6 @@ class PhotoStream {
   /// when none runs and one is due: two views kept at least, and views kept since the last pass
   /// began or a tree other than the last pass's. Returns whether it started.
   bool startIfDue(const VisualHull& hull, uint64_t generation);
-  /// A pass started and not yet taken.
-  bool running() const { return worker_.joinable(); }
 
   /// A finished pass.
   struct Pass {
