@@ -47,27 +47,6 @@ cv::Mat greyOf(const cv::Mat& image) {
   return out;
 }
 
-/// The mean of the largest `best` of values[0 .. count), NaN when fewer than `best` are given.
-inline float bestMean(const float* values, int count, int best) {
-  float top[8];
-  int kept = 0;
-  for (int i = 0; i < count; ++i) {
-    const float v = values[i];
-    if (std::isnan(v)) continue;
-    int at = std::min(kept, best);
-    while (at > 0 && top[at - 1] < v) {
-      if (at < best) top[at] = top[at - 1];
-      --at;
-    }
-    if (at < best) top[at] = v;
-    kept = std::min(kept + 1, best);
-  }
-  if (kept < best) return kNaN;
-  float sum = 0.0f;
-  for (int i = 0; i < best; ++i) sum += top[i];
-  return sum / static_cast<float>(best);
-}
-
 }  // namespace
 
 ReducedView reducedView(const PinholeCamera& camera, const cv::Mat& image, const cv::Mat& mask,

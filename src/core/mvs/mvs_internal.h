@@ -3,7 +3,10 @@
 // The stages of photo carving (sift_hull/mvs/photo_carving.h), shared by its source files.
 
 #include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
+#include <limits>
 #include <opencv2/core.hpp>
 #include <vector>
 
@@ -61,6 +64,28 @@ void patchMatchDepth(const std::vector<ReducedView>& views, uint32_t view,
 /// depth maps agree with it within config.photo_consistency_voxels.
 cv::Mat consistentDepth(const std::vector<ViewDepth>& depths, uint32_t view,
                         const PhotoCarveConfig& config, double voxel_m);
+
+/// The mean of the largest `best` (at most 8) of values[0 .. count) that are not NaN, NaN when
+/// fewer are given: a depth's or a plane's score over its neighbours.
+inline float bestMean(const float* values, int count, int best) {
+  float top[8];
+  int kept = 0;
+  for (int i = 0; i < count; ++i) {
+    const float v = values[i];
+    if (std::isnan(v)) continue;
+    int at = std::min(kept, best);
+    while (at > 0 && top[at - 1] < v) {
+      if (at < best) top[at] = top[at - 1];
+      --at;
+    }
+    if (at < best) top[at] = v;
+    kept = std::min(kept + 1, best);
+  }
+  if (kept < best) return std::numeric_limits<float>::quiet_NaN();
+  float sum = 0.0f;
+  for (int i = 0; i < best; ++i) sum += top[i];
+  return sum / static_cast<float>(best);
+}
 
 /// Whether a leaf is occupied: an in cell, or a surface cell whose centre is inside (as
 /// HullStats::occupied_volume_m3 counts them).

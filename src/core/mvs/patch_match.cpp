@@ -43,20 +43,6 @@ inline float sample(const cv::Mat& image, float x, float y) {
          fy * ((1.0f - fx) * bottom[0] + fx * bottom[1]);
 }
 
-/// The mean of the largest `best` of values[0 .. count) that are not NaN, NaN with fewer.
-inline float bestMean(const float* values, int count, int best) {
-  float top[16];
-  int kept = 0;
-  for (int i = 0; i < count; ++i) {
-    if (!std::isnan(values[i])) top[kept++] = values[i];
-  }
-  if (kept < best) return kNaN;
-  std::partial_sort(top, top + best, top + kept, [](float a, float b) { return a > b; });
-  float sum = 0.0f;
-  for (int i = 0; i < best; ++i) sum += top[i];
-  return sum / static_cast<float>(best);
-}
-
 class PlaneScorer {
  public:
   PlaneScorer(const std::vector<ReducedView>& views, uint32_t view,
