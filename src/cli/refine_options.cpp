@@ -270,6 +270,7 @@ nlohmann::json photoCarve(const ArgParser& parser, const HullInput& input, HullR
       {"free_voxels_found", carved.free_voxels.size()},
       {"restored_voxels", carved.restored_voxels},
       {"sweeps", carved.sweeps},
+      {"depth_map_scale", {{"min", carved.scale_min}, {"max", carved.scale_max}}},
       {"depth_pixels", {{"swept", carved.depth_pixels}, {"consistent", carved.consistent_pixels}}},
       {"time_ms", millisecondsSince(start)},
       {"stage_ms",

@@ -49,8 +49,13 @@ double volumeIoU(const VisualHull& hull, const DenseGrid& dense);
 /// Whether the hull holds a point, as volumeIoU decides it.
 bool hullHolds(const VisualHull& hull, const Eigen::Vector3d& X_W);
 
-/// The hull and a true solid sampled at the centres of a regular grid of per_axis^3 cells over
-/// the hull's cube (x fastest): the ground truth of free-space carving.
+/// The hull and a true solid sampled at one point in each of per_axis^3 cells over the hull's
+/// cube (x fastest): the ground truth of free-space carving. The point's place in its cell comes
+/// from a hash of the cell (stratified sampling, the same points on every call): at the cells'
+/// centres, a face parallel to the grid falls at the same place in every cell, and the volumes of
+/// the axis-aligned solids were off by up to a sample's width (the U-block's cut, 40 views:
+/// 39.0 % with 200 samples per axis, 43.1 % with 160, 50.6 % with 256; stratified: 45.6-45.7 %
+/// with any of them).
 struct SolidSamples {
   int per_axis = 0;
   double cell_m3 = 0.0;

@@ -24,8 +24,12 @@ struct PhotoCarveConfig {
   int photo_neighbours = 6;
   /// Neighbours seen at a larger angle than this from the view are not used.
   double photo_max_neighbour_angle_deg = 75.0;
-  /// The depth maps' resolution, as a share of the images' width and height.
-  double photo_image_scale = 0.5;
+  /// The depth maps' largest resolution, as a share of the images' width and height.
+  double photo_image_scale = 1.0;
+  /// Each view's depth map is reduced until the finest voxel at the hull's centre spans this many
+  /// of its pixels (never beyond photo_image_scale): the depth maps' resolution follows the
+  /// octree's, not the images'.
+  double photo_voxel_px = 1.0;
   /// Patches of (2 r + 1)^2 pixels at that resolution.
   int photo_patch_radius_px = 2;
   /// A pixel's score at a depth is the mean NCC of its best this many neighbours there.
@@ -33,7 +37,7 @@ struct PhotoCarveConfig {
   /// Smallest score of a pixel's depth.
   double photo_min_ncc = 0.5;
   /// Patches flatter than this (standard deviation of the grey level, 0..1) get no depth.
-  double photo_min_patch_std = 0.02;
+  double photo_min_patch_std = 0.01;
   /// Depths swept per view, evenly in inverse depth over the hull's depth range in that view.
   int photo_depth_planes = 64;
   /// Rounds of slanted-plane PatchMatch after the sweep (0: the sweep's fronto-parallel depths).
@@ -76,10 +80,11 @@ struct PhotoCarveResult {
   std::vector<ViewDepth> depths;  ///< one per view, after the consistency check
   /// The finest voxels found empty, in z, y, x order, for VisualHull::carveFree.
   std::vector<Eigen::Vector3i> free_voxels;
-  size_t sweeps = 0;             ///< plane sweeps made (views x neighbours x planes)
-  size_t depth_pixels = 0;       ///< pixels with a depth, before the consistency check
-  size_t consistent_pixels = 0;  ///< and after it
-  size_t restored_voxels = 0;    ///< voxels left occupied because a silhouette pixel needs them
+  double scale_min = 0.0, scale_max = 0.0;  ///< the depth maps' scales over the views
+  size_t sweeps = 0;                        ///< plane sweeps made (views x neighbours x planes)
+  size_t depth_pixels = 0;                  ///< pixels with a depth, before the consistency check
+  size_t consistent_pixels = 0;             ///< and after it
+  size_t restored_voxels = 0;  ///< voxels left occupied because a silhouette pixel needs them
   double depth_ms = 0.0, consistency_ms = 0.0, voting_ms = 0.0, silhouettes_ms = 0.0;
 };
 

@@ -86,6 +86,25 @@ bool hullHolds(const VisualHull& hull, const Eigen::Vector3d& X_W) {
   return state == CellState::kIn || (state == CellState::kSurface && hull.valueAt(X_W) <= 0.0f);
 }
 
+namespace {
+
+/// A point of cell n, the same on every call: offsets in [0, 1) per axis from a SplitMix64 hash
+/// of n, so that a sample's place in its cell does not repeat from cell to cell.
+Eigen::Vector3d jitterInCell(size_t n) {
+  Eigen::Vector3d offset;
+  uint64_t state = static_cast<uint64_t>(n) * 3u;
+  for (int axis = 0; axis < 3; ++axis) {
+    uint64_t z = (state += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    z ^= z >> 31;
+    offset[axis] = static_cast<double>(z >> 11) * 0x1.0p-53;
+  }
+  return offset;
+}
+
+}  // namespace
+
 SolidSamples sampleAgainstSolid(const VisualHull& hull, const SolidPredicate& inside, int per_axis,
                                 const SolidPredicate& cavities) {
   if (per_axis < 1) throw std::invalid_argument("sampleAgainstSolid: per_axis must be >= 1");
@@ -102,7 +121,7 @@ SolidSamples sampleAgainstSolid(const VisualHull& hull, const SolidPredicate& in
     const Eigen::Vector3d cell(static_cast<double>(n % per_axis),
                                static_cast<double>(n / per_axis % per_axis),
                                static_cast<double>(n / per_axis / per_axis));
-    const Eigen::Vector3d X_W = origin_W + (cell.array() + 0.5).matrix() * cell_m;
+    const Eigen::Vector3d X_W = origin_W + (cell + jitterInCell(n)) * cell_m;
     samples.truth[n] = inside(X_W) ? 1 : 0;
     samples.hull[n] = hullHolds(hull, X_W) ? 1 : 0;
     if (cavities) samples.cavity[n] = cavities(X_W) ? 1 : 0;

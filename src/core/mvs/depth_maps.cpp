@@ -49,6 +49,16 @@ cv::Mat greyOf(const cv::Mat& image) {
 
 }  // namespace
 
+double depthMapScale(const PinholeCamera& camera, const Eigen::Vector3d& centre_W, double voxel_m,
+                     const PhotoCarveConfig& config) {
+  const double depth_m = camera.depth(centre_W);
+  const double focal_px = 0.5 * (std::abs(camera.K()(0, 0)) + std::abs(camera.K()(1, 1)));
+  const double footprint_px = depth_m > 0.0 ? focal_px * voxel_m / depth_m : 0.0;
+  if (!(footprint_px > 0.0) || !std::isfinite(footprint_px)) return config.photo_image_scale;
+  return std::min(config.photo_image_scale,
+                  std::max(config.photo_voxel_px / footprint_px, 1.0 / 64));
+}
+
 ReducedView reducedView(const PinholeCamera& camera, const cv::Mat& image, const cv::Mat& mask,
                         double scale, int patch_radius_px) {
   if (image.empty() || mask.empty() || image.size() != mask.size() || mask.type() != CV_8UC1) {
@@ -268,6 +278,27 @@ void sweepDepth(const std::vector<ReducedView>& views, uint32_t view,
   }
 }
 
+namespace {
+
+/// Whether one of the (up to) four pixels around `px` holds a depth within tolerance_m of
+/// expected_m: the pixel grid, not the surface, decides which of them the point falls on, and on
+/// a slanted surface the nearest one alone can be a voxel or more off.
+bool agreesNearby(const cv::Mat& depth_m, const Eigen::Vector2d& px, double expected_m,
+                  double tolerance_m) {
+  const double u = std::floor(px.x()), v = std::floor(px.y());
+  if (!(u >= -1.0 && v >= -1.0 && u < depth_m.cols && v < depth_m.rows)) return false;
+  for (int dv = 0; dv < 2; ++dv) {
+    for (int du = 0; du < 2; ++du) {
+      const int pu = static_cast<int>(u) + du, pv = static_cast<int>(v) + dv;
+      if (pu < 0 || pv < 0 || pu >= depth_m.cols || pv >= depth_m.rows) continue;
+      if (std::abs(depth_m.at<float>(pv, pu) - expected_m) <= tolerance_m) return true;  // NaN: no
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
 cv::Mat consistentDepth(const std::vector<ViewDepth>& depths, uint32_t view,
                         const PhotoCarveConfig& config, double voxel_m) {
   const ViewDepth& ref = depths[view];
@@ -283,12 +314,7 @@ cv::Mat consistentDepth(const std::vector<ViewDepth>& depths, uint32_t view,
         const ViewDepth& other = depths[n];
         const double expected = other.camera.depth(X);
         if (!(expected > 0.0)) continue;
-        const Eigen::Vector2d px = other.camera.projectIdeal(X);
-        const int pu = static_cast<int>(std::lround(px.x()));
-        const int pv = static_cast<int>(std::lround(px.y()));
-        if (pu < 0 || pv < 0 || pu >= other.depth_m.cols || pv >= other.depth_m.rows) continue;
-        const float seen = other.depth_m.at<float>(pv, pu);
-        agree += std::abs(seen - expected) <= tolerance_m ? 1 : 0;  // false for NaN
+        agree += agreesNearby(other.depth_m, other.camera.projectIdeal(X), expected, tolerance_m);
       }
       if (agree >= config.photo_min_consistent_views) kept.at<float>(v, u) = depth;
     }

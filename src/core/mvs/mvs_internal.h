@@ -17,6 +17,11 @@
 namespace sift_hull {
 namespace detail {
 
+/// The share of a view's width and height its depth map has: the finest voxel at `centre_W` spans
+/// config.photo_voxel_px pixels there, at most config.photo_image_scale (and at least 1/64).
+double depthMapScale(const PinholeCamera& camera, const Eigen::Vector3d& centre_W, double voxel_m,
+                     const PhotoCarveConfig& config);
+
 /// A view at the depth maps' scale, in ideal pixels (the lens distortion taken out).
 struct ReducedView {
   PinholeCamera camera;  ///< scaled K, no distortion

@@ -37,8 +37,12 @@ const SettingTable<PhotoCarveConfig>& settingsOf<PhotoCarveConfig>() {
           "neighbours seen at a larger angle from the view's line of sight are not used")
         .above(1.0, 180.0);
     t.add("photo_image_scale", &C::photo_image_scale, "",
-          "the depth maps' resolution, as a share of the images' width and height")
+          "the depth maps' largest resolution, as a share of the images' width and height")
         .above(0.0, 1.0);
+    t.add("photo_voxel_px", &C::photo_voxel_px, "px",
+          "each view's depth map is reduced until the finest voxel at the hull's centre spans "
+          "this many of its pixels (at most photo_image_scale)")
+        .above(0.0, 16.0);
     t.add("photo_patch_radius_px", &C::photo_patch_radius_px, "px",
           "patches of (2 r + 1)^2 pixels at the depth maps' resolution")
         .range(1, 10);
@@ -267,6 +271,8 @@ PhotoCarveResult photoCarve(const VisualHull& hull, const PhotoViews& views,
   Clock::time_point start = Clock::now();
   std::vector<detail::ReducedView> reduced(count);
   std::vector<cv::Mat> masks(count);
+  const Eigen::Vector3d centre_W = cube.origin_W() + Eigen::Vector3d::Constant(cube.edge_m() / 2);
+  result.scale_min = config.photo_image_scale;
   for (uint32_t v = 0; v < count; ++v) {
     masks[v] = views.mask(v);
     const cv::Mat image = views.image(v);
@@ -275,11 +281,12 @@ PhotoCarveResult photoCarve(const VisualHull& hull, const PhotoViews& views,
       throw std::invalid_argument("photo carving: view " + std::to_string(v) +
                                   ": its image and silhouette differ in size");
     }
-    reduced[v] = detail::reducedView(camera, image, masks[v], config.photo_image_scale,
-                                     config.photo_patch_radius_px);
+    const double scale = detail::depthMapScale(camera, centre_W, voxel_m, config);
+    result.scale_min = std::min(result.scale_min, scale);
+    result.scale_max = std::max(result.scale_max, scale);
+    reduced[v] = detail::reducedView(camera, image, masks[v], scale, config.photo_patch_radius_px);
   }
   const std::vector<HullCell> occupied = detail::occupiedLeaves(hull);
-  const Eigen::Vector3d centre_W = cube.origin_W() + Eigen::Vector3d::Constant(cube.edge_m() / 2);
   const std::vector<std::vector<uint32_t>> neighbours = detail::chooseNeighbours(
       views.cameras, centre_W, config.photo_neighbours, config.photo_max_neighbour_angle_deg);
   result.depths.resize(count);
