@@ -37,7 +37,7 @@ function(sift_hull_add_libraries)
 
   set(io sift_hull_io${ARG_SUFFIX})
   add_library(${io} ${type} ${IO})
-  target_link_libraries(${io} PUBLIC ${core})
+  target_link_libraries(${io} PUBLIC ${core} PRIVATE nlohmann_json::nlohmann_json)
 
   set(pipeline sift_hull_pipeline${ARG_SUFFIX})
   add_library(${pipeline} ${type} ${PIPELINE})

@@ -68,6 +68,7 @@ set(SIFT_HULL_IO_SOURCES
   src/core/io/ground_truth_files.cpp
   src/core/io/images.cpp
   src/core/io/llff.cpp
+  src/core/io/nerf.cpp
   src/core/io/pfm.cpp
   src/core/io/ply.cpp
   src/core/io/view_list.cpp

@@ -52,9 +52,10 @@ std::vector<CalibratedView> readMiddleburyPar(const std::string& path);
 /// file and line.
 std::vector<CalibratedView> readProjectionList(const std::string& path);
 
-/// Reads any calibration format: a directory is a COLMAP sparse model (readColmapModel), a file
-/// ending in ".npy" LLFF poses (readLlffPoses, the views being the sorted images of
-/// `image_directory`), else a text file: a first line holding a single integer means a Middlebury
+/// Reads any calibration format: a directory is NeRF transforms (nerfTransformFiles, when it
+/// holds them and no COLMAP cameras file) or a COLMAP sparse model (readColmapModel), a file
+/// ending in ".json" NeRF transforms (readNerfTransforms), one ending in ".npy" LLFF poses
+/// (readLlffPoses, the views being the sorted images of `image_directory`), else a text file: a first line holding a single integer means a Middlebury
 /// par file, otherwise a projection list. A first line shaped like a par line (a name and 21
 /// numbers) is reported as a missing count line.
 std::vector<CalibratedView> readCalibrationWithImages(const std::string& path,
@@ -65,7 +66,8 @@ std::vector<CalibratedView> readCalibration(const std::string& path);
 
 /// Human-readable name of the format readCalibration() reads at `path`, such as
 /// "COLMAP text (cameras.txt, images.txt)", "COLMAP binary (cameras.bin, images.bin)",
-/// "LLFF poses_bounds.npy", "Middlebury par" or "projection list". Does not validate the file.
+/// "NeRF transforms.json", "LLFF poses_bounds.npy", "Middlebury par" or "projection list". Does
+/// not validate the file.
 std::string calibrationFormat(const std::string& path);
 
 /// "no distortion" or "k1=... k2=... p1=... p2=... k3=..." (the non-zero coefficients).

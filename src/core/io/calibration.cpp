@@ -17,6 +17,7 @@
 
 #include "sift_hull/io/colmap.h"
 #include "sift_hull/io/llff.h"
+#include "sift_hull/io/nerf.h"
 #include "sift_hull/io/view_orientation.h"
 #include "sift_hull/limits.h"
 
@@ -277,6 +278,24 @@ bool isDirectory(const std::string& path) {
   return ::stat(path.c_str(), &info) == 0 && S_ISDIR(info.st_mode);
 }
 
+bool hasSuffix(const std::string& path, const std::string& suffix) {
+  if (path.size() < suffix.size()) return false;
+  std::string end = path.substr(path.size() - suffix.size());
+  std::transform(end.begin(), end.end(), end.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return end == suffix;
+}
+
+/// Every view of a directory's NeRF files, in the files' order.
+std::vector<CalibratedView> readNerfDirectory(const std::vector<std::string>& files) {
+  std::vector<CalibratedView> views;
+  for (const std::string& file : files) {
+    std::vector<CalibratedView> more = readNerfTransforms(file);
+    views.insert(views.end(), more.begin(), more.end());
+  }
+  return views;
+}
+
 bool isNpy(const std::string& path) {
   if (path.size() < 4) return false;
   std::string suffix = path.substr(path.size() - 4);
@@ -292,8 +311,12 @@ std::vector<CalibratedView> readCalibration(const std::string& path) {
 }
 
 std::string calibrationFormat(const std::string& path) {
-  if (isDirectory(path)) return colmapModelFormat(path);
+  if (isDirectory(path)) {
+    if (!nerfTransformFiles(path).empty()) return "NeRF transforms.json";
+    return colmapModelFormat(path);
+  }
   if (isNpy(path)) return "LLFF poses_bounds.npy";
+  if (hasSuffix(path, ".json")) return "NeRF transforms.json";
   try {
     const std::vector<Line> lines = readFields(path);
     if (!lines.empty() && looksLikeCountLine(lines.front())) return "Middlebury par";
@@ -321,7 +344,12 @@ std::string describeDistortion(const LensDistortion& d) {
 
 std::vector<CalibratedView> readCalibrationWithImages(const std::string& path,
                                                       const std::string& image_directory) {
-  if (isDirectory(path)) return readColmapModel(path);
+  if (isDirectory(path)) {
+    const std::vector<std::string> nerf = nerfTransformFiles(path);
+    if (!nerf.empty()) return readNerfDirectory(nerf);
+    return readColmapModel(path);
+  }
+  if (hasSuffix(path, ".json")) return readNerfTransforms(path);
   if (isNpy(path)) {
     std::vector<std::string> names;
     try {
