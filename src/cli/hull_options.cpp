@@ -48,8 +48,9 @@ std::vector<std::string> viewNamesFromArgs(const ArgParser& parser) {
 
 void addViewSetOptions(ArgParser* parser) {
   parser->addOption("calib", "FILE|DIR",
-                    "Middlebury par file, projection list, COLMAP sparse model directory or LLFF "
-                    "poses_bounds.npy");
+                    "Middlebury par file, projection list, COLMAP sparse model directory, LLFF "
+                    "poses_bounds.npy, or NeRF transforms.json (or a directory of "
+                    "transforms*.json)");
   parser->addOption("images", "DIR", "directory of the images the calibration names");
   addSilhouetteOptions(parser);
   parser->addOption("views", "LIST", "comma-separated image names to use (default: all)");

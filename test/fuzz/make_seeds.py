@@ -254,3 +254,16 @@ ring3_rows = [llff_row(*ring_camera(i, 3)) for i in range(3)]
 write("fuzz_npy", "ring3", npy(ring3_rows))
 write("fuzz_npy", "ring3_fortran", npy(ring3_rows, fortran=True))
 write("fuzz_npy", "ring2_v2", npy(ring3_rows[:2], version=2))
+
+
+def nerf_frame(name, centre_z, extra=""):
+    return ('{"file_path": "%s", %s"transform_matrix": [[1, 0, 0, 0], [0, -1, 0, 0.1], '
+            '[0, 0, -1, %r], [0, 0, 0, 1]]}' % (name, extra, centre_z))
+
+
+write("fuzz_nerf_transforms", "angle_two_frames",
+      ('{"camera_angle_x": 0.69, "w": 64, "h": 48, "frames": [%s, %s]}' %
+       (nerf_frame("./train/r_0", -4.0), nerf_frame("./train/r_1", -5.0))).encode())
+write("fuzz_nerf_transforms", "instant_ngp_per_frame",
+      ('{"fl_x": 50, "fl_y": 51, "cx": 32, "cy": 24, "w": 64, "h": 48, "k1": 0.01, "p1": 0.001, '
+       '"frames": [%s]}' % nerf_frame("a.png", -4.0, '"fl_x": 60, "k2": -0.02, ')).encode())

@@ -24,12 +24,31 @@ void checkImageSize(const CalibratedView& view, cv::Size image_size, const std::
 /// come back as BGR, 8 bits per channel.
 cv::Mat loadViewImage(const std::string& directory, const CalibratedView& view);
 
+/// A view's image and, when the file has an alpha channel that is not constant, the silhouette it
+/// holds: alpha at least half of full scale (CV_8UC1, 255 inside); else alpha_mask is empty.
+struct ViewImage {
+  cv::Mat bgr;         ///< as loadViewImage gives it
+  cv::Mat alpha_mask;  ///< empty without a varying alpha channel
+};
+
+/// loadViewImage(), keeping the alpha channel of a PNG, TIFF or WebP image as its silhouette (the
+/// NeRF synthetic scenes' RGBA images, cut-outs). Other files are decoded as loadViewImage does.
+ViewImage loadViewImageWithAlpha(const std::string& directory, const CalibratedView& view);
+
+/// The mask file of an image in `mask_directory`: the image's own name when that file exists,
+/// else the one file whose name is the same number under another width or extension
+/// (image/000012.png and mask/012.png in IDR / DTU sets); else the own name, which the reader
+/// then reports missing.
+std::string maskPath(const std::string& mask_directory, const std::string& image_name);
+
 /// Reads a mask file: any non-zero pixel is inside. Returns CV_8UC1 with 255 inside.
 /// Throws std::runtime_error naming the file when it is missing or unreadable.
 cv::Mat loadMask(const std::string& path);
 
-/// Silhouettes of all views, in view order: the mask file of each view's name in `mask_directory`
-/// when that is not empty, else extracted from the view's image in `image_directory` by `recipe`.
+/// Silhouettes of all views, in view order: the mask file of each view (maskPath) in
+/// `mask_directory` when that is not empty, else the image's alpha channel when it has a varying
+/// one (loadViewImageWithAlpha), else extracted from the view's image in `image_directory` by
+/// `recipe`. Mask files may hold 1, 3 or 4 channels: any non-zero grey level is inside.
 /// Throws std::runtime_error naming a missing or unreadable file, a mask whose size differs from
 /// its image's, or an image whose size differs from the first view's.
 std::vector<cv::Mat> loadSilhouettes(const std::vector<CalibratedView>& views,

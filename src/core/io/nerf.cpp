@@ -113,7 +113,10 @@ std::vector<CalibratedView> readFile(const std::string& path) {
     // The image's size: the json's, else the file's.
     std::optional<double> w = get("w"), h = get("h");
     if (!w || !h) {
-      const cv::Mat image = cv::imread(directory + "/" + name, cv::IMREAD_UNCHANGED);
+      // Only a regular file is decoded: a device or a fifo named by file_path would block.
+      const std::string image_path = directory + "/" + name;
+      const cv::Mat image =
+          isFile(image_path) ? cv::imread(image_path, cv::IMREAD_UNCHANGED) : cv::Mat();
       if (image.empty()) {
         fail(path, where + ": no \"w\" and \"h\", and the image cannot be read for its size");
       }

@@ -96,6 +96,25 @@ cv::Mat eightBitImage(const sensor_msgs::ImageConstPtr& image, std::string* why_
   }
 }
 
+cv::Mat alphaMask(const sensor_msgs::ImageConstPtr& image) {
+  namespace enc = sensor_msgs::image_encodings;
+  if (!enc::hasAlpha(image->encoding) || enc::bitDepth(image->encoding) != 8) return {};
+  std::string why_not;
+  if (!holdsEightBitImage(*image, &why_not)) return {};
+  cv::Mat alpha;
+  try {
+    cv::extractChannel(cv_bridge::toCvShare(image, "bgra8")->image, alpha, 3);
+  } catch (const cv_bridge::Exception&) {
+    return {};
+  }
+  double low = 0.0, high = 0.0;
+  cv::minMaxLoc(alpha, &low, &high);
+  if (!(low < high)) return {};  // a constant alpha says nothing about the object
+  cv::Mat mask;
+  cv::compare(alpha, 128, mask, cv::CMP_GE);
+  return mask;
+}
+
 sensor_msgs::Image imageMessage(const cv::Mat& image, const std_msgs::Header& header) {
   if (image.type() != CV_8UC1 && image.type() != CV_8UC3) {
     throw std::invalid_argument("imageMessage: expected an 8-bit grey or BGR image");

@@ -64,6 +64,10 @@ bool holdsEightBitImage(const sensor_msgs::Image& image, std::string* why_not);
 /// pixels the data does not hold (holdsPixels).
 cv::Mat eightBitImage(const sensor_msgs::ImageConstPtr& image, std::string* why_not);
 
+/// The silhouette an 8-bit image with an alpha channel (rgba8, bgra8) holds: alpha at least 128,
+/// CV_8UC1 with 255 inside. Empty for another encoding or an alpha that is constant.
+cv::Mat alphaMask(const sensor_msgs::ImageConstPtr& image);
+
 /// What a camera_info says of its image, read through image_geometry::PinholeCameraModel.
 struct CameraInfoGeometry {
   /// The image is rectified: its camera is P's K' (and R), not K and D.

@@ -165,7 +165,9 @@ bool HullNode::viewOf(const Posed& posed, View* view) {
   view->mask = config_.from_image ? ros_conversions::eightBitImage(posed.silhouette, &why_not)
                                   : ros_conversions::maskFromImage(silhouette, &why_not);
   if (config_.from_image && !view->mask.empty()) {
-    view->mask = silhouetteFromImage(view->mask, config_.recipe);
+    // An image with a varying alpha channel (rgba8, bgra8) carries its own silhouette.
+    const cv::Mat alpha = ros_conversions::alphaMask(posed.silhouette);
+    view->mask = alpha.empty() ? silhouetteFromImage(view->mask, config_.recipe) : alpha;
   }
   if (view->mask.empty() ||
       !ros_conversions::cameraFromInfo(*posed.info, posed.T_W_C,
