@@ -49,6 +49,8 @@ set(SIFT_HULL_CORE_SOURCES
   src/core/hull/reduced_distance_map.cpp
   src/core/hull/run_length_mask.cpp
   src/core/hull/silhouette.cpp
+  src/core/hull/view_prior.cpp
+  src/core/hull/view_silhouettes.cpp
   src/core/mvs/depth_maps.cpp
   src/core/mvs/mesh_colour.cpp
   src/core/mvs/patch_match.cpp

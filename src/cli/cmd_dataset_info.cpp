@@ -108,6 +108,7 @@ int runDatasetInfo(const std::vector<std::string>& args) {
       "images", "DIR",
       "directory of the images (default: the calibration file's, or the COLMAP model directory)");
   addSilhouetteOptions(&parser);
+  addSilhouetteOutputOption(&parser);
   parser.addFlag("json", "print the result as one JSON object");
   if (!parser.parse(args)) return 0;
   const std::string calib = parser.get("calib");
@@ -118,9 +119,13 @@ int runDatasetInfo(const std::vector<std::string>& args) {
                                                               : parentDirectory(calib);
 
   const std::vector<CalibratedView> views = readCalibrationWithImages(calib, images);
+  ViewSilhouettes found;
   const std::vector<cv::Mat> silhouettes =
       loadSilhouettes(views, images, parser.has("silhouettes") ? parser.get("silhouettes") : "",
-                      silhouetteConfigFromArgs(parser));
+                      silhouetteConfigFromArgs(parser), &found);
+  std::vector<std::string> names;
+  for (const CalibratedView& view : views) names.push_back(view.name);
+  writeSilhouettesFromArgs(parser, names, [&](size_t i) { return silhouettes[i]; });
   const cv::Size size = silhouettes.front().size();  // loadSilhouettes: one size for all
   nlohmann::json cameras = nlohmann::json::array();
   for (size_t i = 0; i < views.size(); ++i) {
@@ -131,13 +136,14 @@ int runDatasetInfo(const std::vector<std::string>& args) {
                        {"camera_model", views[i].camera_model},
                        {"distortion", distortionJson(views[i].camera.distortion())}});
   }
-  const nlohmann::json info = {{"calib", calib},
-                               {"format", format},
-                               {"camera_models", describeModels(views)},
-                               {"views", views.size()},
-                               {"image_size", {size.width, size.height}},
-                               {"cameras", cameras},
-                               {"common_point", commonPointJson(views, size)}};
+  nlohmann::json info = {{"calib", calib},
+                         {"format", format},
+                         {"camera_models", describeModels(views)},
+                         {"views", views.size()},
+                         {"image_size", {size.width, size.height}},
+                         {"cameras", cameras},
+                         {"common_point", commonPointJson(views, size)}};
+  if (found.ball_centre_W) info["silhouettes"] = viewSilhouettesJson(found);
   printResult(parser.flag("json"), info, describe(info));
   return 0;
 }

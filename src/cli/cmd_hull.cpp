@@ -17,6 +17,7 @@
 #include "sift_hull/hull/silhouette.h"
 #include "sift_hull/io/ply.h"
 #include "sift_hull/mvs/mesh_colour.h"
+#include "silhouette_options.h"
 
 namespace sift_hull {
 namespace cli {
@@ -159,6 +160,7 @@ int runHull(const std::vector<std::string>& args) {
                    "write the mesh (binary PLY, world coordinates; with --images, each vertex "
                    "coloured by the views that see it)");
   parser.addOption("out-octree", "BT", "write the OctoMap (.bt)");
+  addSilhouetteOutputOption(&parser);
   parser.addOption("out-render", "PNG",
                    "write shaded renderings of the mesh (with --refine-with-matches also those of "
                    "the silhouettes' hull, as PNG with _before before the extension)");
@@ -182,7 +184,10 @@ int runHull(const std::vector<std::string>& args) {
     throw UsageError("--out-color-octree needs --images");
   }
   PoorResults poor(parser.flag("allow-poor"));
-  HullInput input = runLengthViewSetFromArgs(parser);
+  ViewSilhouettes found;
+  HullInput input = runLengthViewSetFromArgs(parser, &found);
+  writeSilhouettesFromArgs(parser, input.names, [&](size_t i) { return input.mask(i); });
+  for (const std::string& warning : found.warnings) poor.warn(warning);
   const std::optional<HeldOutView> held_out = holdOutView(parser, &input);
   for (const std::string& warning :
        runLengthSilhouetteWarnings(input.names, input.run_length_masks))
@@ -215,6 +220,7 @@ int runHull(const std::vector<std::string>& args) {
   writeOutputs(parser, result, *octree);
   nlohmann::json json = hullJson(result, occupiedLeaves(*octree), iou);
   json.update(refined);
+  if (found.ball_centre_W) json["silhouettes"] = viewSilhouettesJson(found);
   json["warnings"] = poor.warnings();
   json["peak_memory_mib"] = {{"through_hull", hull_peak_mib}, {"total", peakMemoryMiB()}};
   printResult(parser.flag("json"), json, hullText(json));

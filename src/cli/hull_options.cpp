@@ -63,10 +63,11 @@ HullInput viewSetFromArgs(const ArgParser& parser) {
                        silhouetteConfigFromArgs(parser), viewNamesFromArgs(parser));
 }
 
-HullInput runLengthViewSetFromArgs(const ArgParser& parser) {
+HullInput runLengthViewSetFromArgs(const ArgParser& parser, ViewSilhouettes* report) {
   const std::string masks = parser.has("silhouettes") ? parser.get("silhouettes") : "";
   return loadRunLengthHullInput(parser.get("calib"), parser.get("images"), masks,
-                                silhouetteConfigFromArgs(parser), viewNamesFromArgs(parser));
+                                silhouetteConfigFromArgs(parser), viewNamesFromArgs(parser),
+                                report);
 }
 
 void addHullOptions(ArgParser* parser) {

@@ -9,6 +9,7 @@
 #include "sift_hull/eval/hull_evaluation.h"
 #include "sift_hull/hull/hull_config.h"
 #include "sift_hull/hull/hull_pipeline.h"
+#include "sift_hull/hull/view_silhouettes.h"
 
 namespace sift_hull {
 namespace cli {
@@ -19,7 +20,7 @@ void addViewSetOptions(ArgParser* parser);
 /// The views those options name (all when neither --views nor --views-file is given).
 HullInput viewSetFromArgs(const ArgParser& parser);
 /// The same views with their silhouettes run-length encoded (HullInput::run_length_masks).
-HullInput runLengthViewSetFromArgs(const ArgParser& parser);
+HullInput runLengthViewSetFromArgs(const ArgParser& parser, ViewSilhouettes* report = nullptr);
 
 /// --max-depth, --carve-outside-image, --distance-slack-px, --distance-reduction, --threads, with
 /// HullConfig's defaults.

@@ -1,5 +1,9 @@
 #include "silhouette_options.h"
 
+#include <filesystem>
+#include <opencv2/imgcodecs.hpp>
+#include <stdexcept>
+
 #include "setting_options.h"
 #include "sift_hull/hull/silhouette.h"
 
@@ -23,6 +27,40 @@ SilhouetteConfig silhouetteConfigFromArgs(const ArgParser& parser) {
   }
   validateOptions(config);
   return config;
+}
+
+void addSilhouetteOutputOption(ArgParser* parser) {
+  parser->addOption("out-silhouettes", "DIR",
+                    "write the silhouettes used, one PNG per view named like its image (.png), to "
+                    "look at and correct; --silhouettes DIR reads them back");
+}
+
+void writeSilhouettesFromArgs(const ArgParser& parser, const std::vector<std::string>& names,
+                              const std::function<cv::Mat(size_t)>& mask) {
+  if (!parser.has("out-silhouettes")) return;
+  const std::string directory = parser.get("out-silhouettes");
+  for (size_t i = 0; i < names.size(); ++i) {
+    std::string name = names[i];
+    const std::string::size_type dot = name.find_last_of('.'), slash = name.find_last_of('/');
+    if (dot != std::string::npos && (slash == std::string::npos || dot > slash)) name.erase(dot);
+    const std::string path = directory + "/" + name + ".png";
+    std::filesystem::create_directories(std::filesystem::path(path).parent_path());
+    if (!cv::imwrite(path, mask(i))) throw std::runtime_error(path + ": cannot write the mask");
+  }
+}
+
+nlohmann::json viewSilhouettesJson(const ViewSilhouettes& report) {
+  nlohmann::json json = {{"method", "views"},
+                         {"support_cut_fraction", report.support_fraction},
+                         {"support_cut_height", report.support_height},
+                         {"up", {report.up_W.x(), report.up_W.y(), report.up_W.z()}},
+                         {"time_ms", report.time_ms},
+                         {"warnings", report.warnings}};
+  if (report.ball_centre_W) {
+    const Eigen::Vector3d& c = *report.ball_centre_W;
+    json["frusta_ball"] = {{"centre", {c.x(), c.y(), c.z()}}, {"radius", report.ball_radius}};
+  }
+  return json;
 }
 
 }  // namespace cli

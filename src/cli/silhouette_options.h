@@ -1,7 +1,11 @@
 #pragma once
 
+#include <functional>
+#include <nlohmann/json.hpp>
+
 #include "args.h"
 #include "sift_hull/hull/silhouette.h"
+#include "sift_hull/hull/view_silhouettes.h"
 #include "sift_hull/io/calibration.h"
 
 namespace sift_hull {
@@ -11,6 +15,15 @@ namespace cli {
 /// the defaults of SilhouetteConfig.
 void addSilhouetteOptions(ArgParser* parser);
 SilhouetteConfig silhouetteConfigFromArgs(const ArgParser& parser);
+
+/// --out-silhouettes DIR: write the silhouettes used.
+void addSilhouetteOutputOption(ArgParser* parser);
+/// With --out-silhouettes, writes each view's mask (`mask(i)`, CV_8UC1) as DIR/NAME, the image's
+/// name with the extension .png (sub-directories created).
+void writeSilhouettesFromArgs(const ArgParser& parser, const std::vector<std::string>& names,
+                              const std::function<cv::Mat(size_t)>& mask);
+/// What the "views" method found, for the JSON: the ball, the support cut, time, warnings.
+nlohmann::json viewSilhouettesJson(const ViewSilhouettes& report);
 
 }  // namespace cli
 }  // namespace sift_hull

@@ -9,7 +9,12 @@
 
 namespace sift_hull {
 
-/// Silhouette extraction from an image. Two methods:
+/// Silhouette extraction from images. Three methods:
+/// - "views", from all the views of a calibrated set together
+///   (sift_hull/hull/view_silhouettes.h): a prior from the cameras' common frusta, GrabCut with
+///   the image border as background, a coarse hull tolerant of a tenth of the views, its support
+///   cut, the hull's projection as the prior of a second cut. `segment_side_px` is the working
+///   size. For one image alone (silhouetteFromImage) it is "background".
 /// - "background" (the default), a colour model of the image border (the object rarely touches
 ///   it): each pixel's colour distance (CIE Lab) to the nearest of the border's colour clusters
 ///   (k-means, k = 8; clusters under 0.5 % of the border dropped), a threshold on that distance
@@ -24,10 +29,11 @@ namespace sift_hull {
 ///   dilation and an erosion with discs of the given radii. The command line and the nodes take
 ///   it when a threshold is given and no method is named.
 struct SilhouetteConfig {
-  std::string silhouette_method = "background";  ///< "background" or "threshold"
+  std::string silhouette_method = "background";  ///< "views", "background" or "threshold"
   double threshold = 0.19;
   int dilate_px = 10;
   int erode_px = 7;
+  int segment_side_px = 400;  ///< "views": longest side of the images the cuts work on
 };
 /// Its settings: names, units, ranges, help (sift_hull/settings.h).
 template <>
@@ -38,7 +44,7 @@ const SettingTable<SilhouetteConfig>& settingsOf<SilhouetteConfig>();
 void validate(const SilhouetteConfig& config);
 
 /// Mask (CV_8UC1, 255 inside, 0 outside) of the object in an 8-bit grey or BGR image, by the
-/// config's method.
+/// config's method ("views" needs the other views: "background" here).
 cv::Mat silhouetteFromImage(const cv::Mat& image, const SilhouetteConfig& config);
 
 /// The colour distance of every pixel (CV_32FC1, CIE Lab units) to the nearest colour cluster of

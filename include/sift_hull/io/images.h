@@ -6,6 +6,7 @@
 
 #include "sift_hull/hull/run_length_mask.h"
 #include "sift_hull/hull/silhouette.h"
+#include "sift_hull/hull/view_silhouettes.h"
 #include "sift_hull/io/calibration.h"
 
 namespace sift_hull {
@@ -48,19 +49,24 @@ cv::Mat loadMask(const std::string& path);
 /// Silhouettes of all views, in view order: the mask file of each view (maskPath) in
 /// `mask_directory` when that is not empty, else the image's alpha channel when it has a varying
 /// one (loadViewImageWithAlpha), else extracted from the view's image in `image_directory` by
-/// `recipe`. Mask files may hold 1, 3 or 4 channels: any non-zero grey level is inside.
+/// `recipe`; by the "views" method (silhouettesFromViews), all views' images together, their
+/// cameras the views', and `report`, when given, gets what it found (priors, hull projections,
+/// support, warnings; not the masks). Mask files may hold 1, 3 or 4 channels: any non-zero grey
+/// level is inside.
 /// Throws std::runtime_error naming a missing or unreadable file, a mask whose size differs from
 /// its image's, or an image whose size differs from the first view's.
 std::vector<cv::Mat> loadSilhouettes(const std::vector<CalibratedView>& views,
                                      const std::string& image_directory,
                                      const std::string& mask_directory,
-                                     const SilhouetteConfig& recipe);
+                                     const SilhouetteConfig& recipe,
+                                     ViewSilhouettes* report = nullptr);
 
 /// loadSilhouettes(), each silhouette run-length encoded as soon as it is made: at most one
 /// full-resolution image and mask per thread stays in memory at a time.
 std::vector<RunLengthMask> loadRunLengthSilhouettes(const std::vector<CalibratedView>& views,
                                                     const std::string& image_directory,
                                                     const std::string& mask_directory,
-                                                    const SilhouetteConfig& recipe);
+                                                    const SilhouetteConfig& recipe,
+                                                    ViewSilhouettes* report = nullptr);
 
 }  // namespace sift_hull

@@ -5,6 +5,7 @@
 
 #include "sift_hull/hull/hull_pipeline.h"
 #include "sift_hull/hull/silhouette.h"
+#include "sift_hull/hull/view_silhouettes.h"
 
 namespace sift_hull {
 
@@ -18,13 +19,15 @@ std::vector<std::string> readViewList(const std::string& path);
 /// The calibration is read by readCalibrationWithImages(calibration_path, image_directory).
 HullInput loadHullInput(const std::string& calibration_path, const std::string& image_directory,
                         const std::string& mask_directory, const SilhouetteConfig& recipe,
-                        const std::vector<std::string>& view_names);
+                        const std::vector<std::string>& view_names,
+                        ViewSilhouettes* report = nullptr);
 
 /// loadHullInput() with the silhouettes run-length encoded as they are read
 /// (HullInput::run_length_masks, `masks` empty): no full-resolution mask is kept.
 HullInput loadRunLengthHullInput(const std::string& calibration_path,
                                  const std::string& image_directory,
                                  const std::string& mask_directory, const SilhouetteConfig& recipe,
-                                 const std::vector<std::string>& view_names);
+                                 const std::vector<std::string>& view_names,
+                                 ViewSilhouettes* report = nullptr);
 
 }  // namespace sift_hull

@@ -7,10 +7,10 @@
 #include <vector>
 
 #include "sift_hull/hull/hull_config.h"
-#include "sift_hull/hull/hull_stream.h"
-#include "sift_hull/hull/silhouette.h"
 #include "sift_hull/hull/hull_pipeline.h"
+#include "sift_hull/hull/hull_stream.h"
 #include "sift_hull/hull/reduced_distance_map.h"
+#include "sift_hull/hull/silhouette.h"
 #include "sift_hull/limits.h"
 
 namespace sift_hull {
@@ -52,9 +52,10 @@ const SettingTable<SilhouetteConfig>& settingsOf<SilhouetteConfig>() {
   static const SettingTable<SilhouetteConfig> table = [] {
     SettingTable<SilhouetteConfig> t;
     t.add("silhouette_method", &SilhouetteConfig::silhouette_method, "",
-          "how a silhouette is taken from a photo: background (the border's colours, no "
-          "threshold) or threshold (grey level)")
-        .oneOf({"background", "threshold"});
+          "how a silhouette is taken from a photo: views (all calibrated views together: a "
+          "prior from the cameras, GrabCut, a coarse hull), background (the border's colours, "
+          "one image) or threshold (grey level)")
+        .oneOf({"views", "background", "threshold"});
     t.add("threshold", &SilhouetteConfig::threshold, "",
           "the threshold method: grey level in [0, 1] above which a pixel is the object")
         .range(0.0, 1.0);
@@ -64,6 +65,9 @@ const SettingTable<SilhouetteConfig>& settingsOf<SilhouetteConfig>() {
     t.add("erode_px", &SilhouetteConfig::erode_px, "px",
           "radius of the disc the mask is then eroded with")
         .range(0, limits::kMaxMorphologyRadiusPx);
+    t.add("segment_side_px", &SilhouetteConfig::segment_side_px, "px",
+          "the views method: longest image side the segmentation works at")
+        .range(64, 4096);
     return t;
   }();
   return table;

@@ -14,7 +14,6 @@
 
 namespace sift_hull {
 
-
 namespace {
 
 /// The least share of the border a background colour cluster holds.
@@ -240,8 +239,8 @@ cv::Mat silhouetteFromImage(const cv::Mat& image, const SilhouetteConfig& config
   if (image.empty() || image.depth() != CV_8U) {
     throw std::invalid_argument("silhouetteFromImage needs a non-empty 8-bit image");
   }
-  return config.silhouette_method == "background" ? backgroundSilhouette(image, config)
-                                                  : thresholdSilhouette(image, config);
+  return config.silhouette_method != "threshold" ? backgroundSilhouette(image, config)
+                                                 : thresholdSilhouette(image, config);
 }
 
 std::vector<std::string> silhouetteWarnings(const std::vector<std::string>& names,

@@ -2,6 +2,7 @@
 
 #include <dirent.h>
 
+#include <algorithm>
 #include <cctype>
 #include <exception>
 #include <fstream>
@@ -9,6 +10,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
+
+#include "sift_hull/hull/view_silhouettes.h"
 
 namespace sift_hull {
 namespace {
@@ -153,12 +156,17 @@ template <typename Kept, typename Keep>
 std::vector<Kept> loadSilhouettesAs(const std::vector<CalibratedView>& views,
                                     const std::string& image_directory,
                                     const std::string& mask_directory,
-                                    const SilhouetteConfig& recipe, const Keep& keep) {
+                                    const SilhouetteConfig& recipe, const Keep& keep,
+                                    ViewSilhouettes* report) {
+  const bool together =
+      mask_directory.empty() && recipe.silhouette_method == "views" && views.size() >= 2;
   // Each view read and its silhouette made on OpenCV's threads, one image in memory per thread;
   // then the checks in view order, so the first error is the one a sequential read would meet.
   struct Loaded {
     cv::Size image_size, silhouette_size;
     Kept silhouette;
+    cv::Mat working;  ///< the "views" method: the image at the working size, until all are read
+    bool pending = false;
     std::exception_ptr error;
   };
   std::vector<Loaded> loaded(views.size());
@@ -170,8 +178,16 @@ std::vector<Kept> loadSilhouettesAs(const std::vector<CalibratedView>& views,
           // An image with an alpha channel carries its own silhouette.
           const ViewImage image = loadViewImageWithAlpha(image_directory, views[i]);
           loaded[i].image_size = image.bgr.size();
-          silhouette =
-              image.alpha_mask.empty() ? silhouetteFromImage(image.bgr, recipe) : image.alpha_mask;
+          if (!image.alpha_mask.empty()) {
+            silhouette = image.alpha_mask;
+          } else if (together) {
+            cv::resize(image.bgr, loaded[i].working,
+                       workingSize(image.bgr.size(), recipe.segment_side_px), 0, 0, cv::INTER_AREA);
+            loaded[i].pending = true;
+            continue;
+          } else {
+            silhouette = silhouetteFromImage(image.bgr, recipe);
+          }
         } else {
           loaded[i].image_size = loadViewImage(image_directory, views[i]).size();
           silhouette = loadMask(maskPath(mask_directory, views[i].name));
@@ -198,11 +214,41 @@ std::vector<Kept> loadSilhouettesAs(const std::vector<CalibratedView>& views,
                                "): one calibration set is for one image size");
     }
     if (loaded[i].error) std::rethrow_exception(loaded[i].error);
+    if (loaded[i].pending) {
+      silhouettes.emplace_back();
+      continue;
+    }
     if (loaded[i].silhouette_size != size) {
       throw std::runtime_error(mask_directory + "/" + view.name +
                                ": mask size differs from the image's");
     }
     silhouettes.push_back(std::move(loaded[i].silhouette));
+  }
+  const bool any_pending =
+      std::any_of(loaded.begin(), loaded.end(), [](const Loaded& l) { return l.pending; });
+  if (!any_pending) return silhouettes;
+  // The "views" method: every view's working-size image at once, with the cameras.
+  std::vector<cv::Mat> working;
+  std::vector<PinholeCamera> cameras;
+  std::vector<std::string> names;
+  const cv::Size size = workingSize(loaded[0].image_size, recipe.segment_side_px);
+  for (size_t i = 0; i < views.size(); ++i) {
+    if (loaded[i].working.empty()) {  // a view with its own alpha mask: read again, small
+      cv::resize(loadViewImage(image_directory, views[i]), loaded[i].working, size, 0, 0,
+                 cv::INTER_AREA);
+    }
+    working.push_back(std::move(loaded[i].working));
+    cameras.push_back(views[i].camera);
+    names.push_back(views[i].name);
+  }
+  ViewSilhouettes found =
+      silhouettesFromViews(working, cameras, names, loaded[0].image_size, recipe);
+  for (size_t i = 0; i < views.size(); ++i) {
+    if (loaded[i].pending) silhouettes[i] = keep(found.masks[i]);
+  }
+  if (report != nullptr) {
+    found.masks.clear();
+    *report = std::move(found);
   }
   return silhouettes;
 }
@@ -212,18 +258,20 @@ std::vector<Kept> loadSilhouettesAs(const std::vector<CalibratedView>& views,
 std::vector<cv::Mat> loadSilhouettes(const std::vector<CalibratedView>& views,
                                      const std::string& image_directory,
                                      const std::string& mask_directory,
-                                     const SilhouetteConfig& recipe) {
-  return loadSilhouettesAs<cv::Mat>(views, image_directory, mask_directory, recipe,
-                                    [](const cv::Mat& silhouette) { return silhouette; });
+                                     const SilhouetteConfig& recipe, ViewSilhouettes* report) {
+  return loadSilhouettesAs<cv::Mat>(
+      views, image_directory, mask_directory, recipe,
+      [](const cv::Mat& silhouette) { return silhouette; }, report);
 }
 
 std::vector<RunLengthMask> loadRunLengthSilhouettes(const std::vector<CalibratedView>& views,
                                                     const std::string& image_directory,
                                                     const std::string& mask_directory,
-                                                    const SilhouetteConfig& recipe) {
+                                                    const SilhouetteConfig& recipe,
+                                                    ViewSilhouettes* report) {
   return loadSilhouettesAs<RunLengthMask>(
       views, image_directory, mask_directory, recipe,
-      [](const cv::Mat& silhouette) { return RunLengthMask(silhouette); });
+      [](const cv::Mat& silhouette) { return RunLengthMask(silhouette); }, report);
 }
 
 }  // namespace sift_hull

@@ -64,11 +64,11 @@ void addCameras(const std::vector<CalibratedView>& views, HullInput* input) {
 
 HullInput loadHullInput(const std::string& calibration_path, const std::string& image_directory,
                         const std::string& mask_directory, const SilhouetteConfig& recipe,
-                        const std::vector<std::string>& view_names) {
+                        const std::vector<std::string>& view_names, ViewSilhouettes* report) {
   const std::vector<CalibratedView> views =
       hullViews(calibration_path, image_directory, view_names);
   HullInput input;
-  input.masks = loadSilhouettes(views, image_directory, mask_directory, recipe);
+  input.masks = loadSilhouettes(views, image_directory, mask_directory, recipe, report);
   addCameras(views, &input);
   return input;
 }
@@ -76,11 +76,13 @@ HullInput loadHullInput(const std::string& calibration_path, const std::string& 
 HullInput loadRunLengthHullInput(const std::string& calibration_path,
                                  const std::string& image_directory,
                                  const std::string& mask_directory, const SilhouetteConfig& recipe,
-                                 const std::vector<std::string>& view_names) {
+                                 const std::vector<std::string>& view_names,
+                                 ViewSilhouettes* report) {
   const std::vector<CalibratedView> views =
       hullViews(calibration_path, image_directory, view_names);
   HullInput input;
-  input.run_length_masks = loadRunLengthSilhouettes(views, image_directory, mask_directory, recipe);
+  input.run_length_masks =
+      loadRunLengthSilhouettes(views, image_directory, mask_directory, recipe, report);
   addCameras(views, &input);
   return input;
 }

@@ -1,0 +1,65 @@
+#pragma once
+
+#include <Eigen/Core>
+#include <opencv2/core.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "sift_hull/geometry/camera.h"
+#include "sift_hull/hull/bounding_box.h"
+#include "sift_hull/hull/silhouette.h"
+
+namespace sift_hull {
+
+/// Silhouettes from the photographs of a calibrated set, without masks (the "views" method of
+/// SilhouetteConfig). The cameras tell where the object is: what they all look at.
+///  1. Prior: the largest ball inside the intersection of all views' frusta (its centre found on a
+///     grid, refined twice, inside the frusta's LP box; hullBoundingBox), projected into each view
+///     as "probably object". It needs no metric camera and no point on the optical axes.
+///  2. Each view segmented by OpenCV's GrabCut at half the working size, its border band certain
+///     background (so that floor, table and turntable colours enter the background model).
+///  3. A coarse hull carved from those masks on a grid of `kCoarseCells` cells along the longest
+///     side, tolerating the disagreement of a tenth of the views; a support below the object (a
+///     floor patch, a shadow, a turntable disc: a flat layer at the bottom, along the cameras' mean
+///     up direction, much wider than what stands on it) is cut away.
+///  4. The hull projected back as the new prior; each view segmented again at the working size;
+///     the mask is that segmentation inside the hull's projection, upsampled to the image.
+struct ViewSilhouettes {
+  std::vector<cv::Mat> masks;             ///< CV_8UC1 at each image's full size, 255 inside
+  std::vector<cv::Mat> priors;            ///< working size: the ball's projection, 255 inside
+  std::vector<cv::Mat> hull_projections;  ///< working size: the coarse hull's projection
+  std::optional<Eigen::Vector3d> ball_centre_W;
+  double ball_radius = 0.0;
+  /// The support cut from the coarse hull: its share of the coarse hull's cells, and its top's
+  /// height above the hull's lowest cell along the up direction (world units). 0 when none.
+  double support_fraction = 0.0;
+  double support_height = 0.0;
+  Eigen::Vector3d up_W = Eigen::Vector3d::UnitZ();
+  /// Views whose segmentation the other views do not confirm, named for the user.
+  std::vector<std::string> warnings;
+  double time_ms = 0.0;
+};
+
+/// Cells along the longest side of the coarse hull's grid.
+inline constexpr int kCoarseCells = 96;
+
+/// The views' silhouettes by the method above. `images` are BGR, 8 bits, at the working size
+/// (SilhouetteConfig::segment_side_px on the longest side, or smaller), `full_size` the size of the
+/// images the cameras are for. Throws std::runtime_error, naming the views, when the set cannot be
+/// separated: fewer than two views, frusta with no common part, or a coarse hull that is empty.
+ViewSilhouettes silhouettesFromViews(const std::vector<cv::Mat>& images,
+                                     const std::vector<PinholeCamera>& cameras,
+                                     const std::vector<std::string>& names, cv::Size full_size,
+                                     const SilhouetteConfig& config);
+
+/// The working size of an image of `full_size`: its longest side brought to at most
+/// `segment_side_px`, the aspect kept.
+cv::Size workingSize(cv::Size full_size, int segment_side_px);
+
+/// The centre and radius of (about) the largest ball inside every camera's frustum, inside `box`;
+/// nullopt when no point of the box is inside every frustum.
+std::optional<std::pair<Eigen::Vector3d, double>> largestBallInFrusta(
+    const std::vector<PinholeCamera>& cameras, cv::Size full_size, const Box3d& box);
+
+}  // namespace sift_hull

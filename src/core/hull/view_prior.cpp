@@ -1,0 +1,173 @@
+// The 3-D side of the "views" silhouettes (hull/view_prior.h).
+
+#include "hull/view_prior.h"
+
+#include <algorithm>
+#include <cmath>
+#include <mutex>
+#include <opencv2/core/utility.hpp>
+#include <opencv2/imgproc.hpp>
+#include <unordered_set>
+
+namespace sift_hull {
+namespace view_prior {
+namespace {
+
+struct Grid {
+  Eigen::Vector3d origin;
+  double cell = 0.0;
+  int nx = 0, ny = 0, nz = 0;
+  Eigen::Vector3d centre(int x, int y, int z) const {
+    return origin + cell * Eigen::Vector3d(x + 0.5, y + 0.5, z + 0.5);
+  }
+};
+
+Grid gridOver(const Box3d& box, int cells) {
+  Grid grid;
+  grid.cell = box.size().maxCoeff() / cells;
+  grid.origin = box.min_W;
+  const Eigen::Vector3d size = box.size();
+  grid.nx = std::max(1, static_cast<int>(std::ceil(size.x() / grid.cell)));
+  grid.ny = std::max(1, static_cast<int>(std::ceil(size.y() / grid.cell)));
+  grid.nz = std::max(1, static_cast<int>(std::ceil(size.z() / grid.cell)));
+  return grid;
+}
+
+}  // namespace
+
+CoarseHull carve(const std::vector<cv::Mat>& masks, const std::vector<PinholeCamera>& cameras,
+                 const PixelScale& scale, const Box3d& box, int cells, int tolerated) {
+  const Grid grid = gridOver(box, cells);
+  CoarseHull hull;
+  hull.cell = grid.cell;
+  std::mutex mutex;
+  cv::parallel_for_(cv::Range(0, grid.nz), [&](const cv::Range& range) {
+    std::vector<Eigen::Vector3d> kept;
+    for (int z = range.start; z < range.end; ++z) {
+      for (int y = 0; y < grid.ny; ++y) {
+        for (int x = 0; x < grid.nx; ++x) {
+          const Eigen::Vector3d X = grid.centre(x, y, z);
+          int against = 0, seen = 0;
+          for (size_t v = 0; v < cameras.size() && against <= tolerated; ++v) {
+            if (!(cameras[v].depth(X) > 0.0)) continue;
+            const Eigen::Vector2d p = scale(cameras[v].project(X));
+            const int u = static_cast<int>(std::lround(p.x()));
+            const int w = static_cast<int>(std::lround(p.y()));
+            if (u < 0 || w < 0 || u >= masks[v].cols || w >= masks[v].rows) continue;
+            ++seen;
+            against += masks[v].at<uint8_t>(w, u) == 0;
+          }
+          if (against <= tolerated && seen >= 2) kept.push_back(X);
+        }
+      }
+    }
+    const std::lock_guard<std::mutex> lock(mutex);
+    hull.centres_W.insert(hull.centres_W.end(), kept.begin(), kept.end());
+  });
+  return hull;
+}
+
+Box3d boxOf(const CoarseHull& hull, double margin_cells) {
+  Box3d box;
+  if (hull.centres_W.empty()) return box;
+  box.min_W = box.max_W = hull.centres_W.front();
+  for (const Eigen::Vector3d& c : hull.centres_W) {
+    box.min_W = box.min_W.cwiseMin(c);
+    box.max_W = box.max_W.cwiseMax(c);
+  }
+  const double margin = (0.5 + margin_cells) * hull.cell;
+  box.min_W.array() -= margin;
+  box.max_W.array() += margin;
+  return box;
+}
+
+Eigen::Vector3d meanUp(const std::vector<PinholeCamera>& cameras) {
+  Eigen::Vector3d up = Eigen::Vector3d::Zero();
+  for (const PinholeCamera& camera : cameras) {
+    // The image's y axis points down; its sign follows the camera's handedness.
+    const double hand = camera.improper() ? -1.0 : 1.0;
+    up -= hand * camera.R().row(1).transpose();
+  }
+  return up.norm() > 1e-9 ? Eigen::Vector3d(up.normalized()) : Eigen::Vector3d::UnitZ();
+}
+
+double cutSupport(const Eigen::Vector3d& up, CoarseHull* hull, double* height) {
+  *height = 0.0;
+  if (hull->centres_W.size() < 64) return 0.0;
+  double low = std::numeric_limits<double>::infinity(), high = -low;
+  for (const Eigen::Vector3d& c : hull->centres_W) {
+    low = std::min(low, up.dot(c));
+    high = std::max(high, up.dot(c));
+  }
+  const int layers = static_cast<int>(std::floor((high - low) / hull->cell)) + 1;
+  std::vector<double> area(static_cast<size_t>(layers), 0.0);
+  const auto layerOf = [&](const Eigen::Vector3d& c) {
+    return std::clamp(static_cast<int>(std::floor((up.dot(c) - low) / hull->cell + 0.5)), 0,
+                      layers - 1);
+  };
+  for (const Eigen::Vector3d& c : hull->centres_W) area[static_cast<size_t>(layerOf(c))] += 1.0;
+  const int thickest = std::max(2, layers / 10);
+  int cut = 0;
+  double widest = 0.0;
+  for (int c = 1; c <= thickest && c + 5 <= layers; ++c) {
+    widest = std::max(widest, area[static_cast<size_t>(c - 1)]);
+    std::vector<double> above(area.begin() + c, area.begin() + c + 5);
+    std::nth_element(above.begin(), above.begin() + 2, above.end());
+    if (widest > 3.0 * above[2]) cut = c;
+  }
+  if (cut == 0) return 0.0;
+  // A support is a notable part of what the views agree on; a few wide cells are the object's.
+  double below = 0.0;
+  for (int c = 0; c < cut; ++c) below += area[static_cast<size_t>(c)];
+  if (below < 0.01 * static_cast<double>(hull->centres_W.size())) return 0.0;
+  const size_t before = hull->centres_W.size();
+  hull->centres_W.erase(std::remove_if(hull->centres_W.begin(), hull->centres_W.end(),
+                                       [&](const Eigen::Vector3d& c) { return layerOf(c) < cut; }),
+                        hull->centres_W.end());
+  *height = cut * hull->cell;
+  return 1.0 - static_cast<double>(hull->centres_W.size()) / static_cast<double>(before);
+}
+
+cv::Mat project(const CoarseHull& hull, const PinholeCamera& camera, const PixelScale& scale,
+                cv::Size size) {
+  cv::Mat mask = cv::Mat::zeros(size, CV_8UC1);
+  if (hull.centres_W.empty()) return mask;
+  // Surface cells: those with an empty face neighbour. Cells are keyed by their grid index
+  // relative to the first cell.
+  const Eigen::Vector3d origin = hull.centres_W.front();
+  const auto key = [&](const Eigen::Vector3d& c) {
+    const Eigen::Vector3d i = (c - origin) / hull.cell;
+    const int64_t x = std::llround(i.x()) + 4096, y = std::llround(i.y()) + 4096,
+                  z = std::llround(i.z()) + 4096;
+    return (x << 26) | (y << 13) | z;
+  };
+  std::unordered_set<int64_t> cells;
+  cells.reserve(hull.centres_W.size() * 2);
+  for (const Eigen::Vector3d& c : hull.centres_W) cells.insert(key(c));
+  const double focal = std::abs(camera.K()(0, 0)) * scale.sx;
+  static const int kFaces[6][3] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
+                                   {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
+  for (const Eigen::Vector3d& c : hull.centres_W) {
+    bool surface = false;
+    for (const auto& f : kFaces) {
+      surface = surface || !cells.count(key(c + hull.cell * Eigen::Vector3d(f[0], f[1], f[2])));
+    }
+    const double depth = camera.depth(c);
+    if (!surface || !(depth > 0.0)) continue;
+    const Eigen::Vector2d p = scale(camera.project(c));
+    const double radius = 0.9 * focal * hull.cell / depth;
+    if (p.x() < -radius || p.y() < -radius || p.x() > size.width + radius ||
+        p.y() > size.height + radius) {
+      continue;
+    }
+    cv::circle(
+        mask, cv::Point(static_cast<int>(std::lround(p.x())), static_cast<int>(std::lround(p.y()))),
+        std::max(1, static_cast<int>(std::ceil(radius))), cv::Scalar(255), cv::FILLED);
+  }
+  cv::morphologyEx(mask, mask, cv::MORPH_CLOSE,
+                   cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(5, 5)));
+  return mask;
+}
+
+}  // namespace view_prior
+}  // namespace sift_hull
