@@ -13,6 +13,7 @@ set(SIFT_HULL_CORE_GTESTS
   test_dataset io
   test_colmap io
   test_calibration_formats io
+  test_idr_cameras eval
   test_ply io
   test_ground_truth_files io
   test_features eval
@@ -53,4 +54,4 @@ set(SIFT_HULL_CORE_GTESTS
 # The libFuzzer harnesses of test/fuzz, file test/fuzz/fuzz_<name>.cpp; test_fuzz_corpus replays
 # their corpus through them, each entry point renamed fuzz_<name>.
 set(SIFT_HULL_FUZZ_HARNESSES middlebury_par projection_list homography pfm ply bounding_box
-  colmap_binary npy)
+  colmap_binary npy idr_cameras)
