@@ -14,3 +14,7 @@ find_library(GLPK_LIBRARY glpk REQUIRED)
 # that the alternatives system points at, and the library itself).
 find_path(OPENBLAS_INCLUDE_DIR cblas.h PATH_SUFFIXES openblas-pthread openblas REQUIRED)
 find_library(OPENBLAS_LIBRARY openblas REQUIRED)
+# minizip (libminizip-dev) reads and writes the zip archives of numpy's .npz files (IDR cameras);
+# Debian ships a pkg-config file for it, no CMake one.
+find_package(PkgConfig REQUIRED)
+pkg_check_modules(minizip REQUIRED IMPORTED_TARGET minizip)

@@ -15,6 +15,7 @@ set(SIFT_HULL_CORE_GTESTS
   test_calibration_formats io
   test_nerf_transforms eval
   test_photo_set_inputs eval
+  test_idr_cameras eval
   test_ply io
   test_ground_truth_files io
   test_features eval
@@ -55,4 +56,4 @@ set(SIFT_HULL_CORE_GTESTS
 # The libFuzzer harnesses of test/fuzz, file test/fuzz/fuzz_<name>.cpp; test_fuzz_corpus replays
 # their corpus through them, each entry point renamed fuzz_<name>.
 set(SIFT_HULL_FUZZ_HARNESSES middlebury_par projection_list homography pfm ply bounding_box
-  colmap_binary npy nerf_transforms)
+  colmap_binary npy nerf_transforms idr_cameras)

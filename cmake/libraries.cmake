@@ -9,8 +9,8 @@
 #                               sift_hull_pipeline
 # Used by the package's CMakeLists.txt and by the sanitizer build (test/sanitize), which makes static
 # variants with other compile flags. Expects OpenCV, Eigen3, octomap, VTK, GLPK (GLPK_INCLUDE_DIR,
-# GLPK_LIBRARY), OpenBLAS (OPENBLAS_INCLUDE_DIR, OPENBLAS_LIBRARY), nlohmann_json and Threads to be
-# found already.
+# GLPK_LIBRARY), OpenBLAS (OPENBLAS_INCLUDE_DIR, OPENBLAS_LIBRARY), nlohmann_json, minizip
+# (PkgConfig::minizip) and Threads to be found already (cmake/dependencies.cmake).
 include(${CMAKE_CURRENT_LIST_DIR}/sources.cmake)
 
 function(sift_hull_add_libraries)
@@ -37,7 +37,8 @@ function(sift_hull_add_libraries)
 
   set(io sift_hull_io${ARG_SUFFIX})
   add_library(${io} ${type} ${IO})
-  target_link_libraries(${io} PUBLIC ${core} PRIVATE nlohmann_json::nlohmann_json)
+  target_link_libraries(${io} PUBLIC ${core} PRIVATE nlohmann_json::nlohmann_json
+    PkgConfig::minizip)
 
   set(pipeline sift_hull_pipeline${ARG_SUFFIX})
   add_library(${pipeline} ${type} ${PIPELINE})

@@ -68,9 +68,11 @@ set(SIFT_HULL_IO_SOURCES
   src/core/io/colmap_text.cpp
   src/core/io/colmap_writer.cpp
   src/core/io/ground_truth_files.cpp
+  src/core/io/idr.cpp
   src/core/io/images.cpp
   src/core/io/llff.cpp
   src/core/io/nerf.cpp
+  src/core/io/npz.cpp
   src/core/io/pfm.cpp
   src/core/io/ply.cpp
   src/core/io/view_list.cpp

@@ -40,6 +40,11 @@ constexpr size_t kMaxCalibrationViews = 1000000;
 constexpr size_t kMaxImageNameChars = 4096;
 /// Bytes of a .npy header (LLFF poses_bounds.npy); numpy writes well under 200.
 constexpr size_t kMaxNpyHeaderBytes = 65536;
+/// Decompressed bytes of one .npy entry of an .npz archive (IDR cameras.npz), checked before it is
+/// allocated: a 4x4 float64 array takes 256 bytes, so a deflate bomb stops here.
+constexpr size_t kMaxNpzEntryBytes = 1 << 20;
+/// Entries of an .npz archive: IDR and NeuS write six arrays per view.
+constexpr size_t kMaxNpzEntries = 16 * kMaxCalibrationViews;
 
 /// Throws std::invalid_argument "`name` must be in [low, high], got value" when out of range.
 inline void requireInRange(const std::string& name, long long value, long long low,

@@ -1,11 +1,14 @@
 #include <algorithm>
+#include <iomanip>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <sstream>
 
 #include "args.h"
 #include "commands.h"
 #include "sift_hull/geometry/camera_set.h"
 #include "sift_hull/io/calibration.h"
+#include "sift_hull/io/idr.h"
 #include "sift_hull/io/images.h"
 #include "silhouette_options.h"
 
@@ -51,6 +54,20 @@ nlohmann::json commonPointJson(const std::vector<CalibratedView>& views, cv::Siz
   return result;
 }
 
+/// The box around IDR's object sphere (idrObjectBox), or null without a scale_mat_0.
+nlohmann::json idrBoxJson(const std::string& calib) {
+  const std::optional<Box3d> box = idrObjectBox(calib);
+  if (!box) return nullptr;
+  std::ostringstream option;
+  option << std::setprecision(9);
+  for (int i = 0; i < 6; ++i) {
+    option << (i ? "," : "") << (i < 3 ? box->min_W(i) : box->max_W(i - 3));
+  }
+  return {{"min", vectorJson(box->min_W)},
+          {"max", vectorJson(box->max_W)},
+          {"box_option", option.str()}};
+}
+
 nlohmann::json distortionJson(const LensDistortion& d) {
   return {{"k1", d.k1}, {"k2", d.k2}, {"p1", d.p1}, {"p2", d.p2},
           {"k3", d.k3}, {"k4", d.k4}, {"k5", d.k5}, {"k6", d.k6}};
@@ -90,6 +107,11 @@ std::string describe(const nlohmann::json& info) {
   }
   if (!common["reason"].is_null()) text << ": " << common["reason"].get<std::string>();
   text << "\n";
+  if (info.contains("idr_object_box") && !info["idr_object_box"].is_null()) {
+    const auto& box = info["idr_object_box"];
+    text << "IDR object box (scale_mat_0's unit sphere): " << box["min"].dump() << " .. "
+         << box["max"].dump() << " (--box " << box["box_option"].get<std::string>() << ")\n";
+  }
   return text.str();
 }
 
@@ -103,20 +125,25 @@ int runDatasetInfo(const std::vector<std::string>& args) {
                    "and inside every image), and the share of each image its silhouette covers.");
   parser.addOption("calib", "FILE|DIR",
                    "Middlebury *_par.txt, a list of 3x4 projection matrices, a COLMAP sparse model "
-                   "directory or an LLFF poses_bounds.npy");
+                   "directory, an LLFF poses_bounds.npy, a NeRF transforms.json or an IDR / NeuS "
+                   "cameras.npz (or the directory holding it)");
   parser.addOption(
       "images", "DIR",
-      "directory of the images (default: the calibration file's, or the COLMAP model directory)");
+      "directory of the images (default: the calibration file's, the COLMAP model directory, "
+      "or IDR's image/ beside cameras.npz)");
   addSilhouetteOptions(&parser);
   addSilhouetteOutputOption(&parser);
   parser.addFlag("json", "print the result as one JSON object");
   if (!parser.parse(args)) return 0;
   const std::string calib = parser.get("calib");
   const std::string format = calibrationFormat(calib);
-  // A COLMAP model is a directory: its images default to that directory, a file's to its own.
+  // A COLMAP model is a directory: its images default to that directory, IDR's to its image/, a
+  // file's to its own.
+  const bool idr = format == "IDR cameras.npz";
   const std::string images = parser.has("images")             ? parser.get("images")
                              : format.rfind("COLMAP", 0) == 0 ? calib
-                                                              : parentDirectory(calib);
+                             : idr ? idrImageDirectory(idrCamerasFile(calib), "")
+                                   : parentDirectory(calib);
 
   const std::vector<CalibratedView> views = readCalibrationWithImages(calib, images);
   ViewSilhouettes found;
@@ -144,6 +171,7 @@ int runDatasetInfo(const std::vector<std::string>& args) {
                          {"cameras", cameras},
                          {"common_point", commonPointJson(views, size)}};
   if (found.ball_centre_W) info["silhouettes"] = viewSilhouettesJson(found);
+  if (idr) info["idr_object_box"] = idrBoxJson(calib);
   printResult(parser.flag("json"), info, describe(info));
   return 0;
 }

@@ -42,8 +42,9 @@ size_t viewIndex(const std::vector<CalibratedView>& views, const std::string& na
 
 void addPairOptions(ArgParser* parser) {
   parser->addOption("calib", "FILE",
-                    "calibration of the pair (Middlebury par, projections, COLMAP model directory "
-                    "or LLFF poses_bounds.npy, whose views are the images beside the left one)");
+                    "calibration of the pair (Middlebury par, projections, COLMAP model "
+                    "directory, NeRF transforms.json, or LLFF poses_bounds.npy or IDR cameras.npz, "
+                    "whose views are the images beside the left one)");
   parser->addOption("left-view", "NAME", "LEFT's name in --calib (default: its file name)");
   parser->addOption("right-view", "NAME", "RIGHT's name in --calib (default: its file name)");
   parser->addFlag("rectified", "the pair is rectified: epipolar lines are image rows");

@@ -49,8 +49,8 @@ std::vector<std::string> viewNamesFromArgs(const ArgParser& parser) {
 void addViewSetOptions(ArgParser* parser) {
   parser->addOption("calib", "FILE|DIR",
                     "Middlebury par file, projection list, COLMAP sparse model directory, LLFF "
-                    "poses_bounds.npy, or NeRF transforms.json (or a directory of "
-                    "transforms*.json)");
+                    "poses_bounds.npy, NeRF transforms.json, or IDR / NeuS cameras.npz (or a "
+                    "directory holding it; its views are the sorted images of --images)");
   parser->addOption("images", "DIR", "directory of the images the calibration names");
   addSilhouetteOptions(parser);
   parser->addOption("views", "LIST", "comma-separated image names to use (default: all)");

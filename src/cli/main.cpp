@@ -11,7 +11,8 @@ const Program& offlineProgram() {
   static const Program program{
       "sift_hull",
       {
-          {"dataset-info", "summarise a calibrated view set (par, projection list, COLMAP, LLFF)",
+          {"dataset-info",
+           "summarise a calibrated view set (par, projection list, COLMAP, LLFF, NeRF, IDR)",
            runDatasetInfo},
           {"scene", "render a synthetic scene with exact ground truth", runScene},
           {"match", "match SIFT features of two images and filter them (epipolar, gsc, ...)",

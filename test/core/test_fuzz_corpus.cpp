@@ -23,6 +23,7 @@ extern "C" int fuzz_bounding_box(const uint8_t* data, size_t size);
 extern "C" int fuzz_colmap_binary(const uint8_t* data, size_t size);
 extern "C" int fuzz_npy(const uint8_t* data, size_t size);
 extern "C" int fuzz_nerf_transforms(const uint8_t* data, size_t size);
+extern "C" int fuzz_idr_cameras(const uint8_t* data, size_t size);
 
 namespace sift_hull {
 namespace {
@@ -63,6 +64,7 @@ TEST(FuzzCorpus, BoundingBox) { replay("fuzz_bounding_box", fuzz_bounding_box); 
 TEST(FuzzCorpus, ColmapBinary) { replay("fuzz_colmap_binary", fuzz_colmap_binary); }
 TEST(FuzzCorpus, Npy) { replay("fuzz_npy", fuzz_npy); }
 TEST(FuzzCorpus, NerfTransforms) { replay("fuzz_nerf_transforms", fuzz_nerf_transforms); }
+TEST(FuzzCorpus, IdrCameras) { replay("fuzz_idr_cameras", fuzz_idr_cameras); }
 
 }  // namespace
 }  // namespace sift_hull

@@ -4,14 +4,17 @@
 Small, valid files of each format (plus a few edge cases), made from the formats as the readers
 and writers in src/core define them: readMiddleburyPar / writeMiddleburyPar (dataset.cpp),
 readProjectionList, readHomography (evaluation.cpp, Oxford's H1to2p layout), readPfm / writePfm
-(io/pfm.cpp), readPly / writePly (io/ply.cpp), and the byte layout of fuzz_bounding_box.cpp.
+(io/pfm.cpp), readPly / writePly (io/ply.cpp), readIdrCameraMatrices / writeIdrCameras (io/idr.cpp,
+numpy .npz archives), and the byte layout of fuzz_bounding_box.cpp.
 Not written here: the copies of ../shared/repro's files (par_c_1e39.txt, par_t_1e307.txt,
 pfm_4GiB_header.pfm) and the regress_* files, fixed findings kept as regression inputs
 (test/fuzz/findings/README.md). Deterministic: running it again gives the same bytes.
 """
+import io
 import math
 import pathlib
 import struct
+import zipfile
 
 CORPUS = pathlib.Path(__file__).resolve().parent / "corpus"
 
@@ -267,3 +270,43 @@ write("fuzz_nerf_transforms", "angle_two_frames",
 write("fuzz_nerf_transforms", "instant_ngp_per_frame",
       ('{"fl_x": 50, "fl_y": 51, "cx": 32, "cy": 24, "w": 64, "h": 48, "k1": 0.01, "p1": 0.001, '
        '"frames": [%s]}' % nerf_frame("a.png", -4.0, '"fl_x": 60, "k2": -0.02, ')).encode())
+
+
+# ---- IDR / NeuS cameras.npz: a zip archive of 4x4 .npy arrays ----------------------------------
+def npy_matrix(m, dtype="<f8"):
+    header = "{'descr': '%s', 'fortran_order': False, 'shape': (%d, %d), }" % (
+        dtype, len(m), len(m[0]))
+    header += " " * ((64 - (10 + len(header) + 1) % 64) % 64) + "\n"
+    values = [x for row in m for x in row]
+    code = "d" if dtype == "<f8" else "f"
+    return b"\x93NUMPY\x01\x00" + struct.pack("<H", len(header)) + header.encode() + struct.pack(
+        f"<{len(values)}{code}", *values)
+
+
+def world_mat(K, R, t):
+    return projection(K, R, t) + [[0.0, 0.0, 0.0, 1.0]]
+
+
+def npz(entries, compression=zipfile.ZIP_STORED):
+    out = io.BytesIO()
+    with zipfile.ZipFile(out, "w") as archive:
+        for name, data in entries:
+            info = zipfile.ZipInfo(name, date_time=(1980, 1, 1, 0, 0, 0))
+            info.compress_type = compression
+            archive.writestr(info, data)
+    return out.getvalue()
+
+
+unit_scale = [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0],
+              [0.0, 0.0, 0.0, 1.0]]
+write("fuzz_idr_cameras", "ring3_stored.npz",
+      npz([(f"world_mat_{i}.npy", npy_matrix(world_mat(*ring_camera(i, 3)))) for i in range(3)] +
+          [("scale_mat_0.npy", npy_matrix(unit_scale))]))
+write("fuzz_idr_cameras", "ring4_deflated.npz",
+      npz([(f"{kind}_{i}.npy", npy_matrix(world_mat(*ring_camera(i, 4)) if kind == "world_mat"
+                                          else unit_scale))
+           for i in range(4) for kind in ("world_mat", "scale_mat", "camera_mat")],
+          zipfile.ZIP_DEFLATED))
+write("fuzz_idr_cameras", "ring2_float32_no_scale.npz",
+      npz([(f"world_mat_{i}.npy", npy_matrix(world_mat(*ring_camera(i, 2)), "<f4"))
+           for i in range(2)]))

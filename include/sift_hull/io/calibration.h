@@ -28,7 +28,7 @@ struct CalibratedView {
   PinholeCamera camera;  ///< with the lens distortion the calibration gives, if any
   std::string source;    ///< "FILE:LINE" the view was read from; empty when made in code
   /// Camera model of the calibration: a COLMAP model name ("PINHOLE", "OPENCV", ...), "LLFF",
-  /// "par" or "projection"; empty when made in code.
+  /// "NeRF", "IDR", "par" or "projection"; empty when made in code.
   std::string camera_model;
   /// Image size the calibration gives for the view (a COLMAP camera's WIDTH and HEIGHT); 0 when
   /// it gives none. checkImageSize compares it with the image.
@@ -53,20 +53,26 @@ std::vector<CalibratedView> readMiddleburyPar(const std::string& path);
 std::vector<CalibratedView> readProjectionList(const std::string& path);
 
 /// Reads any calibration format: a directory is NeRF transforms (nerfTransformFiles, when it
-/// holds them and no COLMAP cameras file) or a COLMAP sparse model (readColmapModel), a file
-/// ending in ".json" NeRF transforms (readNerfTransforms), one ending in ".npy" LLFF poses
-/// (readLlffPoses, the views being the sorted images of `image_directory`), else a text file: a first line holding a single integer means a Middlebury
-/// par file, otherwise a projection list. A first line shaped like a par line (a name and 21
-/// numbers) is reported as a missing count line.
+/// holds them and no COLMAP cameras file), IDR cameras (its cameras.npz, else its
+/// cameras_sphere.npz, when it holds neither a COLMAP cameras file nor NeRF transforms:
+/// idrCamerasFile) or a COLMAP sparse model (readColmapModel); a file ending in ".json" NeRF
+/// transforms (readNerfTransforms), one ending in ".npy" LLFF poses (readLlffPoses, the views
+/// being the sorted images of `image_directory`), one ending in ".npz" IDR / NeuS / VolSDF
+/// cameras (readIdrCameras, the views being the sorted images of `image_directory`, or of the
+/// file's image/ sub-directory when it is empty); else a text file: a first line holding a
+/// single integer means a Middlebury par file, otherwise a projection list. A first line shaped
+/// like a par line (a name and 21 numbers) is reported as a missing count line.
 std::vector<CalibratedView> readCalibrationWithImages(const std::string& path,
                                                       const std::string& image_directory);
 
-/// readCalibrationWithImages(path, parentDirectory(path)).
+/// readCalibrationWithImages(path, parentDirectory(path)); for IDR cameras (idrCamerasFile)
+/// readCalibrationWithImages(path, ""): the images of the file's image/ sub-directory.
 std::vector<CalibratedView> readCalibration(const std::string& path);
 
 /// Human-readable name of the format readCalibration() reads at `path`, such as
 /// "COLMAP text (cameras.txt, images.txt)", "COLMAP binary (cameras.bin, images.bin)",
-/// "NeRF transforms.json", "LLFF poses_bounds.npy", "Middlebury par" or "projection list". Does
+/// "NeRF transforms.json", "LLFF poses_bounds.npy", "IDR cameras.npz", "Middlebury par" or
+/// "projection list". Does
 /// not validate the file.
 std::string calibrationFormat(const std::string& path);
 

@@ -9,7 +9,7 @@
 
 namespace sift_hull {
 
-/// A two-dimensional float64 array read from a .npy file, stored row-major.
+/// A two-dimensional float64 (or float32, widened) array read from a .npy file, stored row-major.
 struct NpyMatrix {
   uint64_t rows = 0;
   uint64_t cols = 0;
@@ -19,11 +19,12 @@ struct NpyMatrix {
 };
 
 /// Parses a .npy file (format versions 1.0, 2.0 and 3.0) of `size_bytes` bytes holding a
-/// little-endian float64 ('<f8') array of shape (N, `cols`), in C or Fortran order. Throws
-/// ParseError "FILE: what" for a bad magic string, version, header, dtype, shape or a file whose
-/// length does not match the shape.
+/// little-endian float64 ('<f8') array of shape (N, `cols`), in C or Fortran order; N must be
+/// `rows` when that is not 0, and with `allow_float32` a little-endian float32 ('<f4') array is
+/// read too. Throws ParseError "FILE: what" for a bad magic string, version, header, dtype, shape
+/// or a file whose length does not match the shape.
 NpyMatrix parseNpyMatrix(std::istream& in, uint64_t size_bytes, const std::string& file,
-                         uint64_t cols);
+                         uint64_t cols, uint64_t rows = 0, bool allow_float32 = false);
 
 /// Reads LLFF's poses_bounds.npy: N x 17 float64, each row a 3x5 matrix (the camera-to-world
 /// rotation's columns in LLFF's [down, right, backwards] axes, the camera centre, and [height,

@@ -16,6 +16,7 @@
 #include <sstream>
 
 #include "sift_hull/io/colmap.h"
+#include "sift_hull/io/idr.h"
 #include "sift_hull/io/llff.h"
 #include "sift_hull/io/nerf.h"
 #include "sift_hull/io/view_orientation.h"
@@ -307,15 +308,18 @@ bool isNpy(const std::string& path) {
 }  // namespace
 
 std::vector<CalibratedView> readCalibration(const std::string& path) {
-  return readCalibrationWithImages(path, parentDirectory(path));
+  // IDR's views are the images of its image/ sub-directory (readIdrCameras).
+  return readCalibrationWithImages(path, idrCamerasFile(path).empty() ? parentDirectory(path) : "");
 }
 
 std::string calibrationFormat(const std::string& path) {
   if (isDirectory(path)) {
     if (!nerfTransformFiles(path).empty()) return "NeRF transforms.json";
+    if (!idrCamerasFile(path).empty()) return "IDR cameras.npz";
     return colmapModelFormat(path);
   }
   if (isNpy(path)) return "LLFF poses_bounds.npy";
+  if (hasSuffix(path, ".npz")) return "IDR cameras.npz";
   if (hasSuffix(path, ".json")) return "NeRF transforms.json";
   try {
     const std::vector<Line> lines = readFields(path);
@@ -347,9 +351,12 @@ std::vector<CalibratedView> readCalibrationWithImages(const std::string& path,
   if (isDirectory(path)) {
     const std::vector<std::string> nerf = nerfTransformFiles(path);
     if (!nerf.empty()) return readNerfDirectory(nerf);
+    const std::string idr = idrCamerasFile(path);
+    if (!idr.empty()) return readIdrCameras(idr, image_directory);
     return readColmapModel(path);
   }
   if (hasSuffix(path, ".json")) return readNerfTransforms(path);
+  if (hasSuffix(path, ".npz")) return readIdrCameras(path, image_directory);
   if (isNpy(path)) {
     std::vector<std::string> names;
     try {

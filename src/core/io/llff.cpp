@@ -100,7 +100,7 @@ std::vector<uint64_t> parseShape(const std::string& text, const std::string& fil
 }  // namespace
 
 NpyMatrix parseNpyMatrix(std::istream& in, uint64_t size_bytes, const std::string& file,
-                         uint64_t cols) {
+                         uint64_t cols, uint64_t rows, bool allow_float32) {
   char preamble[8];
   if (size_bytes < 10 || !in.read(preamble, 8)) fail(file, "too short for a .npy file");
   if (std::memcmp(preamble, "\x93NUMPY", 6) != 0) {
@@ -132,16 +132,25 @@ NpyMatrix parseNpyMatrix(std::istream& in, uint64_t size_bytes, const std::strin
   for (const char* key : {"descr", "fortran_order", "shape"}) {
     if (!dict.count(key)) fail(file, std::string("the .npy header has no '") + key + "'");
   }
-  if (dict.at("descr") != "<f8") {
-    fail(file, "dtype '" + dict.at("descr") +
-                   "' is not supported: expected little-endian float64 "
-                   "('<f8')");
+  const std::string& descr = dict.at("descr");
+  const bool float32 = allow_float32 && descr == "<f4";
+  if (descr != "<f8" && !float32) {
+    fail(file, "dtype '" + descr +
+                   (allow_float32 ? "' is not supported: expected little-endian float64 or "
+                                    "float32 ('<f8' or '<f4')"
+                                  : "' is not supported: expected little-endian float64 "
+                                    "('<f8')"));
   }
+  const uint64_t item_bytes = float32 ? 4 : 8;
   const std::string& order = dict.at("fortran_order");
   if (order != "False" && order != "True") {
     fail(file, "fortran_order must be True or False, not '" + order + "'");
   }
   const std::vector<uint64_t> shape = parseShape(dict.at("shape"), file);
+  if (rows > 0 && (shape.size() != 2 || shape[0] != rows || shape[1] != cols)) {
+    fail(file, "array shape " + dict.at("shape") + " is not (" + std::to_string(rows) + ", " +
+                   std::to_string(cols) + ")");
+  }
   if (shape.size() != 2 || shape[1] != cols || shape[0] < 1) {
     fail(file, "array shape " + dict.at("shape") + " is not (N, " + std::to_string(cols) +
                    ") with N >= 1");
@@ -150,12 +159,20 @@ NpyMatrix parseNpyMatrix(std::istream& in, uint64_t size_bytes, const std::strin
     fail(file, std::to_string(shape[0]) + " rows, more than the limit of 1000000");
   }
   const uint64_t count = shape[0] * cols;
-  if (size_bytes - data_offset != count * 8) {
-    fail(file, "shape " + dict.at("shape") + " needs " + std::to_string(count * 8) +
+  if (size_bytes - data_offset != count * item_bytes) {
+    fail(file, "shape " + dict.at("shape") + " needs " + std::to_string(count * item_bytes) +
                    " bytes of data, the file has " + std::to_string(size_bytes - data_offset));
   }
   std::vector<double> stored(count);
-  if (!in.read(reinterpret_cast<char*>(stored.data()), static_cast<std::streamsize>(count * 8))) {
+  if (float32) {
+    std::vector<float> narrow(count);
+    if (!in.read(reinterpret_cast<char*>(narrow.data()),
+                 static_cast<std::streamsize>(count * item_bytes))) {
+      fail(file, "truncated .npy data");
+    }
+    std::copy(narrow.begin(), narrow.end(), stored.begin());
+  } else if (!in.read(reinterpret_cast<char*>(stored.data()),
+                      static_cast<std::streamsize>(count * item_bytes))) {
     fail(file, "truncated .npy data");
   }
   NpyMatrix matrix;
