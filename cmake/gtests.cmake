@@ -34,6 +34,7 @@ set(SIFT_HULL_CORE_GTESTS
   test_photo_carving eval
   test_photo_stream eval
   test_scene_backgrounds eval
+  test_scene_support eval
   test_silhouettes eval
   test_mesh_render eval
   test_hull eval

@@ -87,6 +87,7 @@ set(SIFT_HULL_EVAL_SOURCES
   src/core/synthetic/mask_render.cpp
   src/core/synthetic/scene.cpp
   src/core/synthetic/scene_match.cpp
+  src/core/synthetic/scene_support.cpp
   src/core/synthetic/shape.cpp
   src/core/synthetic/synthetic_matches.cpp
   src/core/synthetic/texture.cpp

@@ -50,6 +50,7 @@ SceneConfig configFromArgs(const ArgParser& parser) {
   config.seed = static_cast<unsigned>(parser.getInt("seed"));
   config.camera_distance_m = parser.getDouble("camera-distance-m");
   config.background = parser.get("background");
+  config.support = parser.get("support");
   config.distortion = parseDistortion(parser.get("distortion"));
   validateOptions(config);
   return config;
@@ -69,7 +70,9 @@ int runScene(const std::vector<std::string>& args) {
   parser.addOption("size", "WxH", "image size in pixels",
                    std::to_string(defaults.width_px) + "x" + std::to_string(defaults.height_px));
   parser.addOption("shape", "NAME", "one of " + joined(Shape::names()), defaults.shape);
-  parser.addOption("layout", "NAME", "camera layout: ring or sphere", defaults.layout);
+  parser.addOption("layout", "NAME",
+                   "camera layout: ring or sphere (with a support: elevations 10 to 70 deg)",
+                   defaults.layout);
   parser.addOption("seed", "S", "texture and camera jitter seed", std::to_string(defaults.seed));
   parser.addOption("camera-distance-m", "M", "camera distance from the object's centre in metres",
                    numberText(defaults.camera_distance_m));
@@ -77,6 +80,11 @@ int runScene(const std::vector<std::string>& args) {
                    "what the rays missing the object see: " + joined(sceneBackgrounds()) +
                        " (blue: uniform dark blue; textured: coloured blobs)",
                    defaults.background);
+  parser.addOption("support", "NAME",
+                   "what the object stands on: " + joined(sceneSupports()) +
+                       " (floor: a tiled plane; turntable: a blue disc on it), lit from above so "
+                       "that the object casts a shadow; masks and depth maps stay the object's",
+                   defaults.support);
   parser.addOption("distortion", "K1,K2,P1,P2[,K3]",
                    "lens distortion of every camera (OpenCV's radial-tangential model); not zero: "
                    "the calibration is written as a COLMAP model in DIR/sparse",
@@ -98,6 +106,7 @@ int runScene(const std::vector<std::string>& args) {
       {"size", {config.width_px, config.height_px}},
       {"shape", config.shape},
       {"background", config.background},
+      {"support", config.support},
       {"time_ms", {{"render", render_ms}, {"write", total_ms - render_ms}, {"total", total_ms}}}};
   std::ostringstream text;
   text << "wrote " << config.views << " views of '" << config.shape << "' (" << config.width_px

@@ -6,6 +6,7 @@
 
 #include "sift_hull/hull/hull_pipeline.h"
 #include "sift_hull/io/calibration.h"
+#include "sift_hull/synthetic/scene_support.h"
 #include "sift_hull/synthetic/shape.h"
 
 namespace sift_hull {
@@ -16,15 +17,27 @@ struct SceneConfig {
   int width_px = 640;
   int height_px = 480;
   std::string shape = Shape::defaultName();
-  std::string layout = "ring";       ///< "ring" (one elevation) or "sphere" (spread over a sphere)
+  /// "ring" (one elevation, ring_elevation_deg) or "sphere" (spread over the sphere, elevations
+  /// within +-76.5 deg; with a support, over its upper part only: elevations 10 to 70 deg).
+  std::string layout = "ring";
   unsigned seed = 1;                 ///< texture and camera jitter
   double camera_distance_m = 4.0;    ///< from the shape's bounding centre
-  double ring_elevation_deg = 25.0;  ///< above the horizontal plane, for the ring layout
+  double ring_elevation_deg = 25.0;  ///< above the horizontal plane, for the ring layout (>= 5
+                                     ///< with a support, so the cameras stay above the floor)
   double fill_fraction = 0.8;        ///< share of the smaller image side the bounding sphere spans
   /// What the rays that miss the object see (sceneBackgrounds()): "black"; "blue", a uniform dark
   /// blue (grey level 0.196, just above the Middlebury recipe's threshold); "textured", coloured
   /// blobs on a sphere at infinity (a colour per ray direction, so the views see one world).
   std::string background = "black";
+  /// What the object stands on (sceneSupports(), SceneSupport): "none" (it floats, lit by a fixed
+  /// light without shadows); "floor", an infinite plane of mottled grey-brown tiles touching the
+  /// shape's lowest point; "turntable", a saturated blue disc (radius 1.6 times the shape's
+  /// bounding radius, 0.05 times it thick) on that floor, the object standing on the disc's centre.
+  /// With a support, one light from above at 40 degrees from the vertical lights the object and the
+  /// support, and the object casts its shadow onto the floor and the disc. The rays that miss the
+  /// object and the support (above the horizon) see the background. The masks and the depth maps
+  /// stay those of the object alone.
+  std::string support = "none";
   /// Lens distortion of every camera. Not zero: the images, masks and depth maps are those of the
   /// distorted lens (each pixel's ray undistorted), and writeScene writes the calibration as a
   /// COLMAP text model (sparse/), as a par file cannot hold distortion.
@@ -41,18 +54,24 @@ void validate(const SceneConfig& config);
 /// One rendered view. Pixel (u, v) is the colour seen along the ray through its centre.
 struct RenderedView {
   CalibratedView view;
-  cv::Mat image;  ///< CV_8UC3, BGR, on the scene's background
-  cv::Mat mask;   ///< CV_8UC1, 255 where the ray hits the object
-  cv::Mat depth;  ///< CV_32FC1, depth along the optical axis in metres, +inf on the background
+  cv::Mat image;  ///< CV_8UC3, BGR, on the scene's support and background
+  cv::Mat mask;   ///< CV_8UC1, 255 where the ray hits the object (never the support or a shadow)
+  /// CV_32FC1, depth of the object along the optical axis in metres; +inf wherever the ray misses
+  /// the object, on the support as on the background.
+  cv::Mat depth;
 };
 
 /// The cameras of a scene, looking at the shape's bounding centre, named view_NNNN.png.
 std::vector<CalibratedView> sceneCameras(const SceneConfig& config, const Shape& shape);
 
 /// Ray-casts one view: solid procedural texture, Lambertian shading under a fixed world light.
-/// `background` as SceneConfig::background.
+/// `background` and `support` as SceneConfig::background and SceneConfig::support. The mask and
+/// the depth map are the object's whatever the support: the support never hides the object from a
+/// camera above the floor (sceneCameras places them there with a support); a camera below it sees
+/// the object through the floor.
 RenderedView renderView(const Shape& shape, const CalibratedView& view, cv::Size size,
-                        unsigned seed, const std::string& background = "black");
+                        unsigned seed, const std::string& background = "black",
+                        const std::string& support = "none");
 
 std::vector<RenderedView> renderScene(const SceneConfig& config);
 

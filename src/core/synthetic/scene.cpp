@@ -14,6 +14,7 @@
 
 #include "sift_hull/io/colmap.h"
 #include "sift_hull/io/pfm.h"
+#include "synthetic/support_shading.h"
 #include "synthetic/texture.h"
 
 namespace sift_hull {
@@ -34,6 +35,12 @@ Eigen::Vector3d viewDirection(const SceneConfig& config, int i, std::mt19937* rn
   if (config.layout == "ring") {
     azimuth = 2.0 * kPi * i / config.views + jitter(*rng);
     elevation = config.ring_elevation_deg * kPi / 180.0 + jitter(*rng);
+  } else if (config.support != "none") {
+    // Fibonacci points over the band of elevations 10 to 70 deg, even in area: the floor hides
+    // what lies below, and looking straight down shows little but the top.
+    const double low = std::sin(10.0 * kPi / 180.0), high = std::sin(70.0 * kPi / 180.0);
+    elevation = std::asin(low + (high - low) * (i + 0.5) / config.views);
+    azimuth = i * kPi * (3.0 - std::sqrt(5.0)) + jitter(*rng);
   } else {  // Fibonacci sphere, poles left out so that "up" stays defined
     const double height = 1.0 - 2.0 * (i + 0.5) / config.views;
     elevation = std::asin(height) * 0.85;
@@ -79,22 +86,40 @@ cv::Vec3b backgroundColour(const std::string& background, const Eigen::Vector3d&
   return cv::Vec3b(0, 0, 0);
 }
 
-void shadePixel(const Shape& shape, const PinholeCamera& camera, const Eigen::Vector2d& pixel,
-                unsigned seed, const std::string& background, cv::Vec3b* colour, uint8_t* inside,
-                float* depth) {
-  static const Eigen::Vector3d light_W = Eigen::Vector3d(0.4, 0.3, 0.85).normalized();
+/// What every pixel of a view shares.
+struct ViewLighting {
+  const Shape& shape;
+  const SceneSupport& support;
+  const std::string& background;
+  unsigned seed;
+  double pixel_angle_rad;  ///< the angle a pixel spans, for the floor's level of detail
+};
+
+void shadePixel(const ViewLighting& scene, const PinholeCamera& camera,
+                const Eigen::Vector2d& pixel, cv::Vec3b* colour, uint8_t* inside, float* depth) {
+  static const Eigen::Vector3d fixed_light_W = Eigen::Vector3d(0.4, 0.3, 0.85).normalized();
   const Eigen::Vector3d origin = camera.centre();
   const Eigen::Vector3d direction = camera.rayDirection(pixel);
   RayHit hit;
-  if (!direction.allFinite() || !shape.firstHit(origin, direction, &hit)) {
-    *colour = backgroundColour(background, direction, seed);
+  if (!direction.allFinite() || !scene.shape.firstHit(origin, direction, &hit)) {
+    // The object stands on the support, the cameras above it: a ray that meets the object meets
+    // it first, so the support never changes the mask.
+    SupportHit support_hit;
+    if (direction.allFinite() && firstSupportHit(scene.support, origin, direction, &support_hit)) {
+      *colour = shadeSupport(scene.shape, scene.support, support_hit, origin, direction,
+                             scene.pixel_angle_rad, scene.seed);
+    } else {
+      *colour = backgroundColour(scene.background, direction, scene.seed);
+    }
     *inside = 0;
     *depth = std::numeric_limits<float>::infinity();
     return;
   }
   const Eigen::Vector3d X_W = origin + hit.distance_m * direction;
-  const double shading = 0.35 + 0.65 * std::max(0.0, hit.normal_W.dot(light_W));
-  const cv::Vec3f albedo = solidTexture(X_W, seed);
+  const Eigen::Vector3d& light_W = scene.support.floor ? scene.support.light_W : fixed_light_W;
+  const double shading =
+      kAmbientShading + (1.0 - kAmbientShading) * std::max(0.0, hit.normal_W.dot(light_W));
+  const cv::Vec3f albedo = solidTexture(X_W, scene.seed);
   for (int c = 0; c < 3; ++c)
     (*colour)[c] = cv::saturate_cast<uint8_t>(255.0 * shading * albedo[c]);
   *inside = 255;
@@ -122,6 +147,7 @@ nlohmann::json toJson(const SceneConfig& c) {
           {"ring_elevation_deg", c.ring_elevation_deg},
           {"fill_fraction", c.fill_fraction},
           {"background", c.background},
+          {"support", c.support},
           {"distortion",
            {c.distortion.k1, c.distortion.k2, c.distortion.p1, c.distortion.p2, c.distortion.k3}}};
 }
@@ -138,6 +164,7 @@ SceneConfig configFromJson(const nlohmann::json& j) {
   c.ring_elevation_deg = j.at("ring_elevation_deg").get<double>();
   c.fill_fraction = j.at("fill_fraction").get<double>();
   c.background = j.value("background", "black");  // scenes written before it existed: black
+  c.support = j.value("support", "none");
   if (j.contains("distortion")) {
     const std::vector<double> d = j.at("distortion").get<std::vector<double>>();
     if (d.size() != 5) throw std::invalid_argument("distortion must hold k1, k2, p1, p2, k3");
@@ -171,6 +198,11 @@ void validate(const SceneConfig& config) {
   const std::vector<std::string>& backgrounds = sceneBackgrounds();
   require(std::find(backgrounds.begin(), backgrounds.end(), config.background) != backgrounds.end(),
           "background must be black, blue or textured, not '" + config.background + "'");
+  const std::vector<std::string>& supports = sceneSupports();
+  require(std::find(supports.begin(), supports.end(), config.support) != supports.end(),
+          "support must be none, floor or turntable, not '" + config.support + "'");
+  require(config.support == "none" || config.layout != "ring" || config.ring_elevation_deg >= 5.0,
+          "with a support the ring elevation must be at least 5 deg (cameras above the floor)");
   validate(config.distortion);
   const PinholeCamera camera = PinholeCamera(intrinsics(config, Shape::byName(config.shape)),
                                              Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero())
@@ -205,14 +237,15 @@ const std::vector<std::string>& sceneBackgrounds() {
 }
 
 RenderedView renderView(const Shape& shape, const CalibratedView& view, cv::Size size,
-                        unsigned seed, const std::string& background) {
+                        unsigned seed, const std::string& background, const std::string& support) {
   RenderedView out{view, cv::Mat(size, CV_8UC3), cv::Mat(size, CV_8UC1), cv::Mat(size, CV_32FC1)};
+  const SceneSupport scene_support = sceneSupport(shape, support);
+  const ViewLighting scene{shape, scene_support, background, seed, 1.0 / view.camera.K()(0, 0)};
   cv::parallel_for_(cv::Range(0, size.height), [&](const cv::Range& rows) {
     for (int v = rows.start; v < rows.end; ++v) {
       for (int u = 0; u < size.width; ++u) {
-        shadePixel(shape, view.camera, Eigen::Vector2d(u, v), seed, background,
-                   &out.image.at<cv::Vec3b>(v, u), &out.mask.at<uint8_t>(v, u),
-                   &out.depth.at<float>(v, u));
+        shadePixel(scene, view.camera, Eigen::Vector2d(u, v), &out.image.at<cv::Vec3b>(v, u),
+                   &out.mask.at<uint8_t>(v, u), &out.depth.at<float>(v, u));
       }
     }
   });
@@ -224,7 +257,7 @@ std::vector<RenderedView> renderScene(const SceneConfig& config) {
   std::vector<RenderedView> rendered;
   for (const CalibratedView& view : sceneCameras(config, shape)) {
     rendered.push_back(renderView(shape, view, cv::Size(config.width_px, config.height_px),
-                                  config.seed, config.background));
+                                  config.seed, config.background, config.support));
   }
   return rendered;
 }
@@ -234,7 +267,7 @@ RenderedView renderSceneView(const SceneConfig& config, size_t index) {
   const std::vector<CalibratedView> cameras = sceneCameras(config, shape);
   if (index >= cameras.size()) throw std::out_of_range("renderSceneView: no such view");
   return renderView(shape, cameras[index], cv::Size(config.width_px, config.height_px), config.seed,
-                    config.background);
+                    config.background, config.support);
 }
 
 void writeScene(const std::string& directory, const SceneConfig& config,

@@ -1,5 +1,6 @@
 #include "synthetic/texture.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 
@@ -50,6 +51,25 @@ double fractalNoise(const Eigen::Vector3d& p, uint32_t seed, int octaves) {
   return sum / total;
 }
 
+/// How much of a detail of size `period_m` a pixel of footprint `footprint_m` keeps: all of it
+/// down to two pixels, none at one pixel or less.
+double keptShare(double period_m, double footprint_m) {
+  if (footprint_m <= 0.0) return 1.0;
+  return std::clamp(period_m / footprint_m - 1.0, 0.0, 1.0);
+}
+
+/// The share of [x - w/2, x + w/2] that the lines [k period - width/2, k period + width/2] cover
+/// (a box filter over the footprint w); a point sample for a footprint well under the width.
+double lineCoverage(double x, double w, double period, double width) {
+  const double u = x + 0.5 * width;  // lines at [k period, k period + width] in u
+  if (w < 0.05 * width) return u - period * std::floor(u / period) < width ? 1.0 : 0.0;
+  const auto covered = [&](double t) {  // covered length of [0, t], negative for t < 0
+    const double k = std::floor(t / period);
+    return k * width + std::min(t - k * period, width);
+  };
+  return std::clamp((covered(u + 0.5 * w) - covered(u - 0.5 * w)) / w, 0.0, 1.0);
+}
+
 }  // namespace
 
 cv::Vec3f solidTexture(const Eigen::Vector3d& X_W, unsigned seed) {
@@ -67,6 +87,44 @@ cv::Vec3f solidTexture(const Eigen::Vector3d& X_W, unsigned seed) {
   const cv::Vec3f tint(0.6f + 0.4f * std::cos(angle), 0.6f + 0.4f * std::cos(angle + 2.1),
                        0.6f + 0.4f * std::cos(angle + 4.2));
   return tint * static_cast<float>(brightness);
+}
+
+cv::Vec3f floorTexture(const Eigen::Vector2d& xy, double footprint_m, unsigned seed) {
+  constexpr double kTile = 0.5, kJoint = 0.012;
+  // Mottle: four octaves of value noise, blobs from 0.25 m down to 3 cm, each faded to its mean
+  // once the pixel footprint nears its size.
+  double sum = 0.0, total = 0.0, amplitude = 0.5, frequency = 4.0;
+  for (int octave = 0; octave < 4; ++octave) {
+    const Eigen::Vector3d p(frequency * xy.x(), frequency * xy.y(), 0.5 + 7.3 * octave);
+    sum += amplitude *
+           (0.5 + keptShare(1.0 / frequency, footprint_m) * (valueNoise(p, seed + octave) - 0.5));
+    total += amplitude;
+    amplitude *= 0.5;
+    frequency *= 2.03;
+  }
+  const double mottle = sum / total;
+  const double hue =
+      0.5 + keptShare(1.0, footprint_m) *
+                (valueNoise(Eigen::Vector3d(1.3 * xy.x(), 1.3 * xy.y(), 0.5), seed + 11) - 0.5);
+  const auto tile_index = [&](double x) { return static_cast<int32_t>(std::floor(x / kTile)); };
+  const double tile_shade = keptShare(kTile, 3.0 * footprint_m) *
+                            (lattice(tile_index(xy.x()), tile_index(xy.y()), 0, seed + 57) - 0.5);
+  const double brightness =
+      std::clamp(0.75 + 1.1 * (mottle - 0.5), 0.45, 1.05) * (1.0 + 0.3 * tile_shade);
+  const cv::Vec3f grey(0.60f, 0.61f, 0.62f), brown(0.38f, 0.53f, 0.70f);  // BGR
+  const cv::Vec3f colour = grey + static_cast<float>(hue) * (brown - grey);
+  const double joint_x = lineCoverage(xy.x(), footprint_m, kTile, kJoint);
+  const double joint_y = lineCoverage(xy.y(), footprint_m, kTile, kJoint);
+  const double joint = joint_x + joint_y - joint_x * joint_y;
+  return colour * static_cast<float>(brightness * (1.0 - joint)) +
+         cv::Vec3f(0.16f, 0.17f, 0.18f) * static_cast<float>(joint);
+}
+
+cv::Vec3f discTexture(const Eigen::Vector2d& offset_xy, double radius_m, unsigned seed) {
+  const double r = offset_xy.norm() / radius_m;
+  if (r > 0.95 && r < 0.97) return cv::Vec3f(0.85f, 0.85f, 0.82f);
+  const double n = valueNoise(Eigen::Vector3d(6.0 * offset_xy.x(), 6.0 * offset_xy.y(), 0.5), seed);
+  return cv::Vec3f(0.80f, 0.36f, 0.08f) * static_cast<float>(0.92 + 0.16 * n);
 }
 
 }  // namespace sift_hull
