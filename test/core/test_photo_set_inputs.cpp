@@ -119,3 +119,29 @@ TEST(PhotoSetInputs, MasksPairByNumberAcrossNameWidthsAndChannels) {
 
 }  // namespace
 }  // namespace sift_hull
+
+namespace sift_hull {
+namespace {
+
+TEST(PhotoSetInputs, SceneWritesTheSameCamerasInEveryFormat) {
+  const std::string dir = test::temporaryDirectory();
+  SceneConfig config = smallScene();
+  writeScene(dir, config, renderScene(config));
+  const std::vector<CalibratedView> par = readCalibration(dir + "/scene_par.txt");
+  const std::vector<CalibratedView> nerf = readCalibration(dir + "/transforms.json");
+  const std::vector<CalibratedView> idr = readCalibrationWithImages(dir + "/cameras.npz", dir);
+  ASSERT_EQ(nerf.size(), par.size());
+  ASSERT_EQ(idr.size(), par.size());
+  for (size_t i = 0; i < par.size(); ++i) {
+    EXPECT_EQ(nerf[i].name, par[i].name);
+    EXPECT_EQ(idr[i].name, par[i].name);
+    for (const Eigen::Vector3d& X :
+         {Eigen::Vector3d(0.3, -0.2, 0.1), Eigen::Vector3d(-0.4, 0.5, 0.2)}) {
+      EXPECT_LT((nerf[i].camera.project(X) - par[i].camera.project(X)).norm(), 1e-6);
+      EXPECT_LT((idr[i].camera.project(X) - par[i].camera.project(X)).norm(), 1e-6);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace sift_hull

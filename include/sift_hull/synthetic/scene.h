@@ -85,7 +85,9 @@ inline constexpr const char* kDepthDirectory = "depth";
 
 /// Writes into `directory` (created when missing) the images view_NNNN.png, masks/view_NNNN.png,
 /// depth/view_NNNN.pfm, scene.json (the config) and the calibration: scene_par.txt (Middlebury
-/// format), or for a distorted lens sparse/cameras.txt and sparse/images.txt (COLMAP text).
+/// format), or for a distorted lens sparse/cameras.txt and sparse/images.txt (COLMAP text); and the
+/// same cameras as transforms.json (NeRF; not for fisheye, rational or k3 lenses) and cameras.npz
+/// (IDR, scale_mat the shape's bounding sphere; without distortion).
 void writeScene(const std::string& directory, const SceneConfig& config,
                 const std::vector<RenderedView>& views);
 

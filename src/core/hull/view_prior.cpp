@@ -7,6 +7,7 @@
 #include <mutex>
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
+#include <unordered_map>
 #include <unordered_set>
 
 namespace sift_hull {
@@ -91,36 +92,118 @@ Eigen::Vector3d meanUp(const std::vector<PinholeCamera>& cameras) {
   return up.norm() > 1e-9 ? Eigen::Vector3d(up.normalized()) : Eigen::Vector3d::UnitZ();
 }
 
+void keepLargestPart(CoarseHull* hull) {
+  if (hull->centres_W.empty()) return;
+  const Eigen::Vector3d origin = hull->centres_W.front();
+  const auto index = [&](const Eigen::Vector3d& c) {
+    const Eigen::Vector3d i = (c - origin) / hull->cell;
+    return Eigen::Vector3i(static_cast<int>(std::lround(i.x())),
+                           static_cast<int>(std::lround(i.y())),
+                           static_cast<int>(std::lround(i.z())));
+  };
+  const auto key = [](const Eigen::Vector3i& i) {
+    return ((int64_t{i.x()} + 4096) << 26) | ((int64_t{i.y()} + 4096) << 13) | (i.z() + 4096);
+  };
+  std::unordered_map<int64_t, size_t> cells;
+  for (size_t k = 0; k < hull->centres_W.size(); ++k) cells[key(index(hull->centres_W[k]))] = k;
+  std::vector<int> part(hull->centres_W.size(), -1);
+  std::vector<size_t> sizes;
+  for (size_t seed = 0; seed < part.size(); ++seed) {
+    if (part[seed] >= 0) continue;
+    const int id = static_cast<int>(sizes.size());
+    sizes.push_back(0);
+    std::vector<size_t> stack{seed};
+    part[seed] = id;
+    while (!stack.empty()) {
+      const size_t k = stack.back();
+      stack.pop_back();
+      ++sizes.back();
+      const Eigen::Vector3i i = index(hull->centres_W[k]);
+      for (int dx = -1; dx <= 1; ++dx) {
+        for (int dy = -1; dy <= 1; ++dy) {
+          for (int dz = -1; dz <= 1; ++dz) {
+            const auto found = cells.find(key(i + Eigen::Vector3i(dx, dy, dz)));
+            if (found == cells.end() || part[found->second] >= 0) continue;
+            part[found->second] = id;
+            stack.push_back(found->second);
+          }
+        }
+      }
+    }
+  }
+  const int largest =
+      static_cast<int>(std::max_element(sizes.begin(), sizes.end()) - sizes.begin());
+  std::vector<Eigen::Vector3d> kept;
+  kept.reserve(sizes[static_cast<size_t>(largest)]);
+  for (size_t k = 0; k < part.size(); ++k) {
+    if (part[k] == largest) kept.push_back(hull->centres_W[k]);
+  }
+  hull->centres_W = std::move(kept);
+}
+
 double cutSupport(const Eigen::Vector3d& up, CoarseHull* hull, double* height) {
   *height = 0.0;
-  if (hull->centres_W.size() < 64) return 0.0;
+  const size_t before = hull->centres_W.size();
+  if (before < 64) return 0.0;
   double low = std::numeric_limits<double>::infinity(), high = -low;
   for (const Eigen::Vector3d& c : hull->centres_W) {
     low = std::min(low, up.dot(c));
     high = std::max(high, up.dot(c));
   }
   const int layers = static_cast<int>(std::floor((high - low) / hull->cell)) + 1;
-  std::vector<double> area(static_cast<size_t>(layers), 0.0);
   const auto layerOf = [&](const Eigen::Vector3d& c) {
     return std::clamp(static_cast<int>(std::floor((up.dot(c) - low) / hull->cell + 0.5)), 0,
                       layers - 1);
   };
-  for (const Eigen::Vector3d& c : hull->centres_W) area[static_cast<size_t>(layerOf(c))] += 1.0;
-  const int thickest = std::max(2, layers / 10);
+  // Cells in the plane across `up`, keyed by their rounded coordinates there.
+  const Eigen::Vector3d e1 = up.unitOrthogonal(), e2 = up.cross(e1);
+  const auto key = [&](const Eigen::Vector3d& c, int dx, int dy) {
+    const int64_t x = std::llround(e1.dot(c) / hull->cell) + dx + (1 << 20);
+    const int64_t y = std::llround(e2.dot(c) / hull->cell) + dy + (1 << 20);
+    return (x << 22) | y;
+  };
+  std::vector<std::vector<const Eigen::Vector3d*>> by_layer(static_cast<size_t>(layers));
+  for (const Eigen::Vector3d& c : hull->centres_W) {
+    by_layer[static_cast<size_t>(layerOf(c))].push_back(&c);
+  }
+  // The share of a layer's cells outside the footprint of the five layers above it, grown by two
+  // cells: what stands there does not cover it.
+  constexpr int kAbove = 5, kGrow = 2;
+  const auto uncovered = [&](int layer) {
+    std::unordered_set<int64_t> footprint;
+    for (int l = layer + 1; l <= layer + kAbove && l < layers; ++l) {
+      for (const Eigen::Vector3d* cell : by_layer[static_cast<size_t>(l)]) {
+        for (int dx = -kGrow; dx <= kGrow; ++dx) {
+          for (int dy = -kGrow; dy <= kGrow; ++dy) footprint.insert(key(*cell, dx, dy));
+        }
+      }
+    }
+    size_t outside = 0;
+    for (const Eigen::Vector3d* cell : by_layer[static_cast<size_t>(layer)]) {
+      outside += footprint.count(key(*cell, 0, 0)) == 0;
+    }
+    return outside;
+  };
+  // The support's top: the widest layer of the lower half, when a third of it, and 1 % of the
+  // hull, lies uncovered. Below it lies what the support hides from every camera above it; the
+  // layers above it that are still that wide (its thickness, up to a tenth of the height) go too.
+  int widest = 0;
+  for (int l = 1; l <= layers / 2; ++l) {
+    if (by_layer[static_cast<size_t>(l)].size() > by_layer[static_cast<size_t>(widest)].size()) {
+      widest = l;
+    }
+  }
+  const auto isSupport = [&](int layer) {
+    const size_t outside = uncovered(layer);
+    return 3 * outside >= by_layer[static_cast<size_t>(layer)].size() && outside * 100 >= before;
+  };
   int cut = 0;
-  double widest = 0.0;
-  for (int c = 1; c <= thickest && c + 5 <= layers; ++c) {
-    widest = std::max(widest, area[static_cast<size_t>(c - 1)]);
-    std::vector<double> above(area.begin() + c, area.begin() + c + 5);
-    std::nth_element(above.begin(), above.begin() + 2, above.end());
-    if (widest > 3.0 * above[2]) cut = c;
+  if (widest + kAbove < layers && isSupport(widest)) {
+    cut = widest + 1;
+    while (cut < layers - kAbove && cut <= widest + std::max(2, layers / 10) && isSupport(cut))
+      ++cut;
   }
   if (cut == 0) return 0.0;
-  // A support is a notable part of what the views agree on; a few wide cells are the object's.
-  double below = 0.0;
-  for (int c = 0; c < cut; ++c) below += area[static_cast<size_t>(c)];
-  if (below < 0.01 * static_cast<double>(hull->centres_W.size())) return 0.0;
-  const size_t before = hull->centres_W.size();
   hull->centres_W.erase(std::remove_if(hull->centres_W.begin(), hull->centres_W.end(),
                                        [&](const Eigen::Vector3d& c) { return layerOf(c) < cut; }),
                         hull->centres_W.end());

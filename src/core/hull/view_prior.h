@@ -32,16 +32,19 @@ struct CoarseHull {
 CoarseHull carve(const std::vector<cv::Mat>& masks, const std::vector<PinholeCamera>& cameras,
                  const PixelScale& scale, const Box3d& box, int cells, int tolerated);
 
+/// Keeps the largest 26-connected part of the cells (specks a few views agree on by chance go).
+void keepLargestPart(CoarseHull* hull);
+
 /// The box of the cells, grown by `margin_cells` cells.
 Box3d boxOf(const CoarseHull& hull, double margin_cells);
 
 /// The cameras' mean up direction (the negated image y axis, in world coordinates), unit length.
 Eigen::Vector3d meanUp(const std::vector<PinholeCamera>& cameras);
 
-/// Cuts a support from the bottom of the hull along `up`: a flat layer (at most a tenth of the
-/// hull's height, at least 1 % of its cells) whose widest slice is more than three times the median
-/// of the five slices above it.
-/// Returns the share of cells removed; `height` gets the cut's height above the lowest cell.
+/// Cuts a support from the bottom of the hull along `up` (a floor patch, a shadow, a turntable
+/// disc): the bottom layers (at most a tenth of the hull's height) when a third of their cells, and
+/// at least 1 % of the hull's, lie outside the footprint of the five layers above them grown by two
+/// cells. Returns the share of cells removed; `height` gets the cut's height above the lowest cell.
 double cutSupport(const Eigen::Vector3d& up, CoarseHull* hull, double* height);
 
 /// The hull's projection into a view of `size` (working pixels): its surface cells splatted as

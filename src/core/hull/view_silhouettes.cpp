@@ -218,9 +218,11 @@ ViewSilhouettes silhouettesFromViews(const std::vector<cv::Mat>& images,
   // cut.
   const int tolerated = static_cast<int>(n / 10);
   CoarseHull hull = view_prior::carve(first, cameras, half_scale, frusta, kCoarseCells, tolerated);
+  view_prior::keepLargestPart(&hull);
   if (!hull.centres_W.empty()) {
     hull = view_prior::carve(first, cameras, half_scale, view_prior::boxOf(hull, 2.0), kCoarseCells,
                              tolerated);
+    view_prior::keepLargestPart(&hull);
   }
   if (hull.centres_W.empty()) {
     throw std::runtime_error(

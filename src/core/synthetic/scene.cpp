@@ -13,6 +13,8 @@
 #include <stdexcept>
 
 #include "sift_hull/io/colmap.h"
+#include "sift_hull/io/idr.h"
+#include "sift_hull/io/nerf.h"
 #include "sift_hull/io/pfm.h"
 #include "synthetic/support_shading.h"
 #include "synthetic/texture.h"
@@ -281,6 +283,19 @@ void writeScene(const std::string& directory, const SceneConfig& config,
     writeMiddleburyPar(directory + "/scene_par.txt", cameras);
   } else {
     writeColmapText(directory + "/sparse", cameras, config.width_px, config.height_px);
+  }
+  // The same cameras in the formats of today's photo sets: NeRF's transforms.json and, without
+  // distortion, IDR's cameras.npz with the shape's bounding sphere as scale_mat.
+  const LensDistortion& lens = config.distortion;
+  if (!lens.fisheye && !lens.rational() && lens.k3 == 0.0) {
+    writeNerfTransforms(directory + "/transforms.json", cameras, config.width_px, config.height_px);
+  }
+  if (lens.isZero()) {
+    const Shape shape = Shape::byName(config.shape);
+    Eigen::Matrix4d scale_mat = Eigen::Matrix4d::Identity();
+    scale_mat.topLeftCorner<3, 3>() *= shape.boundingRadius();
+    scale_mat.topRightCorner<3, 1>() = shape.boundingCentre();
+    writeIdrCameras(directory + "/cameras.npz", cameras, scale_mat);
   }
   const std::string json_path = directory + "/scene.json";
   std::ofstream json_file(json_path);
