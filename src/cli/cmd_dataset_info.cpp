@@ -153,6 +153,7 @@ int runDatasetInfo(const std::vector<std::string>& args) {
   std::vector<std::string> names;
   for (const CalibratedView& view : views) names.push_back(view.name);
   writeSilhouettesFromArgs(parser, names, [&](size_t i) { return silhouettes[i]; });
+  writeViewPriorsFromArgs(parser, names, found);
   const cv::Size size = silhouettes.front().size();  // loadSilhouettes: one size for all
   nlohmann::json cameras = nlohmann::json::array();
   for (size_t i = 0; i < views.size(); ++i) {

@@ -187,6 +187,7 @@ int runHull(const std::vector<std::string>& args) {
   ViewSilhouettes found;
   HullInput input = runLengthViewSetFromArgs(parser, &found);
   writeSilhouettesFromArgs(parser, input.names, [&](size_t i) { return input.mask(i); });
+  writeViewPriorsFromArgs(parser, input.names, found);
   for (const std::string& warning : found.warnings) poor.warn(warning);
   const std::optional<HeldOutView> held_out = holdOutView(parser, &input);
   for (const std::string& warning :

@@ -35,10 +35,10 @@ void addSilhouetteOutputOption(ArgParser* parser) {
                     "look at and correct; --silhouettes DIR reads them back");
 }
 
-void writeSilhouettesFromArgs(const ArgParser& parser, const std::vector<std::string>& names,
-                              const std::function<cv::Mat(size_t)>& mask) {
-  if (!parser.has("out-silhouettes")) return;
-  const std::string directory = parser.get("out-silhouettes");
+namespace {
+
+void writeMasks(const std::string& directory, const std::vector<std::string>& names,
+                const std::function<cv::Mat(size_t)>& mask) {
   for (size_t i = 0; i < names.size(); ++i) {
     std::string name = names[i];
     const std::string::size_type dot = name.find_last_of('.'), slash = name.find_last_of('/');
@@ -47,6 +47,22 @@ void writeSilhouettesFromArgs(const ArgParser& parser, const std::vector<std::st
     std::filesystem::create_directories(std::filesystem::path(path).parent_path());
     if (!cv::imwrite(path, mask(i))) throw std::runtime_error(path + ": cannot write the mask");
   }
+}
+
+}  // namespace
+
+void writeSilhouettesFromArgs(const ArgParser& parser, const std::vector<std::string>& names,
+                              const std::function<cv::Mat(size_t)>& mask) {
+  if (parser.has("out-silhouettes")) writeMasks(parser.get("out-silhouettes"), names, mask);
+}
+
+void writeViewPriorsFromArgs(const ArgParser& parser, const std::vector<std::string>& names,
+                             const ViewSilhouettes& found) {
+  if (!parser.has("out-silhouettes") || found.priors.size() != names.size()) return;
+  const std::string directory = parser.get("out-silhouettes");
+  writeMasks(directory + "/prior", names, [&](size_t i) { return found.priors[i]; });
+  writeMasks(directory + "/hull_projection", names,
+             [&](size_t i) { return found.hull_projections[i]; });
 }
 
 nlohmann::json viewSilhouettesJson(const ViewSilhouettes& report) {

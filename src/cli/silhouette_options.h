@@ -22,6 +22,10 @@ void addSilhouetteOutputOption(ArgParser* parser);
 /// name with the extension .png (sub-directories created).
 void writeSilhouettesFromArgs(const ArgParser& parser, const std::vector<std::string>& names,
                               const std::function<cv::Mat(size_t)>& mask);
+/// With --out-silhouettes and the views method, also its priors and coarse hull projections at
+/// the working size: DIR/prior/NAME.png and DIR/hull_projection/NAME.png.
+void writeViewPriorsFromArgs(const ArgParser& parser, const std::vector<std::string>& names,
+                             const ViewSilhouettes& found);
 /// What the "views" method found, for the JSON: the ball, the support cut, time, warnings.
 nlohmann::json viewSilhouettesJson(const ViewSilhouettes& report);
 
