@@ -53,8 +53,9 @@ const SettingTable<SilhouetteConfig>& settingsOf<SilhouetteConfig>() {
     SettingTable<SilhouetteConfig> t;
     t.add("silhouette_method", &SilhouetteConfig::silhouette_method, "",
           "how a silhouette is taken from a photo: views (all calibrated views together: a "
-          "prior from the cameras, GrabCut, a coarse hull), background (the border's colours, "
-          "one image) or threshold (grey level)")
+          "prior from the cameras, GrabCut, a coarse hull; for one image alone, as the hull node "
+          "has, background), background (the border's colours, one image) or threshold (grey "
+          "level)")
         .oneOf({"views", "background", "threshold"});
     t.add("threshold", &SilhouetteConfig::threshold, "",
           "the threshold method: grey level in [0, 1] above which a pixel is the object")
