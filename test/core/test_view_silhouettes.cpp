@@ -4,9 +4,11 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <functional>
 #include <iostream>
 #include <opencv2/imgproc.hpp>
 
+#include "hull/view_prior.h"
 #include "sift_hull/hull/view_silhouettes.h"
 #include "sift_hull/synthetic/scene.h"
 
@@ -101,6 +103,61 @@ TEST(ViewSilhouettes, TurntableBeatsThePerImageMethod) {
   EXPECT_GT(scores.mean, 0.95);
   EXPECT_GT(scores.min, 0.88);
   EXPECT_GT(scores.mean, background.mean + 0.2);
+}
+
+/// Cells of unit edge whose centres pass `inside`, over [-40, 40]^2 x [-30, 50].
+view_prior::CoarseHull cellsWhere(const std::function<bool(const Eigen::Vector3d&)>& inside) {
+  view_prior::CoarseHull hull;
+  hull.cell = 1.0;
+  for (int z = -30; z <= 50; ++z) {
+    for (int y = -40; y <= 40; ++y) {
+      for (int x = -40; x <= 40; ++x) {
+        const Eigen::Vector3d c(x, y, z);
+        if (inside(c)) hull.centres_W.push_back(c);
+      }
+    }
+  }
+  return hull;
+}
+
+bool cylinder(const Eigen::Vector3d& c, double radius, double bottom, double top) {
+  return c.head<2>().norm() <= radius && c.z() >= bottom && c.z() <= top;
+}
+
+TEST(ViewSilhouettes, SupportBelowTheObjectIsCutWithWhatItHides) {
+  // An object (a cylinder of radius 10, 40 high) on a disc of radius 30, 2 thick, and below the
+  // disc the cone it hides from cameras above it.
+  view_prior::CoarseHull hull = cellsWhere([](const Eigen::Vector3d& c) {
+    const bool cone = c.z() < -2 && c.z() >= -22 && c.head<2>().norm() <= 30 + 1.5 * (c.z() + 2);
+    return cylinder(c, 10, 0, 40) || cylinder(c, 30, -2, -1) || cone;
+  });
+  const size_t object =
+      cellsWhere([](const Eigen::Vector3d& c) { return cylinder(c, 10, 0, 40); }).centres_W.size();
+  double height = 0.0;
+  const double cut = view_prior::cutSupport(Eigen::Vector3d::UnitZ(), &hull, &height);
+  EXPECT_GT(cut, 0.5);
+  EXPECT_NEAR(hull.centres_W.size(), object, 0.05 * object) << "the object stays";
+  for (const Eigen::Vector3d& c : hull.centres_W) ASSERT_GE(c.z(), -1.0);
+  EXPECT_NEAR(height, 22.0, 2.0);
+}
+
+TEST(ViewSilhouettes, ObjectsWithoutSupportKeepTheirBottom) {
+  for (const auto& shape : std::vector<std::function<bool(const Eigen::Vector3d&)>>{
+           [](const Eigen::Vector3d& c) { return (c - Eigen::Vector3d(0, 0, 10)).norm() <= 20; },
+           // a cone standing on its base, 45 degrees
+           [](const Eigen::Vector3d& c) {
+             return c.z() >= 0 && c.z() <= 30 && c.head<2>().norm() <= 30 - c.z();
+           },
+           // a cylinder with a narrow foot
+           [](const Eigen::Vector3d& c) {
+             return cylinder(c, 15, 5, 40) || cylinder(c, 4, 0, 5);
+           }}) {
+    view_prior::CoarseHull hull = cellsWhere(shape);
+    const size_t before = hull.centres_W.size();
+    double height = 0.0;
+    EXPECT_EQ(view_prior::cutSupport(Eigen::Vector3d::UnitZ(), &hull, &height), 0.0);
+    EXPECT_EQ(hull.centres_W.size(), before);
+  }
 }
 
 TEST(ViewSilhouettes, LargestBallLiesInsideEveryFrustum) {

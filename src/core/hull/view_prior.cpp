@@ -197,11 +197,13 @@ double cutSupport(const Eigen::Vector3d& up, CoarseHull* hull, double* height) {
     const size_t outside = uncovered(layer);
     return 3 * outside >= by_layer[static_cast<size_t>(layer)].size() && outside * 100 >= before;
   };
+  // A support has a thickness: its top is the last layer above the widest still 0.8 as wide.
+  const size_t wide = by_layer[static_cast<size_t>(widest)].size();
+  int top = widest;
+  while (top + 1 < layers && 5 * by_layer[static_cast<size_t>(top + 1)].size() >= 4 * wide) ++top;
   int cut = 0;
-  if (widest + kAbove < layers && isSupport(widest)) {
-    cut = widest + 1;
-    while (cut < layers - kAbove && cut <= widest + std::max(2, layers / 10) && isSupport(cut))
-      ++cut;
+  if (top + kAbove < layers && top - widest <= std::max(2, layers / 10) && isSupport(top)) {
+    cut = top + 1;
   }
   if (cut == 0) return 0.0;
   hull->centres_W.erase(std::remove_if(hull->centres_W.begin(), hull->centres_W.end(),

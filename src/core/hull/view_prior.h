@@ -42,9 +42,11 @@ Box3d boxOf(const CoarseHull& hull, double margin_cells);
 Eigen::Vector3d meanUp(const std::vector<PinholeCamera>& cameras);
 
 /// Cuts a support from the bottom of the hull along `up` (a floor patch, a shadow, a turntable
-/// disc): the bottom layers (at most a tenth of the hull's height) when a third of their cells, and
-/// at least 1 % of the hull's, lie outside the footprint of the five layers above them grown by two
-/// cells. Returns the share of cells removed; `height` gets the cut's height above the lowest cell.
+/// disc) with what it hides below it from cameras above: the widest layer of the lower half and
+/// the layers above it still 0.8 as wide (at most a tenth of the hull's height), when a third of the
+/// top one's cells, and 1 % of the hull's, lie outside the footprint of the five layers above it
+/// grown by two cells; everything up to that top goes. Returns the share of cells removed;
+/// `height` gets the cut's height above the lowest cell.
 double cutSupport(const Eigen::Vector3d& up, CoarseHull* hull, double* height);
 
 /// The hull's projection into a view of `size` (working pixels): its surface cells splatted as
