@@ -76,8 +76,8 @@ Scores views(const std::string& shape, const std::string& support, int count,
 TEST(ViewSilhouettes, TexturedBackgroundGivesTheExactMasks) {
   ViewSilhouettes found;
   const Scores scores = views("cup", "none", 20, nullptr, &found);
-  EXPECT_GT(scores.mean, 0.98);
-  EXPECT_GT(scores.min, 0.97);
+  EXPECT_GT(scores.mean, 0.99);  // measured 0.997 / 0.992
+  EXPECT_GT(scores.min, 0.98);
   ASSERT_TRUE(found.ball_centre_W.has_value());
   EXPECT_LT(found.ball_centre_W->norm(), 0.2) << "the cameras look at the origin";
   EXPECT_GT(found.ball_radius, 0.3);
@@ -88,10 +88,10 @@ TEST(ViewSilhouettes, TexturedBackgroundGivesTheExactMasks) {
 TEST(ViewSilhouettes, FloorWithShadowsBeatsThePerImageMethod) {
   Scores background;
   const Scores scores = views("sculpture", "floor", 16, &background);
-  // Measured: views 0.970 / 0.936, per image 0.903 / 0.691 (mean / min); the shadow where it
+  // Measured: views 0.987 / 0.958, per image 0.903 / 0.691 (mean / min); the shadow where it
   // meets the object is what the views method still takes.
-  EXPECT_GT(scores.mean, 0.95);
-  EXPECT_GT(scores.min, 0.90);
+  EXPECT_GT(scores.mean, 0.975);
+  EXPECT_GT(scores.min, 0.93);
   EXPECT_GT(scores.mean, background.mean + 0.05);
   EXPECT_GT(scores.min, background.min + 0.15);
 }
@@ -99,9 +99,9 @@ TEST(ViewSilhouettes, FloorWithShadowsBeatsThePerImageMethod) {
 TEST(ViewSilhouettes, TurntableBeatsThePerImageMethod) {
   Scores background;
   const Scores scores = views("sculpture", "turntable", 12, &background);
-  // Measured: views 0.967 / 0.925, per image 0.677 / 0.231 (mean / min).
-  EXPECT_GT(scores.mean, 0.95);
-  EXPECT_GT(scores.min, 0.88);
+  // Measured: views 0.975 / 0.930, per image 0.677 / 0.231 (mean / min).
+  EXPECT_GT(scores.mean, 0.965);
+  EXPECT_GT(scores.min, 0.90);
   EXPECT_GT(scores.mean, background.mean + 0.2);
 }
 

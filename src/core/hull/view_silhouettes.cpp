@@ -55,8 +55,22 @@ cv::Mat borderBand(cv::Size size, double fraction) {
   return band;
 }
 
+/// The colours the cuts compare: CIE Lab with the lightness scaled by kLightnessWeight, so that a
+/// shadow (the floor's colour, darker) lies nearer the lit floor than another colour does.
+constexpr double kLightnessWeight = 0.35;
+cv::Mat cutColours(const cv::Mat& bgr) {
+  cv::Mat lab;
+  cv::cvtColor(bgr, lab, cv::COLOR_BGR2Lab);
+  std::vector<cv::Mat> channels;
+  cv::split(lab, channels);
+  channels[0].convertTo(channels[0], CV_8U, kLightnessWeight);
+  cv::merge(channels, lab);
+  return lab;
+}
+
 /// GrabCut from a labelling; the foreground (certain or probable) as 255.
-cv::Mat cut(const cv::Mat& image, cv::Mat labels, int iterations) {
+cv::Mat cut(const cv::Mat& bgr, cv::Mat labels, int iterations) {
+  const cv::Mat image = cutColours(bgr);
   const bool has_foreground = cv::countNonZero((labels == cv::GC_FGD) | (labels == cv::GC_PR_FGD));
   const bool has_background = cv::countNonZero((labels == cv::GC_BGD) | (labels == cv::GC_PR_BGD));
   if (!has_foreground || !has_background) return (labels & 1) * 255;
