@@ -136,6 +136,12 @@ std::string hullText(const nlohmann::json& result) {
          << " pairs), " << result["free_voxels"] << " free voxels, carved "
          << result["carved_volume_m3"] << " m^3\n";
   }
+  if (result.contains("silhouettes")) {
+    const auto& found = result["silhouettes"];
+    text << "silhouettes from the views together in " << found["time_ms"]
+         << " ms; support cut: " << found["support_cut_fraction"] << " of the coarse hull, up to "
+         << found["support_cut_height"] << " above its bottom\n";
+  }
   if (result.contains("volume_iou_vs_truth")) {
     text << "volume IoU against the true solid " << result["volume_iou_vs_truth"]["before"]
          << (result.contains("points") ? " before, " : "");
