@@ -160,6 +160,34 @@ TEST(ViewSilhouettes, ObjectsWithoutSupportKeepTheirBottom) {
   }
 }
 
+TEST(ViewSilhouettes, AViewTheOthersContradictIsNamed) {
+  SceneConfig config;
+  config.views = 12;
+  config.layout = "sphere";
+  config.width_px = 320;
+  config.height_px = 240;
+  config.background = "textured";
+  const std::vector<RenderedView> rendered = renderScene(config);
+  std::vector<cv::Mat> images;
+  std::vector<PinholeCamera> cameras;
+  std::vector<std::string> names;
+  for (const RenderedView& view : rendered) {
+    images.push_back(view.image);
+    cameras.push_back(view.view.camera);
+    names.push_back(view.view.name);
+  }
+  // View 3's photo moved by a quarter of the image: its camera no longer says where the object is.
+  const cv::Mat shift = (cv::Mat_<double>(2, 3) << 1, 0, 80, 0, 1, 0);
+  cv::warpAffine(rendered[3].image, images[3], shift, images[3].size(), cv::INTER_LINEAR,
+                 cv::BORDER_REFLECT);
+  SilhouetteConfig method;
+  method.silhouette_method = "views";
+  const ViewSilhouettes found =
+      silhouettesFromViews(images, cameras, names, images[0].size(), method);
+  ASSERT_EQ(found.warnings.size(), 1u);
+  EXPECT_EQ(found.warnings[0].rfind(names[3] + ": ", 0), 0u) << found.warnings[0];
+}
+
 TEST(ViewSilhouettes, LargestBallLiesInsideEveryFrustum) {
   SceneConfig config;
   config.views = 8;
