@@ -59,13 +59,18 @@ cv::Mat borderBand(cv::Size size, double fraction) {
 /// shadow (the floor's colour, darker) lies nearer the lit floor than another colour does.
 constexpr double kLightnessWeight = 0.35;
 cv::Mat cutColours(const cv::Mat& bgr) {
-  cv::Mat lab;
-  cv::cvtColor(bgr, lab, cv::COLOR_BGR2Lab);
+  // Through floating point: OpenCV's 8-bit Lab conversion keeps lazily built tables no one frees.
+  cv::Mat scaled, lab;
+  bgr.convertTo(scaled, CV_32F, 1.0 / 255.0);
+  cv::cvtColor(scaled, lab, cv::COLOR_BGR2Lab);  // L in [0, 100], a and b about [-127, 127]
   std::vector<cv::Mat> channels;
   cv::split(lab, channels);
-  channels[0].convertTo(channels[0], CV_8U, kLightnessWeight);
-  cv::merge(channels, lab);
-  return lab;
+  channels[0].convertTo(channels[0], CV_8U, 2.55 * kLightnessWeight);
+  channels[1].convertTo(channels[1], CV_8U, 1.0, 128.0);
+  channels[2].convertTo(channels[2], CV_8U, 1.0, 128.0);
+  cv::Mat out;
+  cv::merge(channels, out);
+  return out;
 }
 
 /// GrabCut from a labelling; the foreground (certain or probable) as 255.
