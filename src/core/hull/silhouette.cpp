@@ -10,11 +10,15 @@
 #include <string>
 #include <vector>
 
+#include "hull/silhouette_parts.h"
 #include "sift_hull/limits.h"
 
 namespace sift_hull {
 
 namespace {
+
+using silhouette_parts::disc;
+using silhouette_parts::largeComponents;
 
 /// The least share of the border a background colour cluster holds.
 constexpr double kMinClusterShare = 0.005;
@@ -41,10 +45,6 @@ constexpr double kMinComponentShare = 0.05;
 int borderBand(cv::Size size, double fraction) {
   const int side = std::min(size.width, size.height);
   return std::min(std::max(2, static_cast<int>(fraction * side)), std::max(1, side / 2));
-}
-
-cv::Mat disc(int radius) {
-  return cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * radius + 1, 2 * radius + 1));
 }
 
 /// The image as CV_32FC3 CIE Lab (L in [0, 100]).
@@ -109,25 +109,6 @@ float borderSpread(const cv::Mat& distance, int band) {
   const size_t rank = values.size() * 9 / 10;
   std::nth_element(values.begin(), values.begin() + rank, values.end());
   return std::isfinite(values[rank]) ? values[rank] : 0.0f;
-}
-
-/// The components of a mask holding at least kMinComponentShare of the largest one's area.
-cv::Mat largeComponents(const cv::Mat& mask) {
-  cv::Mat labels, stats, centroids;
-  const int count = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
-  int largest = 0;
-  for (int i = 1; i < count; ++i) largest = std::max(largest, stats.at<int>(i, cv::CC_STAT_AREA));
-  std::vector<uint8_t> keep(count, 0);
-  for (int i = 1; i < count; ++i) {
-    keep[i] = stats.at<int>(i, cv::CC_STAT_AREA) >= kMinComponentShare * largest ? 255 : 0;
-  }
-  cv::Mat kept(mask.size(), CV_8UC1);
-  for (int v = 0; v < mask.rows; ++v) {
-    const int* label = labels.ptr<int>(v);
-    uint8_t* out = kept.ptr<uint8_t>(v);
-    for (int u = 0; u < mask.cols; ++u) out[u] = keep[label[u]];
-  }
-  return kept;
 }
 
 /// Why a mask looks like the background taken for the object, or like nothing: empty, over 90 %
@@ -199,6 +180,33 @@ cv::Mat backgroundSilhouette(const cv::Mat& image, const SilhouetteConfig& confi
 }
 
 }  // namespace
+
+namespace silhouette_parts {
+
+cv::Mat disc(int radius) {
+  return cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * radius + 1, 2 * radius + 1));
+}
+
+/// The components of a mask holding at least kMinComponentShare of the largest one's area.
+cv::Mat largeComponents(const cv::Mat& mask) {
+  cv::Mat labels, stats, centroids;
+  const int count = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
+  int largest = 0;
+  for (int i = 1; i < count; ++i) largest = std::max(largest, stats.at<int>(i, cv::CC_STAT_AREA));
+  std::vector<uint8_t> keep(count, 0);
+  for (int i = 1; i < count; ++i) {
+    keep[i] = stats.at<int>(i, cv::CC_STAT_AREA) >= kMinComponentShare * largest ? 255 : 0;
+  }
+  cv::Mat kept(mask.size(), CV_8UC1);
+  for (int v = 0; v < mask.rows; ++v) {
+    const int* label = labels.ptr<int>(v);
+    uint8_t* out = kept.ptr<uint8_t>(v);
+    for (int u = 0; u < mask.cols; ++u) out[u] = keep[label[u]];
+  }
+  return kept;
+}
+
+}  // namespace silhouette_parts
 
 cv::Mat backgroundDistance(const cv::Mat& image, double border_fraction) {
   if (image.empty() || image.depth() != CV_8U || (image.channels() != 1 && image.channels() != 3)) {

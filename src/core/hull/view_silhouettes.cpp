@@ -11,11 +11,14 @@
 #include <opencv2/imgproc.hpp>
 #include <sstream>
 
+#include "hull/silhouette_parts.h"
 #include "hull/view_prior.h"
 
 namespace sift_hull {
 namespace {
 
+using silhouette_parts::disc;
+using silhouette_parts::largeComponents;
 using view_prior::CoarseHull;
 using view_prior::PixelScale;
 
@@ -96,23 +99,6 @@ cv::Mat cut(const cv::Mat& bgr, cv::Mat labels, int iterations) {
   cv::grabCut(image, labels, cv::Rect(), background_model, foreground_model, iterations,
               cv::GC_INIT_WITH_MASK);
   return (labels & 1) * 255;  // GC_FGD = 1, GC_PR_FGD = 3
-}
-
-/// Components under 5 % of the largest removed.
-cv::Mat largestParts(const cv::Mat& mask) {
-  cv::Mat labels, stats, centroids;
-  const int count = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
-  int largest = 0;
-  for (int i = 1; i < count; ++i) largest = std::max(largest, stats.at<int>(i, cv::CC_STAT_AREA));
-  cv::Mat out = cv::Mat::zeros(mask.size(), CV_8UC1);
-  for (int i = 1; i < count; ++i) {
-    if (stats.at<int>(i, cv::CC_STAT_AREA) * 20 >= largest) out.setTo(255, labels == i);
-  }
-  return out;
-}
-
-cv::Mat disc(int radius) {
-  return cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * radius + 1, 2 * radius + 1));
 }
 
 /// A closing by a disc of `radius` (what a dark rim or fold split), and the holes under 1 % of the
@@ -242,7 +228,7 @@ ViewSilhouettes silhouettesFromViews(const std::vector<cv::Mat>& images,
       cv::Mat labels(half, CV_8UC1, cv::Scalar(cv::GC_PR_BGD));
       labels.setTo(cv::GC_PR_FGD, small_prior);
       labels.setTo(cv::GC_BGD, borderBand(half, 0.03));
-      first[v] = largestParts(cut(small, labels, 3));
+      first[v] = largeComponents(cut(small, labels, 3));
     }
   });
 
@@ -287,7 +273,7 @@ ViewSilhouettes silhouettesFromViews(const std::vector<cv::Mat>& images,
       cv::erode(projection, core, disc(margin));
       labels.setTo(cv::GC_FGD, core & earlier);
       labels.setTo(cv::GC_BGD, borderBand(size, 0.03) & ~projection);
-      const cv::Mat mask = largestParts(cut(images[v], labels, 2) & grown);
+      const cv::Mat mask = largeComponents(cut(images[v], labels, 2) & grown);
       agreement[v] = maskIou(mask, projection);
       cv::Mat full;
       cv::resize(mask, full, full_size, 0, 0, cv::INTER_LINEAR);

@@ -297,13 +297,7 @@ std::vector<CalibratedView> readNerfDirectory(const std::vector<std::string>& fi
   return views;
 }
 
-bool isNpy(const std::string& path) {
-  if (path.size() < 4) return false;
-  std::string suffix = path.substr(path.size() - 4);
-  std::transform(suffix.begin(), suffix.end(), suffix.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return suffix == ".npy";
-}
+bool isNpy(const std::string& path) { return hasSuffix(path, ".npy"); }
 
 }  // namespace
 

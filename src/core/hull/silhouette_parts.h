@@ -1,0 +1,16 @@
+#pragma once
+// Mask clean-up shared by the silhouette methods (hull/silhouette.cpp, hull/view_silhouettes.cpp).
+
+#include <opencv2/core.hpp>
+
+namespace sift_hull {
+namespace silhouette_parts {
+
+/// An elliptic structuring element of the given radius (2 * radius + 1 pixels across).
+cv::Mat disc(int radius);
+
+/// The components of a mask (8-connected) holding at least 5 % of the largest one's area.
+cv::Mat largeComponents(const cv::Mat& mask);
+
+}  // namespace silhouette_parts
+}  // namespace sift_hull
