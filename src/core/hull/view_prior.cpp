@@ -34,6 +34,18 @@ Grid gridOver(const Box3d& box, int cells) {
   return grid;
 }
 
+/// A cell centre's grid index relative to the cell centre `origin`.
+Eigen::Vector3i cellIndex(const Eigen::Vector3d& origin, double cell, const Eigen::Vector3d& c) {
+  const Eigen::Vector3d i = (c - origin) / cell;
+  return {static_cast<int>(std::lround(i.x())), static_cast<int>(std::lround(i.y())),
+          static_cast<int>(std::lround(i.z()))};
+}
+
+/// One key per grid index within 4096 cells of the origin.
+int64_t cellKey(const Eigen::Vector3i& i) {
+  return ((int64_t{i.x()} + 4096) << 26) | ((int64_t{i.y()} + 4096) << 13) | (i.z() + 4096);
+}
+
 }  // namespace
 
 CoarseHull carve(const std::vector<cv::Mat>& masks, const std::vector<PinholeCamera>& cameras,
@@ -95,17 +107,9 @@ Eigen::Vector3d meanUp(const std::vector<PinholeCamera>& cameras) {
 void keepLargestPart(CoarseHull* hull) {
   if (hull->centres_W.empty()) return;
   const Eigen::Vector3d origin = hull->centres_W.front();
-  const auto index = [&](const Eigen::Vector3d& c) {
-    const Eigen::Vector3d i = (c - origin) / hull->cell;
-    return Eigen::Vector3i(static_cast<int>(std::lround(i.x())),
-                           static_cast<int>(std::lround(i.y())),
-                           static_cast<int>(std::lround(i.z())));
-  };
-  const auto key = [](const Eigen::Vector3i& i) {
-    return ((int64_t{i.x()} + 4096) << 26) | ((int64_t{i.y()} + 4096) << 13) | (i.z() + 4096);
-  };
+  const auto index = [&](const Eigen::Vector3d& c) { return cellIndex(origin, hull->cell, c); };
   std::unordered_map<int64_t, size_t> cells;
-  for (size_t k = 0; k < hull->centres_W.size(); ++k) cells[key(index(hull->centres_W[k]))] = k;
+  for (size_t k = 0; k < hull->centres_W.size(); ++k) cells[cellKey(index(hull->centres_W[k]))] = k;
   std::vector<int> part(hull->centres_W.size(), -1);
   std::vector<size_t> sizes;
   for (size_t seed = 0; seed < part.size(); ++seed) {
@@ -122,7 +126,7 @@ void keepLargestPart(CoarseHull* hull) {
       for (int dx = -1; dx <= 1; ++dx) {
         for (int dy = -1; dy <= 1; ++dy) {
           for (int dz = -1; dz <= 1; ++dz) {
-            const auto found = cells.find(key(i + Eigen::Vector3i(dx, dy, dz)));
+            const auto found = cells.find(cellKey(i + Eigen::Vector3i(dx, dy, dz)));
             if (found == cells.end() || part[found->second] >= 0) continue;
             part[found->second] = id;
             stack.push_back(found->second);
@@ -221,10 +225,7 @@ cv::Mat project(const CoarseHull& hull, const PinholeCamera& camera, const Pixel
   // relative to the first cell.
   const Eigen::Vector3d origin = hull.centres_W.front();
   const auto key = [&](const Eigen::Vector3d& c) {
-    const Eigen::Vector3d i = (c - origin) / hull.cell;
-    const int64_t x = std::llround(i.x()) + 4096, y = std::llround(i.y()) + 4096,
-                  z = std::llround(i.z()) + 4096;
-    return (x << 26) | (y << 13) | z;
+    return cellKey(cellIndex(origin, hull.cell, c));
   };
   std::unordered_set<int64_t> cells;
   cells.reserve(hull.centres_W.size() * 2);
