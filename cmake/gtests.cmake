@@ -16,6 +16,7 @@ set(SIFT_HULL_CORE_GTESTS
   test_nerf_transforms eval
   test_photo_set_inputs eval
   test_view_silhouettes eval
+  test_silhouette_choice eval
   test_idr_cameras eval
   test_ply io
   test_ground_truth_files io

@@ -66,12 +66,18 @@ void writeViewPriorsFromArgs(const ArgParser& parser, const std::vector<std::str
 }
 
 nlohmann::json viewSilhouettesJson(const ViewSilhouettes& report) {
-  nlohmann::json json = {{"method", "views"},
+  nlohmann::json json = {{"method", report.method},
+                         {"agreement", {{"views", report.agreement}}},
                          {"support_cut_fraction", report.support_fraction},
                          {"support_cut_height", report.support_height},
                          {"up", {report.up_W.x(), report.up_W.y(), report.up_W.z()}},
                          {"time_ms", report.time_ms},
                          {"warnings", report.warnings}};
+  if (report.background_agreement >= 0.0) {
+    json["agreement"]["background"] = report.background_agreement;
+  } else if (!report.background_reason.empty()) {
+    json["agreement"]["background_skipped"] = report.background_reason;
+  }
   if (report.ball_centre_W) {
     const Eigen::Vector3d& c = *report.ball_centre_W;
     json["frusta_ball"] = {{"centre", {c.x(), c.y(), c.z()}}, {"radius", report.ball_radius}};

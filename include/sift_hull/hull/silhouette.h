@@ -9,13 +9,16 @@
 
 namespace sift_hull {
 
-/// Silhouette extraction from images. Three methods:
+/// Silhouette extraction from images. Four methods:
+/// - "auto" (the default): for a calibrated set, the "views" method's silhouettes, or the
+///   "background" method's where every view's border is plain (no GrabCut needed) and they agree
+///   across the views at least as well (silhouetteAgreement); for one image alone, "background".
 /// - "views", from all the views of a calibrated set together
 ///   (sift_hull/hull/view_silhouettes.h): a prior from the cameras' common frusta, GrabCut with
 ///   the image border as background, a coarse hull tolerant of a tenth of the views, its support
 ///   cut, the hull's projection as the prior of a second cut. `segment_side_px` is the working
 ///   size. For one image alone (silhouetteFromImage) it is "background".
-/// - "background" (the default), a colour model of the image border (the object rarely touches
+/// - "background", a colour model of the image border (the object rarely touches
 ///   it): each pixel's colour distance (CIE Lab) to the nearest of the border's colour clusters
 ///   (k-means, k = 8; clusters under 0.5 % of the border dropped), a threshold on that distance
 ///   chosen per image above the border's own spread of distances (3 times its 90th percentile, at
@@ -29,7 +32,7 @@ namespace sift_hull {
 ///   dilation and an erosion with discs of the given radii. The command line and the nodes take
 ///   it when a threshold is given and no method is named.
 struct SilhouetteConfig {
-  std::string silhouette_method = "background";  ///< "views", "background" or "threshold"
+  std::string silhouette_method = "auto";  ///< "auto", "views", "background" or "threshold"
   double threshold = 0.19;
   int dilate_px = 10;
   int erode_px = 7;
@@ -44,8 +47,12 @@ const SettingTable<SilhouetteConfig>& settingsOf<SilhouetteConfig>();
 void validate(const SilhouetteConfig& config);
 
 /// Mask (CV_8UC1, 255 inside, 0 outside) of the object in an 8-bit grey or BGR image, by the
-/// config's method ("views" needs the other views: "background" here).
+/// config's method ("auto" and "views" need the other views: "background" here).
 cv::Mat silhouetteFromImage(const cv::Mat& image, const SilhouetteConfig& config);
+
+/// The "background" method's silhouette when the image's border is plain (its colour clusters
+/// describe it, so no GrabCut is needed); an empty Mat when the border is textured.
+cv::Mat plainBackgroundSilhouette(const cv::Mat& image, const SilhouetteConfig& config);
 
 /// The colour distance of every pixel (CV_32FC1, CIE Lab units) to the nearest colour cluster of
 /// the image's border band (`border_fraction` of the smaller side, at least 2 pixels wide): the

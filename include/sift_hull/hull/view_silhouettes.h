@@ -36,6 +36,14 @@ struct ViewSilhouettes {
   double support_fraction = 0.0;
   double support_height = 0.0;
   Eigen::Vector3d up_W = Eigen::Vector3d::UnitZ();
+  /// silhouetteAgreement() of the masks.
+  double agreement = 0.0;
+  /// The "auto" method: the one whose silhouettes were used ("views" or "background"), and the
+  /// background method's agreement; negative when it was not a candidate (a textured border in
+  /// some view, which only GrabCut separates: `background_reason` says which).
+  std::string method = "views";
+  double background_agreement = -1.0;
+  std::string background_reason;
   /// Views whose segmentation the other views do not confirm, named for the user.
   std::vector<std::string> warnings;
   double time_ms = 0.0;
@@ -52,6 +60,16 @@ ViewSilhouettes silhouettesFromViews(const std::vector<cv::Mat>& images,
                                      const std::vector<PinholeCamera>& cameras,
                                      const std::vector<std::string>& names, cv::Size full_size,
                                      const SilhouetteConfig& config);
+
+/// How well silhouettes agree across views, on [0, 1]: the mean IoU of each view's mask (at the
+/// working size of `segment_side_px`) with the projection of the coarse hull carved from all the
+/// masks inside the frusta's box, no view's disagreement tolerated. Silhouettes that take a part
+/// of the background in some views but not in others, or lose a part of the object, agree less.
+/// Throws std::invalid_argument for fewer than two masks or masks of different sizes, and
+/// std::runtime_error for frusta with no common part.
+double silhouetteAgreement(const std::vector<cv::Mat>& masks,
+                           const std::vector<PinholeCamera>& cameras,
+                           const std::vector<std::string>& names, int segment_side_px);
 
 /// The working size of an image of `full_size`: its longest side brought to at most
 /// `segment_side_px`, the aspect kept.

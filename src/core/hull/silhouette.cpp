@@ -242,6 +242,17 @@ cv::Mat backgroundDistance(const cv::Mat& image, double border_fraction) {
   return distance;
 }
 
+cv::Mat plainBackgroundSilhouette(const cv::Mat& image, const SilhouetteConfig& config) {
+  validate(config);
+  if (image.empty() || image.depth() != CV_8U) {
+    throw std::invalid_argument("plainBackgroundSilhouette needs a non-empty 8-bit image");
+  }
+  const cv::Mat distance = backgroundDistance(image, kBorderFraction);
+  const float spread = borderSpread(distance, borderBand(image.size(), kBorderFraction));
+  if (spread > kMaxClusteredSpread) return cv::Mat();
+  return cleaned(distance > std::max(kMinObjectDistance, kSpreadFactor * spread), config);
+}
+
 cv::Mat silhouetteFromImage(const cv::Mat& image, const SilhouetteConfig& config) {
   validate(config);
   if (image.empty() || image.depth() != CV_8U) {

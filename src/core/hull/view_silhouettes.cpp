@@ -10,6 +10,7 @@
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 #include <sstream>
+#include <stdexcept>
 
 #include "hull/silhouette_parts.h"
 #include "hull/view_prior.h"
@@ -130,7 +131,68 @@ double maskIou(const cv::Mat& a, const cv::Mat& b) {
   return either > 0.0 ? both / either : 1.0;
 }
 
+/// The box of the views' frusta (hullBoundingBox with whole images).
+Box3d frustaBox(const std::vector<PinholeCamera>& cameras, const std::vector<std::string>& names,
+                cv::Size full_size) {
+  const std::vector<SilhouetteBounds> whole(
+      cameras.size(), boundsOfInside(cv::Rect(cv::Point(0, 0), full_size), full_size, true));
+  try {
+    return hullBoundingBox(cameras, whole, names);
+  } catch (const HullBoxError& e) {
+    throw std::runtime_error(std::string("the views' frusta have no bounded common part (") +
+                             e.what() + "): give masks with --silhouettes");
+  }
+}
+
+/// A coarse hull of `masks` inside `box`, its largest part, carved again on a grid over that
+/// part's box (finer cells where the object is).
+CoarseHull carveTight(const std::vector<cv::Mat>& masks, const std::vector<PinholeCamera>& cameras,
+                      const PixelScale& scale, const Box3d& box, int tolerated) {
+  CoarseHull hull = view_prior::carve(masks, cameras, scale, box, kCoarseCells, tolerated);
+  view_prior::keepLargestPart(&hull);
+  if (!hull.centres_W.empty()) {
+    hull = view_prior::carve(masks, cameras, scale, view_prior::boxOf(hull, 2.0), kCoarseCells,
+                             tolerated);
+    view_prior::keepLargestPart(&hull);
+  }
+  return hull;
+}
+
 }  // namespace
+
+double silhouetteAgreement(const std::vector<cv::Mat>& masks,
+                           const std::vector<PinholeCamera>& cameras,
+                           const std::vector<std::string>& names, int segment_side_px) {
+  const size_t n = masks.size();
+  if (n < 2 || cameras.size() != n || names.size() != n) {
+    throw std::invalid_argument("silhouetteAgreement: two masks or more, each with its camera");
+  }
+  const cv::Size full_size = masks.front().size();
+  const cv::Size size = workingSize(full_size, segment_side_px);
+  const PixelScale scale{static_cast<double>(size.width) / full_size.width,
+                         static_cast<double>(size.height) / full_size.height};
+  std::vector<cv::Mat> small(n);
+  for (size_t v = 0; v < n; ++v) {
+    if (masks[v].size() != full_size || masks[v].type() != CV_8UC1) {
+      throw std::invalid_argument("silhouetteAgreement: " + names[v] +
+                                  "'s mask is not CV_8UC1 of the first's size");
+    }
+    cv::resize(masks[v], small[v], size, 0, 0, cv::INTER_AREA);
+    small[v] = small[v] >= 128;
+  }
+  const CoarseHull hull =
+      carveTight(small, cameras, scale, frustaBox(cameras, names, full_size), 0);
+  if (hull.centres_W.empty()) return 0.0;
+  std::vector<double> iou(n);
+  cv::parallel_for_(cv::Range(0, static_cast<int>(n)), [&](const cv::Range& range) {
+    for (int v = range.start; v < range.end; ++v) {
+      iou[v] = maskIou(small[v], view_prior::project(hull, cameras[v], scale, size));
+    }
+  });
+  double sum = 0.0;
+  for (const double value : iou) sum += value;
+  return sum / static_cast<double>(n);
+}
 
 cv::Size workingSize(cv::Size full_size, int segment_side_px) {
   const int longest = std::max(full_size.width, full_size.height);
@@ -186,15 +248,7 @@ ViewSilhouettes silhouettesFromViews(const std::vector<cv::Mat>& images,
                    static_cast<double>(size.height) / full_size.height};
   ViewSilhouettes result;
   // 1. The frusta's box and the largest ball inside them.
-  std::vector<SilhouetteBounds> whole(
-      n, boundsOfInside(cv::Rect(cv::Point(0, 0), full_size), full_size, true));
-  Box3d frusta;
-  try {
-    frusta = hullBoundingBox(cameras, whole, names);
-  } catch (const HullBoxError& e) {
-    throw std::runtime_error(std::string("the views' frusta have no bounded common part (") +
-                             e.what() + "): give masks with --silhouettes");
-  }
+  const Box3d frusta = frustaBox(cameras, names, full_size);
   const auto ball = largestBallInFrusta(cameras, full_size, frusta);
   if (!ball) throw std::runtime_error("no point lies inside every view's frustum");
   result.ball_centre_W = ball->first;
@@ -235,13 +289,7 @@ ViewSilhouettes silhouettesFromViews(const std::vector<cv::Mat>& images,
   // 3. A coarse hull from those masks, a tenth of the views' disagreement tolerated; its support
   // cut.
   const int tolerated = static_cast<int>(n / 10);
-  CoarseHull hull = view_prior::carve(first, cameras, half_scale, frusta, kCoarseCells, tolerated);
-  view_prior::keepLargestPart(&hull);
-  if (!hull.centres_W.empty()) {
-    hull = view_prior::carve(first, cameras, half_scale, view_prior::boxOf(hull, 2.0), kCoarseCells,
-                             tolerated);
-    view_prior::keepLargestPart(&hull);
-  }
+  CoarseHull hull = carveTight(first, cameras, half_scale, frusta, tolerated);
   if (hull.centres_W.empty()) {
     throw std::runtime_error(
         "the views' segmentations share no object: nothing is inside all but " +
@@ -280,6 +328,7 @@ ViewSilhouettes silhouettesFromViews(const std::vector<cv::Mat>& images,
       result.masks[v] = closeAndFill(full >= 128, config.erode_px);
     }
   });
+  result.agreement = silhouetteAgreement(result.masks, cameras, names, config.segment_side_px);
   for (size_t v = 0; v < n; ++v) {
     if (agreement[v] < 0.8) {
       std::ostringstream text;

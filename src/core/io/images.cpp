@@ -151,6 +151,34 @@ cv::Mat loadMask(const std::string& path) {
 
 namespace {
 
+/// What silhouetteAgreement resolves: outlines a pixel or two apart at the working size (half a
+/// coarse cell) change it by one to two hundredths.
+constexpr double kAgreementResolution = 0.01;
+
+/// The "auto" method's choice between the views method's silhouettes (`found`) and the background
+/// method's (`plain`, one per view, empty where a view's border is textured or the view carries
+/// its own alpha mask). The background method's, a colour model at full resolution, where every
+/// view has one and they agree across the views as well (silhouetteAgreement) to within the
+/// measure's resolution; the views method's where they agree clearly better.
+void chooseBackgroundWhereItAgrees(ViewSilhouettes* found, std::vector<cv::Mat> plain,
+                                   const std::vector<std::string>& names,
+                                   const std::vector<PinholeCamera>& cameras,
+                                   const SilhouetteConfig& recipe) {
+  for (size_t i = 0; i < plain.size(); ++i) {
+    if (plain[i].empty()) {
+      found->background_reason =
+          names[i] + ": its border is textured (the background method would need GrabCut)";
+      return;
+    }
+  }
+  found->background_agreement = silhouetteAgreement(plain, cameras, names, recipe.segment_side_px);
+  if (found->background_agreement >= found->agreement - kAgreementResolution) {
+    found->method = "background";
+    found->masks = std::move(plain);
+    found->warnings.clear();  // they named the views method's masks
+  }
+}
+
 /// loadSilhouettes, each silhouette converted by `keep` (cv::Mat -> Kept) as soon as it is made.
 template <typename Kept, typename Keep>
 std::vector<Kept> loadSilhouettesAs(const std::vector<CalibratedView>& views,
@@ -158,14 +186,16 @@ std::vector<Kept> loadSilhouettesAs(const std::vector<CalibratedView>& views,
                                     const std::string& mask_directory,
                                     const SilhouetteConfig& recipe, const Keep& keep,
                                     ViewSilhouettes* report) {
-  const bool together =
-      mask_directory.empty() && recipe.silhouette_method == "views" && views.size() >= 2;
+  const bool choose = recipe.silhouette_method == "auto";
+  const bool together = mask_directory.empty() && (choose || recipe.silhouette_method == "views") &&
+                        views.size() >= 2;
   // Each view read and its silhouette made on OpenCV's threads, one image in memory per thread;
   // then the checks in view order, so the first error is the one a sequential read would meet.
   struct Loaded {
     cv::Size image_size, silhouette_size;
     Kept silhouette;
     cv::Mat working;  ///< the "views" method: the image at the working size, until all are read
+    cv::Mat plain;    ///< the "auto" method: the background method's silhouette, plain borders
     bool pending = false;
     std::exception_ptr error;
   };
@@ -183,6 +213,7 @@ std::vector<Kept> loadSilhouettesAs(const std::vector<CalibratedView>& views,
           } else if (together) {
             cv::resize(image.bgr, loaded[i].working,
                        workingSize(image.bgr.size(), recipe.segment_side_px), 0, 0, cv::INTER_AREA);
+            if (choose) loaded[i].plain = plainBackgroundSilhouette(image.bgr, recipe);
             loaded[i].pending = true;
             continue;
           } else {
@@ -243,6 +274,11 @@ std::vector<Kept> loadSilhouettesAs(const std::vector<CalibratedView>& views,
   }
   ViewSilhouettes found =
       silhouettesFromViews(working, cameras, names, loaded[0].image_size, recipe);
+  if (choose) {
+    std::vector<cv::Mat> plain;
+    for (Loaded& l : loaded) plain.push_back(l.pending ? std::move(l.plain) : cv::Mat());
+    chooseBackgroundWhereItAgrees(&found, std::move(plain), names, cameras, recipe);
+  }
   for (size_t i = 0; i < views.size(); ++i) {
     if (loaded[i].pending) silhouettes[i] = keep(found.masks[i]);
   }
