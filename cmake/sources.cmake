@@ -51,6 +51,7 @@ set(SIFT_HULL_CORE_SOURCES
   src/core/hull/silhouette.cpp
   src/core/hull/view_prior.cpp
   src/core/hull/view_silhouettes.cpp
+  src/core/hull/view_silhouette_set.cpp
   src/core/mvs/depth_maps.cpp
   src/core/mvs/mesh_colour.cpp
   src/core/mvs/patch_match.cpp

@@ -80,6 +80,7 @@ excluded[test_scene]+=":AllShapes/SceneShapes.SilhouetteEqualsProjectionOfAnalyt
 excluded[test_view_silhouettes]="ViewSilhouettes.FloorWithShadowsBeatsThePerImageMethod"
 excluded[test_view_silhouettes]+=":ViewSilhouettes.TurntableBeatsThePerImageMethod"
 excluded[test_silhouette_choice]="SilhouetteChoice.FloorWithShadowsTakesTheViewsMethod"
+excluded[test_silhouette_choice]+=":SilhouetteChoice.ViewsArrivingOneAtATimeAreSegmentedTogetherAsTheSetGrows"
 # The binaries that took longest under the sanitizers, the longest first: they start first when
 # no earlier timing.txt gives the binaries' seconds.
 long_first=(test_photo_carving test_scene test_photo_stream test_point_carved_stream test_cut_shapes

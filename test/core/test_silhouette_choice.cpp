@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "common/test_data.h"
+#include "sift_hull/hull/view_silhouette_set.h"
 #include "sift_hull/hull/view_silhouettes.h"
 #include "sift_hull/io/images.h"
 #include "sift_hull/synthetic/scene.h"
@@ -106,6 +107,52 @@ TEST(SilhouetteChoice, FloorWithShadowsTakesTheViewsMethod) {
   EXPECT_LT(chosen.report.background_agreement, 0.0);
   EXPECT_NE(chosen.report.background_reason.find("textured"), std::string::npos);
   EXPECT_GT(chosen.mean_iou, 0.95);
+}
+
+
+TEST(SilhouetteChoice, ViewsArrivingOneAtATimeAreSegmentedTogetherAsTheSetGrows) {
+  const std::vector<RenderedView> rendered = renderScene(scene("textured", "floor"));
+  ViewSilhouetteSet set(SilhouetteConfig(), 200);
+  std::vector<size_t> due_at;
+  ViewSilhouetteSet::Segmented last;
+  double per_image = 0.0;
+  for (size_t v = 0; v < rendered.size(); ++v) {
+    const cv::Mat now = set.add(rendered[v].view.name, rendered[v].image, rendered[v].view.camera);
+    per_image += iou(now, rendered[v].mask) / rendered.size();
+    if (set.segmentDue(false)) {
+      due_at.push_back(set.size());
+      last = set.segment();
+    }
+  }
+  EXPECT_EQ(due_at, (std::vector<size_t>{4, 6, 9}));
+  EXPECT_FALSE(set.segmentDue(false));
+  ASSERT_TRUE(set.segmentDue(true)) << "views 10 to 12 came since";
+  last = set.segment();
+  EXPECT_FALSE(set.segmentDue(true));
+  ASSERT_EQ(last.masks.size(), rendered.size());
+  double together = 0.0;
+  for (size_t v = 0; v < rendered.size(); ++v) {
+    EXPECT_EQ(last.names[v], rendered[v].view.name);
+    together += iou(last.masks[v], rendered[v].mask) / rendered.size();
+  }
+  std::cout << "one at a time: per image " << per_image << ", together " << together << " ("
+            << last.report.method << ")\n";
+  EXPECT_EQ(last.report.method, "views");
+  EXPECT_GT(together, 0.95);
+  EXPECT_GT(together, per_image + 0.03);
+  EXPECT_GT(set.memoryBytes(), 12u * 100u * 75u * 3u) << "the photographs at the working size";
+  // Another size than the first view's, and a set that keeps no more than it may.
+  cv::Mat other;
+  cv::resize(rendered[0].image, other, cv::Size(160, 120));
+  EXPECT_THROW(set.add("other", other, rendered[0].view.camera), std::invalid_argument);
+  ViewSilhouetteSet small(SilhouetteConfig(), 2);
+  for (size_t v = 0; v < 3; ++v) {
+    EXPECT_FALSE(
+        small.add(rendered[v].view.name, rendered[v].image, rendered[v].view.camera).empty());
+  }
+  EXPECT_EQ(small.size(), 2u);
+  EXPECT_EQ(small.notKept(), 1u);
+  EXPECT_THROW(ViewSilhouetteSet(SilhouetteConfig(), 1), std::invalid_argument);
 }
 
 }  // namespace

@@ -50,11 +50,13 @@ class HullNodeTest : public ::testing::Test {
  protected:
   /// Whether the node extracts silhouettes from images (hull_from_image.test).
   virtual bool fromImage() const { return false; }
+  /// The scene the case publishes.
+  virtual SceneConfig sceneConfig() const { return sphereSceneConfig(); }
 
   void SetUp() override {
-    views_ = sphereViews();
+    views_ = renderScene(sceneConfig());
     std::vector<geometry_msgs::TransformStamped> poses;
-    for (int v = 0; v < kViews; ++v) {
+    for (int v = 0; v < static_cast<int>(views_.size()); ++v) {
       poses.push_back(
           ros_conversions::cameraPoseMessage(views_[v].view.camera, "world", frameOf(v), {}));
     }
@@ -93,7 +95,7 @@ class HullNodeTest : public ::testing::Test {
   /// Publishes every view; the stamp of the last.
   ros::Time publishAllViews() {
     ros::Time last;
-    for (int v = 0; v < kViews; ++v) last = publishView(v);
+    for (int v = 0; v < static_cast<int>(views_.size()); ++v) last = publishView(v);
     return last;
   }
 

@@ -71,6 +71,18 @@ double silhouetteAgreement(const std::vector<cv::Mat>& masks,
                            const std::vector<PinholeCamera>& cameras,
                            const std::vector<std::string>& names, int segment_side_px);
 
+/// The "auto" method's choice between the views method's silhouettes (`found`, with its
+/// agreement) and the background method's (`plain`, one per view at full size, empty where a
+/// view's border is textured or the view carries its own alpha mask). The background method's,
+/// a colour model at full resolution, where every view has one and they agree across the views as
+/// well (silhouetteAgreement) to within the measure's resolution (0.01); the views method's where
+/// they agree clearly better. Sets found->method, background_agreement or background_reason, and
+/// on the background method's side its masks (the views method's warnings cleared).
+void chooseBackgroundWhereItAgrees(ViewSilhouettes* found, std::vector<cv::Mat> plain,
+                                   const std::vector<std::string>& names,
+                                   const std::vector<PinholeCamera>& cameras,
+                                   const SilhouetteConfig& config);
+
 /// The working size of an image of `full_size`: its longest side brought to at most
 /// `segment_side_px`, the aspect kept.
 cv::Size workingSize(cv::Size full_size, int segment_side_px);

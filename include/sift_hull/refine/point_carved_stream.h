@@ -109,6 +109,9 @@ class PointCarvedStream {
 
   /// Back to no views, no hull and no points.
   void reset();
+  /// Back to no views and no hull, the surface points kept: they carve the hull the views added
+  /// next make at the next refinement (the views' silhouettes made anew).
+  void restartViews();
 
   const HullStream& stream() const { return stream_; }
   /// HullStream::takeRefusals.

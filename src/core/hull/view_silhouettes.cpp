@@ -158,7 +158,30 @@ CoarseHull carveTight(const std::vector<cv::Mat>& masks, const std::vector<Pinho
   return hull;
 }
 
+/// What silhouetteAgreement resolves: outlines a pixel or two apart at the working size (half a
+/// coarse cell) change it by one to two hundredths.
+constexpr double kAgreementResolution = 0.01;
+
 }  // namespace
+
+void chooseBackgroundWhereItAgrees(ViewSilhouettes* found, std::vector<cv::Mat> plain,
+                                   const std::vector<std::string>& names,
+                                   const std::vector<PinholeCamera>& cameras,
+                                   const SilhouetteConfig& recipe) {
+  for (size_t i = 0; i < plain.size(); ++i) {
+    if (plain[i].empty()) {
+      found->background_reason =
+          names[i] + ": its border is textured (the background method would need GrabCut)";
+      return;
+    }
+  }
+  found->background_agreement = silhouetteAgreement(plain, cameras, names, recipe.segment_side_px);
+  if (found->background_agreement >= found->agreement - kAgreementResolution) {
+    found->method = "background";
+    found->masks = std::move(plain);
+    found->warnings.clear();  // they named the views method's masks
+  }
+}
 
 double silhouetteAgreement(const std::vector<cv::Mat>& masks,
                            const std::vector<PinholeCamera>& cameras,

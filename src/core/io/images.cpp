@@ -151,34 +151,6 @@ cv::Mat loadMask(const std::string& path) {
 
 namespace {
 
-/// What silhouetteAgreement resolves: outlines a pixel or two apart at the working size (half a
-/// coarse cell) change it by one to two hundredths.
-constexpr double kAgreementResolution = 0.01;
-
-/// The "auto" method's choice between the views method's silhouettes (`found`) and the background
-/// method's (`plain`, one per view, empty where a view's border is textured or the view carries
-/// its own alpha mask). The background method's, a colour model at full resolution, where every
-/// view has one and they agree across the views as well (silhouetteAgreement) to within the
-/// measure's resolution; the views method's where they agree clearly better.
-void chooseBackgroundWhereItAgrees(ViewSilhouettes* found, std::vector<cv::Mat> plain,
-                                   const std::vector<std::string>& names,
-                                   const std::vector<PinholeCamera>& cameras,
-                                   const SilhouetteConfig& recipe) {
-  for (size_t i = 0; i < plain.size(); ++i) {
-    if (plain[i].empty()) {
-      found->background_reason =
-          names[i] + ": its border is textured (the background method would need GrabCut)";
-      return;
-    }
-  }
-  found->background_agreement = silhouetteAgreement(plain, cameras, names, recipe.segment_side_px);
-  if (found->background_agreement >= found->agreement - kAgreementResolution) {
-    found->method = "background";
-    found->masks = std::move(plain);
-    found->warnings.clear();  // they named the views method's masks
-  }
-}
-
 /// loadSilhouettes, each silhouette converted by `keep` (cv::Mat -> Kept) as soon as it is made.
 template <typename Kept, typename Keep>
 std::vector<Kept> loadSilhouettesAs(const std::vector<CalibratedView>& views,

@@ -224,6 +224,16 @@ void PointCarvedStream::reset() {
   free_voxels_ = 0;
 }
 
+void PointCarvedStream::restartViews() {
+  stream_.reset();
+  carving_.reset();
+  carving_found_ = {};
+  std::lock_guard<std::mutex> lock(points_mutex_);
+  points_new_ = stored_points_ > 0;
+  refined_generation_ = 0;
+  free_voxels_ = 0;
+}
+
 size_t PointCarvedStream::storedPoints() const {
   std::lock_guard<std::mutex> lock(points_mutex_);
   return stored_points_;

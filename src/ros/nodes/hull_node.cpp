@@ -75,6 +75,7 @@ HullNode::HullNode(ros::NodeHandle nh, ros::NodeHandle private_nh, HullNodeConfi
                                            [this] { work_.post([this] { takePhotoPass(); }); });
   }
   if (photo_) outputs_.colourClouds();
+  startSegmentingTogether();
   outputs_.advertise();
   refine_timer_ = nh_.createWallTimer(ros::WallDuration(config_.refine_period_s),
                                       [this](const ros::WallTimerEvent&) {
@@ -158,29 +159,6 @@ void HullNode::onSurfacePoints(const sift_hull::SurfacePointsConstPtr& message) 
 }
 
 // --- Work (the worker thread) ------------------------------------------------------------------
-bool HullNode::viewOf(const Posed& posed, View* view) {
-  const sensor_msgs::Image& silhouette = *posed.silhouette;
-  const std::string& name = silhouette.header.frame_id;
-  std::string why_not;
-  view->mask = config_.from_image ? ros_conversions::eightBitImage(posed.silhouette, &why_not)
-                                  : ros_conversions::maskFromImage(silhouette, &why_not);
-  if (config_.from_image && !view->mask.empty()) {
-    // An image with a varying alpha channel (rgba8, bgra8) carries its own silhouette.
-    const cv::Mat alpha = ros_conversions::alphaMask(posed.silhouette);
-    view->mask = alpha.empty() ? silhouetteFromImage(view->mask, config_.recipe) : alpha;
-  }
-  if (view->mask.empty() ||
-      !ros_conversions::cameraFromInfo(*posed.info, posed.T_W_C,
-                                       cv::Size(silhouette.width, silhouette.height), &view->camera,
-                                       &why_not, config_.rectified)) {
-    problem("hull: view '" + name + "' ignored: ", why_not);
-    return false;
-  }
-  view->name = name;
-  view->stamp = silhouette.header.stamp;
-  return true;
-}
-
 void HullNode::integrate(Posed& posed) {
   if (posed.generation != generation_) {  // queued before a ~reset
     ++counts_.reset;
@@ -200,7 +178,9 @@ void HullNode::integrate(Posed& posed) {
     return;
   }
   HullStream::Outcome outcome = HullStream::Outcome::kRefused;
-  const bool changed = carve(view, &outcome);
+  bool changed = carve(view, &outcome);
+  newest_view_stamp_ = std::max(newest_view_stamp_, view.stamp);
+  if (together_ && together_->segmentDue(false)) changed = segmentTogether() || changed;
   if (photo_ &&
       (outcome == HullStream::Outcome::kCarved || outcome == HullStream::Outcome::kWaiting)) {
     keepPhoto(posed, view);
@@ -317,6 +297,7 @@ bool HullNode::reset(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
 void HullNode::resetOnWorker() {
   counts_.reset += hull_.stream().waitingViews();
   hull_.reset();
+  if (together_) together_->clear();
   if (photo_) {
     photo_->reset();
     outputs_.setColours(nullptr, false);
@@ -421,6 +402,7 @@ void HullNode::reportDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& st
   status.add("last view stamp", last_view_stamp_.load());
   status.add("tf transforms refused", tf_listener_.refused());
   if (photo_) reportPhotoDiagnostics(status);
+  if (together_) reportSegmentation(status);
   const auto warn = [&status](const std::string& text) {
     status.mergeSummary(diagnostic_msgs::DiagnosticStatus::WARN, text);
     ROS_WARN_THROTTLE(kThrottle_s, "hull: %s", text.c_str());

@@ -34,6 +34,7 @@
 #include "sift_hull/Save.h"
 #include "sift_hull/SurfacePoints.h"
 #include "sift_hull/hull/bounding_box.h"
+#include "sift_hull/hull/view_silhouette_set.h"
 #include "sift_hull/mvs/photo_stream.h"
 #include "sift_hull/refine/point_carved_stream.h"
 
@@ -121,8 +122,15 @@ class HullNode {
   void startPhotoPass();
   void reportPhotoDiagnostics(diagnostic_updater::DiagnosticStatusWrapper& status);
   // Work (the worker thread).
+  // Views segmented together (hull_node_views.cpp).
   /// The view the three messages make, or false with the reason logged.
   bool viewOf(const Posed& posed, View* view);
+  /// ~from_image with the views or auto method: together_ made.
+  void startSegmentingTogether();
+  /// Every kept view's silhouette made anew from all of them and the hull carved again from
+  /// them (the surface points kept); whether the hull changed. A failure is logged.
+  bool segmentTogether();
+  void reportSegmentation(diagnostic_updater::DiagnosticStatusWrapper& status);
   void integrate(Posed& posed);
   /// Whether the view changed the hull; what the stream made of it in `outcome`.
   bool carve(const View& view, HullStream::Outcome* outcome);
@@ -179,6 +187,14 @@ class HullNode {
   tf2_ros::Buffer tf_buffer_;
   TfListener tf_listener_;
   PoseWait pose_wait_;
+  // ~from_image with the views or auto method (null otherwise): the photographs kept at the
+  // working size (worker).
+  std::unique_ptr<ViewSilhouetteSet> together_;
+  ros::Time newest_view_stamp_;  ///< of the views carved (worker)
+  std::atomic<uint64_t> segmentations_{0}, segmentations_failed_{0};
+  std::atomic<double> last_segmentation_ms_{0.0}, last_agreement_{0.0};
+  std::mutex segmentation_mutex_;  ///< guards last_segmentation_method_
+  std::string last_segmentation_method_;
   // Photo carving (null without ~photo_carve): the passes post their end to the worker.
   std::unique_ptr<PhotoStream> photo_;
   std::mutex photos_mutex_;  ///< guards photos_

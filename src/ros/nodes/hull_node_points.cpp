@@ -55,6 +55,11 @@ void HullNode::continueRefining() {
 
 void HullNode::refineIfDue() {
   refine_posted_ = false;
+  // The views that came since the last segmentation, once none waits: segmented with the rest.
+  if (together_ && work_.counts().waiting == 0 && together_->segmentDue(true) &&
+      segmentTogether()) {
+    publishPending();
+  }
   if (!hull_.refineDue()) return;
   try {
     const ros::WallTime start = ros::WallTime::now();
