@@ -12,7 +12,8 @@ namespace sift_hull {
 /// Silhouette extraction from images. Four methods:
 /// - "auto" (the default): for a calibrated set, the "views" method's silhouettes, or the
 ///   "background" method's where every view's border is plain (no GrabCut needed) and they agree
-///   across the views at least as well (silhouetteAgreement); for one image alone, "background".
+///   across the views as well, to within 0.01 (silhouetteAgreement); for one image alone,
+///   "background". The hull node segments its views together as they come (ViewSilhouetteSet).
 /// - "views", from all the views of a calibrated set together
 ///   (sift_hull/hull/view_silhouettes.h): a prior from the cameras' common frusta, GrabCut with
 ///   the image border as background, a coarse hull tolerant of a tenth of the views, its support

@@ -54,10 +54,9 @@ const SettingTable<SilhouetteConfig>& settingsOf<SilhouetteConfig>() {
     t.add("silhouette_method", &SilhouetteConfig::silhouette_method, "",
           "how a silhouette is taken from a photo: auto (views, or background where every "
           "view's border is plain and its silhouettes agree across the views as well, to within "
-          "0.01; "
-          "for one image alone, as the hull node has, background), views (all calibrated views "
-          "together: a prior from the cameras, GrabCut, a coarse hull), background (the "
-          "border's colours, one image) or threshold (grey level)")
+          "0.01), views (all calibrated views together: a prior from the cameras, GrabCut, a "
+          "coarse hull; the hull node segments its views together as they come), background "
+          "(the border's colours, one image) or threshold (grey level)")
         .oneOf({"auto", "views", "background", "threshold"});
     t.add("threshold", &SilhouetteConfig::threshold, "",
           "the threshold method: grey level in [0, 1] above which a pixel is the object")
