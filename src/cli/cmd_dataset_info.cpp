@@ -171,7 +171,9 @@ int runDatasetInfo(const std::vector<std::string>& args) {
                          {"image_size", {size.width, size.height}},
                          {"cameras", cameras},
                          {"common_point", commonPointJson(views, size)}};
-  if (found.ball_centre_W) info["silhouettes"] = viewSilhouettesJson(found);
+  if (found.ball_centre_W || !found.background_reason.empty()) {
+    info["silhouettes"] = viewSilhouettesJson(found);
+  }
   if (idr) info["idr_object_box"] = idrBoxJson(calib);
   printResult(parser.flag("json"), info, describe(info));
   return 0;

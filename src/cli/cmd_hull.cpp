@@ -227,7 +227,9 @@ int runHull(const std::vector<std::string>& args) {
   writeOutputs(parser, result, *octree);
   nlohmann::json json = hullJson(result, occupiedLeaves(*octree), iou);
   json.update(refined);
-  if (found.ball_centre_W) json["silhouettes"] = viewSilhouettesJson(found);
+  if (found.ball_centre_W || !found.background_reason.empty()) {
+    json["silhouettes"] = viewSilhouettesJson(found);
+  }
   json["warnings"] = poor.warnings();
   json["peak_memory_mib"] = {{"through_hull", hull_peak_mib}, {"total", peakMemoryMiB()}};
   printResult(parser.flag("json"), json, hullText(json));

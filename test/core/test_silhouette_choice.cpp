@@ -109,6 +109,36 @@ TEST(SilhouetteChoice, FloorWithShadowsTakesTheViewsMethod) {
   EXPECT_GT(chosen.mean_iou, 0.95);
 }
 
+TEST(SilhouetteChoice, WhereTheViewsMethodFailsEachViewKeepsItsOwnSilhouette) {
+  // Two views of a ring of 36, 40 degrees apart: their frusta share no bounded part, their
+  // silhouettes do.
+  SceneConfig config = scene("black", "none");
+  config.layout = "ring";
+  config.views = 36;
+  const std::string dir = test::temporaryDirectory();
+  std::vector<RenderedView> truth;
+  std::vector<CalibratedView> views;
+  for (const int v : {0, 4}) {
+    truth.push_back(renderSceneView(config, v));
+    cv::imwrite(dir + "/" + truth.back().view.name, truth.back().image);
+    views.push_back(truth.back().view);
+  }
+  ViewSilhouettes report;
+  const std::vector<cv::Mat> masks = loadSilhouettes(views, dir, "", SilhouetteConfig(), &report);
+  EXPECT_EQ(report.method, "background");
+  EXPECT_NE(report.background_reason.find("the views method failed"), std::string::npos)
+      << report.background_reason;
+  ASSERT_EQ(report.warnings.size(), 1u);
+  SilhouetteConfig background;
+  background.silhouette_method = "background";
+  for (size_t i = 0; i < truth.size(); ++i) {
+    EXPECT_EQ(cv::countNonZero(masks[i] != silhouetteFromImage(truth[i].image, background)), 0);
+  }
+  // Named, the views method fails as before.
+  SilhouetteConfig views_method;
+  views_method.silhouette_method = "views";
+  EXPECT_THROW(loadSilhouettes(views, dir, "", views_method), std::runtime_error);
+}
 
 TEST(SilhouetteChoice, ViewsArrivingOneAtATimeAreSegmentedTogetherAsTheSetGrows) {
   const std::vector<RenderedView> rendered = renderScene(scene("textured", "floor"));

@@ -158,7 +158,7 @@ std::vector<Kept> loadSilhouettesAs(const std::vector<CalibratedView>& views,
                                     const std::string& mask_directory,
                                     const SilhouetteConfig& recipe, const Keep& keep,
                                     ViewSilhouettes* report) {
-  const bool choose = recipe.silhouette_method == "auto";
+  bool choose = recipe.silhouette_method == "auto";
   const bool together = mask_directory.empty() && (choose || recipe.silhouette_method == "views") &&
                         views.size() >= 2;
   // Each view read and its silhouette made on OpenCV's threads, one image in memory per thread;
@@ -244,8 +244,26 @@ std::vector<Kept> loadSilhouettesAs(const std::vector<CalibratedView>& views,
     cameras.push_back(views[i].camera);
     names.push_back(views[i].name);
   }
-  ViewSilhouettes found =
-      silhouettesFromViews(working, cameras, names, loaded[0].image_size, recipe);
+  ViewSilhouettes found;
+  try {
+    found = silhouettesFromViews(working, cameras, names, loaded[0].image_size, recipe);
+  } catch (const std::runtime_error& e) {
+    if (!choose) throw;
+    // auto: each view's own silhouette by the background method, as for one image alone.
+    found = {};
+    found.method = "background";
+    found.background_reason = std::string("the views method failed: ") + e.what();
+    found.warnings.push_back(found.background_reason + "; each view's own silhouette is used");
+    SilhouetteConfig background = recipe;
+    background.silhouette_method = "background";
+    for (size_t i = 0; i < views.size(); ++i) {
+      found.masks.push_back(
+          !loaded[i].pending || !loaded[i].plain.empty()
+              ? loaded[i].plain
+              : silhouetteFromImage(loadViewImage(image_directory, views[i]), background));
+    }
+    choose = false;
+  }
   if (choose) {
     std::vector<cv::Mat> plain;
     for (Loaded& l : loaded) plain.push_back(l.pending ? std::move(l.plain) : cv::Mat());
