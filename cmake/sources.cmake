@@ -50,6 +50,7 @@ set(SIFT_HULL_CORE_SOURCES
   src/core/hull/run_length_mask.cpp
   src/core/hull/silhouette.cpp
   src/core/hull/view_prior.cpp
+  src/core/hull/plane_consistency.cpp
   src/core/hull/view_silhouettes.cpp
   src/core/hull/view_silhouette_set.cpp
   src/core/mvs/depth_maps.cpp

@@ -78,6 +78,11 @@ nlohmann::json viewSilhouettesJson(const ViewSilhouettes& report) {
   } else if (!report.background_reason.empty()) {
     json["agreement"]["background_skipped"] = report.background_reason;
   }
+  json["support_plane"] = nullptr;
+  if (report.support_plane_height) {
+    json["support_plane"] = {{"height", *report.support_plane_height},
+                             {"share", report.support_plane_share}};
+  }
   if (report.ball_centre_W) {
     const Eigen::Vector3d& c = *report.ball_centre_W;
     json["frusta_ball"] = {{"centre", {c.x(), c.y(), c.z()}}, {"radius", report.ball_radius}};

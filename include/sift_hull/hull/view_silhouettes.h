@@ -23,8 +23,13 @@ namespace sift_hull {
 ///     side, tolerating the disagreement of a tenth of the views; a support below the object (a
 ///     floor patch, a shadow, a turntable disc: a flat layer at the bottom, along the cameras' mean
 ///     up direction, much wider than what stands on it) is cut away.
-///  4. The hull projected back as the new prior; each view segmented again at the working size;
-///     the mask is that segmentation inside the hull's projection, upsampled to the image.
+///  4. The support plane, when the views agree on one around the object: a sweep along up over
+///     the lower half of the coarse hull for the height at which the most pixels outside the
+///     first masks match their nearest view through the plane's homography (7x7 NCC > 0.8).
+///  5. The hull projected back as the new prior; each view segmented again at the working size,
+///     what matches 4 neighbouring views through the support plane (floor, turntable, the
+///     object's shadow on them) certain background; the mask is that segmentation inside the
+///     hull's projection, upsampled to the image.
 struct ViewSilhouettes {
   std::vector<cv::Mat> masks;             ///< CV_8UC1 at each image's full size, 255 inside
   std::vector<cv::Mat> priors;            ///< working size: the ball's projection, 255 inside
@@ -36,6 +41,10 @@ struct ViewSilhouettes {
   double support_fraction = 0.0;
   double support_height = 0.0;
   Eigen::Vector3d up_W = Eigen::Vector3d::UnitZ();
+  /// The plane the object stands on, when the views agree on one (height along up_W, world
+  /// units), and the share of the probed pixels around the object that agree there.
+  std::optional<double> support_plane_height;
+  double support_plane_share = 0.0;
   /// silhouetteAgreement() of the masks.
   double agreement = 0.0;
   /// The "auto" method: the one whose silhouettes were used ("views" or "background"), and the

@@ -2,6 +2,7 @@
 
 #include "hull/view_prior.h"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <mutex>
@@ -101,7 +102,24 @@ Eigen::Vector3d meanUp(const std::vector<PinholeCamera>& cameras) {
     const double hand = camera.improper() ? -1.0 : 1.0;
     up -= hand * camera.R().row(1).transpose();
   }
-  return up.norm() > 1e-9 ? Eigen::Vector3d(up.normalized()) : Eigen::Vector3d::UnitZ();
+  if (!(up.norm() > 1e-9)) return Eigen::Vector3d::UnitZ();
+  up.normalize();
+  // Cameras held level (no roll) have horizontal image x axes: up is the direction most nearly
+  // orthogonal to all of them, when they span a plane (the smallest of the scatter's eigenvalues
+  // under a hundredth of the others'), with the mean's sign.
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (const PinholeCamera& camera : cameras) {
+    const Eigen::Vector3d x = camera.R().row(0).transpose();
+    scatter += x * x.transpose();
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(scatter);
+  const Eigen::Vector3d values = solver.eigenvalues();  // ascending
+  if (values(0) < 0.01 * values(1)) {
+    Eigen::Vector3d level = solver.eigenvectors().col(0);
+    if (level.dot(up) < 0.0) level = -level;
+    if (level.dot(up) > std::cos(20.0 * M_PI / 180.0)) return level;
+  }
+  return up;
 }
 
 void keepLargestPart(CoarseHull* hull) {

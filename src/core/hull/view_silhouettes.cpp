@@ -12,6 +12,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "hull/plane_consistency.h"
 #include "hull/silhouette_parts.h"
 #include "hull/view_prior.h"
 
@@ -48,6 +49,9 @@ std::vector<Eigen::Vector4d> frustumPlanes(const std::vector<PinholeCamera>& cam
   }
   return planes;
 }
+
+/// Views each view's pixels are compared with through the support plane.
+constexpr int kPlaneNeighbours = 4;
 
 /// The band along the image border, `fraction` of the smaller side, at least 2 pixels.
 cv::Mat borderBand(cv::Size size, double fraction) {
@@ -319,6 +323,17 @@ ViewSilhouettes silhouettesFromViews(const std::vector<cv::Mat>& images,
         std::to_string(tolerated) + " of the masks; give masks with --silhouettes");
   }
   result.up_W = view_prior::meanUp(cameras);
+  // The plane the object stands on, if the views see one around it: swept over the lower half of
+  // the coarse hull's height (which reaches below the floor: cameras above it cannot carve there).
+  double bottom = std::numeric_limits<double>::infinity(), top = -bottom;
+  for (const Eigen::Vector3d& c : hull.centres_W) {
+    bottom = std::min(bottom, result.up_W.dot(c));
+    top = std::max(top, result.up_W.dot(c));
+  }
+  const std::optional<double> plane =
+      view_prior::supportHeight(images, first, cameras, scale, result.up_W, bottom,
+                                0.5 * (bottom + top), hull.cell, &result.support_plane_share);
+  result.support_plane_height = plane;
   result.support_fraction = view_prior::cutSupport(result.up_W, &hull, &result.support_height);
 
   // 4. The hull's projection as the prior of a second cut at the working size; the mask is that
@@ -344,6 +359,12 @@ ViewSilhouettes silhouettesFromViews(const std::vector<cv::Mat>& images,
       cv::erode(projection, core, disc(margin));
       labels.setTo(cv::GC_FGD, core & earlier);
       labels.setTo(cv::GC_BGD, borderBand(size, 0.03) & ~projection);
+      // What lies on the support plane (floor, turntable, the object's shadow on them) is not
+      // the object, whatever its colour.
+      if (plane) {
+        labels.setTo(cv::GC_BGD, view_prior::onPlane(images, cameras, scale, static_cast<size_t>(v),
+                                                     result.up_W, *plane, kPlaneNeighbours));
+      }
       const cv::Mat mask = largeComponents(cut(images[v], labels, 2) & grown);
       agreement[v] = maskIou(mask, projection);
       cv::Mat full;
