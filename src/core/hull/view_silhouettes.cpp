@@ -101,6 +101,8 @@ cv::Mat cut(const cv::Mat& bgr, cv::Mat labels, int iterations) {
   const bool has_background = cv::countNonZero((labels == cv::GC_BGD) | (labels == cv::GC_PR_BGD));
   if (!has_foreground || !has_background) return (labels & 1) * 255;
   cv::Mat background_model, foreground_model;
+  // GrabCut's k-means draws from the thread's generator: seeded, the same masks every run.
+  cv::theRNG().state = 0x12345678;
   cv::grabCut(image, labels, cv::Rect(), background_model, foreground_model, iterations,
               cv::GC_INIT_WITH_MASK);
   return (labels & 1) * 255;  // GC_FGD = 1, GC_PR_FGD = 3
