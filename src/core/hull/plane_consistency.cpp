@@ -67,9 +67,9 @@ PlaneFrame frameOf(const Eigen::Vector3d& up, double height) {
   return {height * up, e1, up.cross(e1)};
 }
 
-/// The pixels of `here` whose patch agrees with `there` (another view, grey) carried by `h` (a
-/// pixel of here -> its pixel there).
-cv::Mat agreeing(const Patches& here, const cv::Mat& there, const Eigen::Matrix3d& h) {
+/// The NCC of each patch of `here` with `there` (another view, grey) carried by `h` (a pixel of
+/// here -> its pixel there), -1 where it is not judged (no texture, outside `there`).
+cv::Mat correlation(const Patches& here, const cv::Mat& there, const Eigen::Matrix3d& h) {
   // Texture to judge by, grey levels on [0, 1]: a shadow's texture is the floor's, darker.
   constexpr double kMinDeviation = 0.005;
   const cv::Size size = here.grey.size();
@@ -88,8 +88,15 @@ cv::Mat agreeing(const Patches& here, const cv::Mat& there, const Eigen::Matrix3
   cv::boxFilter(here.grey.mul(warped), product, CV_32F, cv::Size(kPlaneWindow, kPlaneWindow));
   cv::divide(product - here.mean.mul(other.mean),
              cv::max(here.deviation.mul(other.deviation), 1e-6), ncc);
-  return (ncc > kPlaneNcc) & (here.deviation > kMinDeviation) & (other.deviation > kMinDeviation) &
-         valid;
+  const cv::Mat judged =
+      (here.deviation > kMinDeviation) & (other.deviation > kMinDeviation) & valid;
+  ncc.setTo(-1.0, judged == 0);
+  return ncc;
+}
+
+/// The pixels of `here` whose patch agrees with `there` carried by `h`.
+cv::Mat agreeing(const Patches& here, const cv::Mat& there, const Eigen::Matrix3d& h) {
+  return correlation(here, there, h) > kPlaneNcc;
 }
 
 /// The `count` views nearest to view `v` in direction, among those above the plane.
@@ -119,14 +126,20 @@ std::optional<Eigen::Matrix3d> homography(const PinholeCamera& v, const PinholeC
 
 cv::Mat onPlane(const std::vector<cv::Mat>& images, const std::vector<PinholeCamera>& cameras,
                 const PixelScale& scale, size_t v, const Eigen::Vector3d& up, double height,
-                int neighbours) {
+                double above, int neighbours) {
   cv::Mat result = cv::Mat::zeros(images[v].size(), CV_8UC1);
   if (!(up.dot(cameras[v].centre()) > height)) return result;
-  const PlaneFrame plane = frameOf(up, height);
+  const PlaneFrame plane = frameOf(up, height), higher = frameOf(up, height + above);
   const Patches here = patchesOf(greyFloat(images[v]), kPlaneWindow);
   for (const size_t j : nearestAbove(cameras, v, up, height, static_cast<size_t>(neighbours))) {
     const auto h = homography(cameras[v], cameras[j], scale, plane);
-    if (h) result |= agreeing(here, greyFloat(images[j]), *h);
+    const auto h_higher = homography(cameras[v], cameras[j], scale, higher);
+    if (!h || !h_higher) continue;
+    const cv::Mat there = greyFloat(images[j]);
+    const cv::Mat ncc = correlation(here, there, *h);
+    // A point of the object just above the plane (its base) matches nearly as well: it is on
+    // the plane only where the plane matches better than one `above` higher.
+    result |= (ncc > kPlaneNcc) & (ncc > correlation(here, there, *h_higher));
   }
   return result;
 }

@@ -15,12 +15,13 @@ namespace sift_hull {
 namespace view_prior {
 
 /// The pixels of view `v` (working size) that lie on the plane {X : up . X = height}: each
-/// pixel's 7x7 grey patch, carried into the `neighbours` views nearest in direction that look at
-/// the plane from above by the homography the plane induces, matches there (NCC above
-/// kPlaneNcc, both patches textured). A textureless patch is not judged. 255 on the plane.
+/// pixel's 7x7 grey patch, carried into one of the `neighbours` views nearest in direction that
+/// look at the plane from above by the homography the plane induces, matches there (NCC above
+/// kPlaneNcc, both patches textured) better than through the plane `above` higher (what stands
+/// on the plane, near its base). A textureless patch is not judged. 255 on the plane.
 cv::Mat onPlane(const std::vector<cv::Mat>& images, const std::vector<PinholeCamera>& cameras,
                 const PixelScale& scale, size_t v, const Eigen::Vector3d& up, double height,
-                int neighbours);
+                double above, int neighbours);
 
 /// The height along `up` of a plane on which the views agree (a floor, a table, a turntable
 /// seen around the object), swept from `low` to `high` in `step`s: the height at which the most

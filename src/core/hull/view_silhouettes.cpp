@@ -364,8 +364,9 @@ ViewSilhouettes silhouettesFromViews(const std::vector<cv::Mat>& images,
       // What lies on the support plane (floor, turntable, the object's shadow on them) is not
       // the object, whatever its colour.
       if (plane) {
-        labels.setTo(cv::GC_BGD, view_prior::onPlane(images, cameras, scale, static_cast<size_t>(v),
-                                                     result.up_W, *plane, kPlaneNeighbours));
+        labels.setTo(cv::GC_BGD,
+                     view_prior::onPlane(images, cameras, scale, static_cast<size_t>(v),
+                                         result.up_W, *plane, hull.cell, kPlaneNeighbours));
       }
       const cv::Mat mask = largeComponents(cut(images[v], labels, 2) & grown);
       agreement[v] = maskIou(mask, projection);
