@@ -1,6 +1,7 @@
 #include "sift_hull/hull/silhouette.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -45,16 +46,6 @@ constexpr double kMinComponentShare = 0.05;
 int borderBand(cv::Size size, double fraction) {
   const int side = std::min(size.width, size.height);
   return std::min(std::max(2, static_cast<int>(fraction * side)), std::max(1, side / 2));
-}
-
-/// The image as CV_32FC3 CIE Lab (L in [0, 100]).
-cv::Mat labOf(const cv::Mat& image) {
-  cv::Mat bgr = image;
-  if (image.channels() == 1) cv::cvtColor(image, bgr, cv::COLOR_GRAY2BGR);
-  cv::Mat scaled, lab;
-  bgr.convertTo(scaled, CV_32FC3, 1.0 / 255.0);
-  cv::cvtColor(scaled, lab, cv::COLOR_BGR2Lab);
-  return lab;
 }
 
 /// Up to `most` Lab colours of the band of `width` pixels along the image border, evenly spaced.
@@ -183,6 +174,33 @@ cv::Mat backgroundSilhouette(const cv::Mat& image, const SilhouetteConfig& confi
 
 namespace silhouette_parts {
 
+cv::Mat labOf(const cv::Mat& image) {
+  cv::Mat bgr = image;
+  if (image.channels() == 1) cv::cvtColor(image, bgr, cv::COLOR_GRAY2BGR);
+  std::array<float, 256> linear;
+  for (int v = 0; v < 256; ++v) {
+    const double c = v / 255.0;
+    linear[static_cast<size_t>(v)] =
+        static_cast<float>(c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4));
+  }
+  const auto f = [](double t) { return t > 0.008856 ? std::cbrt(t) : 7.787 * t + 16.0 / 116.0; };
+  cv::Mat lab(bgr.size(), CV_32FC3);
+  for (int y = 0; y < bgr.rows; ++y) {
+    const cv::Vec3b* in = bgr.ptr<cv::Vec3b>(y);
+    cv::Vec3f* out = lab.ptr<cv::Vec3f>(y);
+    for (int x = 0; x < bgr.cols; ++x) {
+      const double b = linear[in[x][0]], g = linear[in[x][1]], r = linear[in[x][2]];
+      const double fx = f((0.412453 * r + 0.357580 * g + 0.180423 * b) / 0.950456);
+      const double fy = f(0.212671 * r + 0.715160 * g + 0.072169 * b);
+      const double fz = f((0.019334 * r + 0.119193 * g + 0.950227 * b) / 1.088754);
+      out[x] =
+          cv::Vec3f(static_cast<float>(116.0 * fy - 16.0), static_cast<float>(500.0 * (fx - fy)),
+                    static_cast<float>(200.0 * (fy - fz)));
+    }
+  }
+  return lab;
+}
+
 cv::Mat disc(int radius) {
   return cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * radius + 1, 2 * radius + 1));
 }
@@ -212,7 +230,7 @@ cv::Mat backgroundDistance(const cv::Mat& image, double border_fraction) {
   if (image.empty() || image.depth() != CV_8U || (image.channels() != 1 && image.channels() != 3)) {
     throw std::invalid_argument("backgroundDistance needs a non-empty 8-bit grey or BGR image");
   }
-  const cv::Mat lab = labOf(image);
+  const cv::Mat lab = silhouette_parts::labOf(image);
   const cv::Mat samples = borderSamples(lab, borderBand(lab.size(), border_fraction), 4000);
   const int clusters = std::min(8, samples.rows);
   cv::Mat labels, centres;

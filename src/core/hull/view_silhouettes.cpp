@@ -68,27 +68,15 @@ cv::Mat borderBand(cv::Size size, double fraction) {
 /// shadow (the floor's colour, darker) lies nearer the lit floor than another colour does.
 constexpr double kLightnessWeight = 0.35;
 cv::Mat cutColours(const cv::Mat& bgr) {
-  // CIE Lab (D65) computed here: OpenCV's conversion keeps lazily built tables that
-  // LeakSanitizer reports as leaked.
-  std::array<float, 256> linear;
-  for (int v = 0; v < 256; ++v) {
-    const double c = v / 255.0;
-    linear[static_cast<size_t>(v)] =
-        static_cast<float>(c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4));
-  }
-  const auto f = [](double t) { return t > 0.008856 ? std::cbrt(t) : 7.787 * t + 16.0 / 116.0; };
+  const cv::Mat lab = silhouette_parts::labOf(bgr);
   cv::Mat out(bgr.size(), CV_8UC3);
-  for (int y = 0; y < bgr.rows; ++y) {
-    for (int x = 0; x < bgr.cols; ++x) {
-      const cv::Vec3b p = bgr.at<cv::Vec3b>(y, x);
-      const double b = linear[p[0]], g = linear[p[1]], r = linear[p[2]];
-      const double fx = f((0.412453 * r + 0.357580 * g + 0.180423 * b) / 0.950456);
-      const double fy = f(0.212671 * r + 0.715160 * g + 0.072169 * b);
-      const double fz = f((0.019334 * r + 0.119193 * g + 0.950227 * b) / 1.088754);
-      out.at<cv::Vec3b>(y, x) =
-          cv::Vec3b(cv::saturate_cast<uint8_t>(2.55 * kLightnessWeight * (116.0 * fy - 16.0)),
-                    cv::saturate_cast<uint8_t>(500.0 * (fx - fy) + 128.0),
-                    cv::saturate_cast<uint8_t>(200.0 * (fy - fz) + 128.0));
+  for (int y = 0; y < lab.rows; ++y) {
+    const cv::Vec3f* in = lab.ptr<cv::Vec3f>(y);
+    cv::Vec3b* o = out.ptr<cv::Vec3b>(y);
+    for (int x = 0; x < lab.cols; ++x) {
+      o[x] = cv::Vec3b(cv::saturate_cast<uint8_t>(2.55 * kLightnessWeight * in[x][0]),
+                       cv::saturate_cast<uint8_t>(in[x][1] + 128.0),
+                       cv::saturate_cast<uint8_t>(in[x][2] + 128.0));
     }
   }
   return out;
