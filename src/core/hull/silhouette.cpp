@@ -149,20 +149,26 @@ cv::Mat grabCutSilhouette(const cv::Mat& bgr) {
   return mask;
 }
 
-cv::Mat backgroundSilhouette(const cv::Mat& image, const SilhouetteConfig& config) {
+/// The colour model's silhouette, cleaned, and the spread of the border's own distances it was
+/// judged by (`spread`).
+cv::Mat colourModelSilhouette(const cv::Mat& image, const SilhouetteConfig& config, float* spread) {
   const cv::Mat distance = backgroundDistance(image, kBorderFraction);
-  const float spread = borderSpread(distance, borderBand(image.size(), kBorderFraction));
-  const cv::Mat colour = distance > std::max(kMinObjectDistance, kSpreadFactor * spread);
+  *spread = borderSpread(distance, borderBand(image.size(), kBorderFraction));
+  return cleaned(distance > std::max(kMinObjectDistance, kSpreadFactor * *spread), config);
+}
+
+cv::Mat backgroundSilhouette(const cv::Mat& image, const SilhouetteConfig& config) {
+  float spread = 0.0f;
+  const cv::Mat prior = colourModelSilhouette(image, config, &spread);
   // A border its clusters describe to within a few Lab units (a uniform or few-coloured
   // background, camera noise) is all the model needs.
-  if (spread <= kMaxClusteredSpread) return cleaned(colour, config);
+  if (spread <= kMaxClusteredSpread) return prior;
   cv::Mat bgr = image;
   if (image.channels() == 1) cv::cvtColor(image, bgr, cv::COLOR_GRAY2BGR);
   cv::Mat mask = grabCutSilhouette(bgr);
   // The colour model keeps the dark parts of an object on a dark background, which the mixtures
   // may give to the background; it is added where it agrees with the cut (IoU > kMinAgreement),
   // not where it has taken a textured background for the object.
-  const cv::Mat prior = cleaned(colour, config);
   if (suspectReason(prior).empty()) {
     const double both = cv::countNonZero(mask & prior), either = cv::countNonZero(mask | prior);
     if (either > 0 && both / either > kMinAgreement) mask |= prior;
@@ -265,10 +271,9 @@ cv::Mat plainBackgroundSilhouette(const cv::Mat& image, const SilhouetteConfig& 
   if (image.empty() || image.depth() != CV_8U) {
     throw std::invalid_argument("plainBackgroundSilhouette needs a non-empty 8-bit image");
   }
-  const cv::Mat distance = backgroundDistance(image, kBorderFraction);
-  const float spread = borderSpread(distance, borderBand(image.size(), kBorderFraction));
-  if (spread > kMaxClusteredSpread) return cv::Mat();
-  return cleaned(distance > std::max(kMinObjectDistance, kSpreadFactor * spread), config);
+  float spread = 0.0f;
+  const cv::Mat mask = colourModelSilhouette(image, config, &spread);
+  return spread <= kMaxClusteredSpread ? mask : cv::Mat();
 }
 
 cv::Mat silhouetteFromImage(const cv::Mat& image, const SilhouetteConfig& config) {
