@@ -43,7 +43,7 @@ Patches patchesOf(const cv::Mat& grey_float, int window) {
   return p;
 }
 
-cv::Mat greyFloat(const cv::Mat& bgr) {
+cv::Mat greyOf(const cv::Mat& bgr) {
   cv::Mat grey, out;
   if (bgr.channels() == 3) {
     cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
@@ -124,18 +124,20 @@ std::optional<Eigen::Matrix3d> homography(const PinholeCamera& v, const PinholeC
 
 }  // namespace
 
-cv::Mat onPlane(const std::vector<cv::Mat>& images, const std::vector<PinholeCamera>& cameras,
+cv::Mat planeGrey(const cv::Mat& bgr) { return greyOf(bgr); }
+
+cv::Mat onPlane(const std::vector<cv::Mat>& greys, const std::vector<PinholeCamera>& cameras,
                 const PixelScale& scale, size_t v, const Eigen::Vector3d& up, double height,
                 double above, int neighbours) {
-  cv::Mat result = cv::Mat::zeros(images[v].size(), CV_8UC1);
+  cv::Mat result = cv::Mat::zeros(greys[v].size(), CV_8UC1);
   if (!(up.dot(cameras[v].centre()) > height)) return result;
   const PlaneFrame plane = frameOf(up, height), higher = frameOf(up, height + above);
-  const Patches here = patchesOf(greyFloat(images[v]), kPlaneWindow);
+  const Patches here = patchesOf(greys[v], kPlaneWindow);
   for (const size_t j : nearestAbove(cameras, v, up, height, static_cast<size_t>(neighbours))) {
     const auto h = homography(cameras[v], cameras[j], scale, plane);
     const auto h_higher = homography(cameras[v], cameras[j], scale, higher);
     if (!h || !h_higher) continue;
-    const cv::Mat there = greyFloat(images[j]);
+    const cv::Mat& there = greys[j];
     const cv::Mat ncc = correlation(here, there, *h);
     // A point of the object just above the plane (its base) matches nearly as well: it is on
     // the plane only where the plane matches better than one `above` higher.
@@ -159,7 +161,7 @@ std::optional<double> supportHeight(const std::vector<cv::Mat>& images,
   for (size_t v = 0; v < n; ++v) {
     cv::Mat small;
     cv::resize(images[v], small, cv::Size(), 0.5, 0.5, cv::INTER_AREA);
-    grey[v] = greyFloat(small);
+    grey[v] = greyOf(small);
     // What the floor is judged on: the image outside the object's first mask, grown.
     cv::Mat object;
     cv::resize(objects[v], object, small.size(), 0, 0, cv::INTER_NEAREST);

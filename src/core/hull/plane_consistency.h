@@ -19,7 +19,11 @@ namespace view_prior {
 /// look at the plane from above by the homography the plane induces, matches there (NCC above
 /// kPlaneNcc, both patches textured) better than through the plane `above` higher (what stands
 /// on the plane, near its base). A textureless patch is not judged. 255 on the plane.
-cv::Mat onPlane(const std::vector<cv::Mat>& images, const std::vector<PinholeCamera>& cameras,
+/// A working-size BGR image as onPlane compares it: grey, CV_32F on [0, 1].
+cv::Mat planeGrey(const cv::Mat& bgr);
+
+/// (`greys`: planeGrey of every view, made once for the set.)
+cv::Mat onPlane(const std::vector<cv::Mat>& greys, const std::vector<PinholeCamera>& cameras,
                 const PixelScale& scale, size_t v, const Eigen::Vector3d& up, double height,
                 double above, int neighbours);
 

@@ -333,6 +333,10 @@ ViewSilhouettes silhouettesFromViews(const std::vector<cv::Mat>& images,
   result.hull_projections.resize(n);
   result.masks.resize(n);
   std::vector<double> agreement(n, 1.0);
+  std::vector<cv::Mat> greys;  // what the support plane is judged on, each view's made once
+  if (plane) {
+    for (const cv::Mat& image : images) greys.push_back(view_prior::planeGrey(image));
+  }
   cv::parallel_for_(cv::Range(0, static_cast<int>(n)), [&](const cv::Range& range) {
     for (int v = range.start; v < range.end; ++v) {
       const cv::Mat projection = view_prior::project(hull, cameras[v], scale, size);
@@ -353,8 +357,8 @@ ViewSilhouettes silhouettesFromViews(const std::vector<cv::Mat>& images,
       // the object, whatever its colour.
       if (plane) {
         labels.setTo(cv::GC_BGD,
-                     view_prior::onPlane(images, cameras, scale, static_cast<size_t>(v),
-                                         result.up_W, *plane, hull.cell, kPlaneNeighbours));
+                     view_prior::onPlane(greys, cameras, scale, static_cast<size_t>(v), result.up_W,
+                                         *plane, hull.cell, kPlaneNeighbours));
       }
       const cv::Mat mask = largeComponents(cut(images[v], labels, 2) & grown);
       agreement[v] = maskIou(mask, projection);
