@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer harnesses of test/fuzz/ (test/sanitize/CMakeLists.txt, target `fuzzers`,
 # with AddressSanitizer and UndefinedBehaviorSanitizer, in the git-ignored .sanitize_build/) and
-# runs each for SECONDS.
+# runs each for SECONDS, FUZZ_PARALLEL (2) at a time.
 #
 #   scripts/fuzz.sh [SECONDS [RESULTS_DIR]]   (defaults: 30, .sanitize_build/fuzz_results)
 #
@@ -18,6 +18,7 @@
 #
 # Environment:
 #   FUZZ_HARNESSES    the harnesses to run (default: all of them), space-separated
+#   FUZZ_PARALLEL     harnesses run at once (default 2; their output lines interleave)
 #   FUZZ_KEEP_GOING   1: run libFuzzer in fork mode (-fork=1 -ignore_crashes=1 -ignore_timeouts=1
 #                     -ignore_ooms=1), collecting every distinct finding within SECONDS instead
 #                     of stopping at the first (default 0)
@@ -27,6 +28,8 @@ set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/sanitize_common.sh"
 
 seconds="${1:-30}"
+parallel="${FUZZ_PARALLEL:-2}"
+[[ "$parallel" =~ ^[1-9][0-9]*$ ]] || { echo "fuzz: FUZZ_PARALLEL must be a positive number" >&2; exit 2; }
 [[ "$seconds" =~ ^[1-9][0-9]*$ ]] || { echo "usage: scripts/fuzz.sh [SECONDS [RESULTS_DIR]]" >&2; exit 2; }
 results="$(realpath -m "${2:-$sanitize_build/fuzz_results}")"
 mkdir -p "$results"
@@ -55,7 +58,10 @@ export LSAN_OPTIONS="suppressions=$repo_root/test/sanitize/lsan.supp:print_suppr
 mode=()
 [[ "${FUZZ_KEEP_GOING:-0}" == 1 ]] && mode=(-fork=1 -ignore_crashes=1 -ignore_timeouts=1 -ignore_ooms=1)
 
-for harness in "${harnesses[@]}"; do
+# One harness: its run, its findings and its JUnit case.
+fuzz_one() {
+  local harness="$1" seeds corpus artifacts log tmp start rc took saved input base runs pattern
+  local report message tail_log replayed line
   seeds="$repo_root/test/fuzz/corpus/$harness"
   corpus="$work/corpus/$harness"
   artifacts="$work/artifacts/$harness"
@@ -88,7 +94,7 @@ for harness in "${harnesses[@]}"; do
     runs="$(grep -oE '^(stat::number_of_executed_units: *[0-9]+|#[0-9]+:)' "$log" | tail -n 1 |
       grep -oE '[0-9]+' || echo '?')"
     echo "fuzz: $harness passed ($runs inputs in ${took} s)"
-    continue
+    return 0
   fi
   pattern='^(SUMMARY: |==[0-9]+== ?ERROR: )|runtime error:|out-of-memory|ALARM'
   report="$(grep -m1 -E "$pattern" "$log" || true)"
@@ -116,5 +122,17 @@ for harness in "${harnesses[@]}"; do
   "${junit[@]}" case "$results/fuzz-$harness.xml" fuzz "$harness" --failure "$message" \
     --log "$tail_log" --tail 60 --time "$took"
   echo "fuzz: $harness FAILED${report:+: $report}"
+}
+
+# FUZZ_PARALLEL harnesses at a time (each libFuzzer process uses one core).
+running=0
+for harness in "${harnesses[@]}"; do
+  if [[ $running -ge $parallel ]]; then
+    wait -n || true
+    running=$((running - 1))
+  fi
+  fuzz_one "$harness" &
+  running=$((running + 1))
 done
+wait || true
 /usr/bin/python3 "$repo_root/scripts/count_tests.py" "$results"

@@ -12,9 +12,8 @@ cv::Mat disc(int radius);
 /// The components of a mask (8-connected) holding at least 5 % of the largest one's area.
 cv::Mat largeComponents(const cv::Mat& mask);
 
-/// An 8-bit grey or BGR image (sRGB) as CV_32FC3 CIE Lab (D65; L in [0, 100]), as OpenCV's
-/// COLOR_BGR2Lab gives it, computed here: OpenCV's conversion keeps lazily built tables that
-/// LeakSanitizer reports as leaked.
+/// An 8-bit grey or BGR image (sRGB) as CV_32FC3 CIE Lab (D65; L in [0, 100]): OpenCV's
+/// COLOR_BGR2Lab of the image scaled to [0, 1].
 cv::Mat labOf(const cv::Mat& image);
 
 }  // namespace silhouette_parts
