@@ -48,8 +48,12 @@ const SettingTable<SilhouetteConfig>& settingsOf<SilhouetteConfig>();
 void validate(const SilhouetteConfig& config);
 
 /// Mask (CV_8UC1, 255 inside, 0 outside) of the object in an 8-bit grey or BGR image, by the
-/// config's method ("auto" and "views" need the other views: "background" here).
-cv::Mat silhouetteFromImage(const cv::Mat& image, const SilhouetteConfig& config);
+/// config's method ("auto" and "views" need the other views: "background" here). `plain_border`,
+/// when given, is set to whether the background method found the border plain (its colour
+/// clusters describe it, so the mask is plainBackgroundSilhouette's, with no GrabCut); false for
+/// the threshold method.
+cv::Mat silhouetteFromImage(const cv::Mat& image, const SilhouetteConfig& config,
+                            bool* plain_border = nullptr);
 
 /// The "background" method's silhouette when the image's border is plain (its colour clusters
 /// describe it, so no GrabCut is needed); an empty Mat when the border is textured.

@@ -160,20 +160,35 @@ cv::Mat grabCutSilhouette(const cv::Mat& bgr) {
   return mask;
 }
 
-/// The colour model's silhouette, cleaned, and the spread of the border's own distances it was
-/// judged by (`spread`).
-cv::Mat colourModelSilhouette(const cv::Mat& image, const SilhouetteConfig& config, float* spread) {
-  const cv::Mat distance = backgroundDistance(image, kBorderFraction);
-  *spread = borderSpread(distance, borderBand(image.size(), kBorderFraction));
-  return cleaned(distance > std::max(kMinObjectDistance, kSpreadFactor * *spread), config);
+/// The colour model's distances (backgroundDistance) and the spread of the border band's own
+/// distances, by which the border is judged plain (<= kMaxClusteredSpread) or textured.
+struct ColourModel {
+  cv::Mat distance;
+  float spread = 0.0f;
+  bool plainBorder() const { return spread <= kMaxClusteredSpread; }
+};
+
+ColourModel colourModelOf(const cv::Mat& image) {
+  ColourModel model;
+  model.distance = backgroundDistance(image, kBorderFraction);
+  model.spread = borderSpread(model.distance, borderBand(image.size(), kBorderFraction));
+  return model;
 }
 
-cv::Mat backgroundSilhouette(const cv::Mat& image, const SilhouetteConfig& config) {
-  float spread = 0.0f;
-  const cv::Mat prior = colourModelSilhouette(image, config, &spread);
+/// The colour model's silhouette, cleaned.
+cv::Mat colourModelSilhouette(const ColourModel& model, const SilhouetteConfig& config) {
+  return cleaned(model.distance > std::max(kMinObjectDistance, kSpreadFactor * model.spread),
+                 config);
+}
+
+cv::Mat backgroundSilhouette(const cv::Mat& image, const SilhouetteConfig& config,
+                             bool* plain_border) {
+  const ColourModel model = colourModelOf(image);
+  const cv::Mat prior = colourModelSilhouette(model, config);
+  if (plain_border != nullptr) *plain_border = model.plainBorder();
   // A border its clusters describe to within a few Lab units (a uniform or few-coloured
   // background, camera noise) is all the model needs.
-  if (spread <= kMaxClusteredSpread) return prior;
+  if (model.plainBorder()) return prior;
   cv::Mat bgr = image;
   if (image.channels() == 1) cv::cvtColor(image, bgr, cv::COLOR_GRAY2BGR);
   cv::Mat mask = grabCutSilhouette(bgr);
@@ -284,17 +299,18 @@ cv::Mat plainBackgroundSilhouette(const cv::Mat& image, const SilhouetteConfig& 
   if (image.empty() || image.depth() != CV_8U) {
     throw std::invalid_argument("plainBackgroundSilhouette needs a non-empty 8-bit image");
   }
-  float spread = 0.0f;
-  const cv::Mat mask = colourModelSilhouette(image, config, &spread);
-  return spread <= kMaxClusteredSpread ? mask : cv::Mat();
+  const ColourModel model = colourModelOf(image);
+  return model.plainBorder() ? colourModelSilhouette(model, config) : cv::Mat();
 }
 
-cv::Mat silhouetteFromImage(const cv::Mat& image, const SilhouetteConfig& config) {
+cv::Mat silhouetteFromImage(const cv::Mat& image, const SilhouetteConfig& config,
+                            bool* plain_border) {
   validate(config);
   if (image.empty() || image.depth() != CV_8U) {
     throw std::invalid_argument("silhouetteFromImage needs a non-empty 8-bit image");
   }
-  return config.silhouette_method != "threshold" ? backgroundSilhouette(image, config)
+  if (plain_border != nullptr) *plain_border = false;
+  return config.silhouette_method != "threshold" ? backgroundSilhouette(image, config, plain_border)
                                                  : thresholdSilhouette(image, config);
 }
 

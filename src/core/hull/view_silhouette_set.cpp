@@ -28,10 +28,9 @@ cv::Mat ViewSilhouetteSet::add(const std::string& name, const cv::Mat& image,
   SilhouetteConfig background = config_;
   background.silhouette_method = "background";
   // The plain border's colour model when it applies (auto's candidate), else the background
-  // method with its GrabCut.
-  cv::Mat mask = plainBackgroundSilhouette(image, background);
-  const bool plain = !mask.empty();
-  if (!plain) mask = silhouetteFromImage(image, background);
+  // method with its GrabCut; one colour model either way.
+  bool plain = false;
+  cv::Mat mask = silhouetteFromImage(image, background, &plain);
   if (views_.size() >= max_views_) {
     ++not_kept_;
     return mask;
