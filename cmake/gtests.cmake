@@ -48,6 +48,7 @@ set(SIFT_HULL_CORE_GTESTS
   test_refine_command eval
   test_pair_pipeline eval
   test_reduced_distance eval
+  test_reduced_input eval
   test_hull_data eval
   test_hull_stream eval
   test_hull_stream_refusals eval

@@ -77,6 +77,8 @@ set(SIFT_HULL_IO_SOURCES
   src/core/io/npz.cpp
   src/core/io/pfm.cpp
   src/core/io/ply.cpp
+  src/core/io/reduced_images.cpp
+  src/core/io/reduced_view_set.cpp
   src/core/io/view_list.cpp
   src/core/io/view_orientation.cpp
 )

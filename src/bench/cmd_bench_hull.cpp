@@ -14,6 +14,7 @@
 
 #include "args.h"
 #include "bench_commands.h"
+#include "bench_hull_end_to_end.h"
 #include "bench_hull_synthetic.h"
 #include "bench_measure.h"
 #include "bench_report.h"
@@ -301,7 +302,8 @@ std::string markdownReport(const std::vector<DatasetRuns>& all,
 }
 
 int reportBench(const ArgParser& parser, const std::vector<DatasetRuns>& all,
-                const std::optional<SyntheticHullBench>& synthetic) {
+                const std::optional<SyntheticHullBench>& synthetic,
+                const std::optional<EndToEndBench>& end_to_end) {
   nlohmann::json json = {{"datasets", nlohmann::json::array()},
                          {"measurements", measurementsJson(all)},
                          {"cpu", cpuModel()}};
@@ -327,6 +329,14 @@ int reportBench(const ArgParser& parser, const std::vector<DatasetRuns>& all,
       replaceMarkedSection(parser.get("write"), "bench-hull-synthetic", synthetic_report);
     }
     report += (report.empty() ? "" : "\n") + synthetic_report;
+  }
+  if (end_to_end) {
+    json["end_to_end"] = endToEndJson(*end_to_end);
+    const std::string end_to_end_report = endToEndMarkdown(*end_to_end);
+    if (parser.has("write")) {
+      replaceMarkedSection(parser.get("write"), "bench-hull-end-to-end", end_to_end_report);
+    }
+    report += (report.empty() ? "" : "\n") + end_to_end_report;
   }
   printResult(parser.flag("json"), json, report);
   return 0;
@@ -368,17 +378,35 @@ int runBenchHull(const std::vector<std::string>& args) {
   parser.addOption("synthetic-size", "WxH", "image size of the synthetic case",
                    std::to_string(SyntheticHullCase().width_px) + "x" +
                        std::to_string(SyntheticHullCase().height_px));
+  parser.addFlag("end-to-end-only",
+                 "run only the end-to-end case (whole hull processes on 120 JPEG masks of "
+                 "4000x3000)");
+  parser.addFlag("skip-end-to-end", "leave the end-to-end case out");
+  addEndToEndOptions(&parser);
   if (!parser.parse(args)) return 0;
   if (parser.flag("synthetic-only") && parser.flag("skip-synthetic")) {
     throw UsageError("--synthetic-only and --skip-synthetic exclude each other");
+  }
+  if (parser.flag("end-to-end-only") && parser.flag("skip-end-to-end")) {
+    throw UsageError("--end-to-end-only and --skip-end-to-end exclude each other");
+  }
+  if (parser.flag("end-to-end-only") && parser.flag("synthetic-only")) {
+    throw UsageError("--end-to-end-only and --synthetic-only exclude each other");
+  }
+  const bool only_end_to_end = parser.flag("end-to-end-only");
+  std::optional<EndToEndBench> end_to_end;
+  if (!parser.flag("skip-end-to-end") && !parser.flag("synthetic-only")) {
+    end_to_end = benchEndToEndHull(endToEndCaseFromArgs(parser));
   }
   const std::string root = parser.has("data") ? parser.get("data") : defaultDataRoot();
 
   std::vector<DatasetRuns> all;
   std::optional<SyntheticHullBench> synthetic;
-  if (!parser.flag("skip-synthetic")) synthetic = benchSyntheticHull(syntheticCase(parser));
+  if (!parser.flag("skip-synthetic") && !only_end_to_end) {
+    synthetic = benchSyntheticHull(syntheticCase(parser));
+  }
   for (const HullDataset& dataset : hullDatasets()) {
-    if (parser.flag("synthetic-only")) break;
+    if (parser.flag("synthetic-only") || only_end_to_end) break;
     const std::string directory = root + "/" + dataset.directory;
     if (root.empty() || !std::filesystem::exists(directory)) {
       std::cerr << "bench-hull: skipping " << dataset.name << ": no " << directory << '\n';
@@ -391,7 +419,7 @@ int runBenchHull(const std::vector<std::string>& args) {
     all.back().refinement = refinementAtDepth8(directory, dataset);
     all.back().photo_carving = photoCarvingAtDepth8(directory, dataset);
   }
-  return reportBench(parser, all, synthetic);
+  return reportBench(parser, all, synthetic, end_to_end);
 }
 
 }  // namespace cli

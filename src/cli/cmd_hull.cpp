@@ -1,5 +1,8 @@
 #include <octomap/OcTree.h>
+#include <unistd.h>
 
+#include <chrono>
+#include <iomanip>
 #include <iostream>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
@@ -78,6 +81,28 @@ class PoorResults {
  private:
   bool allow_;
   std::vector<std::string> warnings_;
+};
+
+/// The stage a run has reached, on stderr when it is a terminal and the result is not JSON: one
+/// line rewritten in place, with the seconds since the start; cleared at the end.
+class Progress {
+ public:
+  explicit Progress(bool wanted) : shown_(wanted && isatty(STDERR_FILENO) == 1) {}
+  void stage(const std::string& text) {
+    if (!shown_) return;
+    const double seconds = std::chrono::duration<double>(Clock::now() - start_).count();
+    std::ostringstream line;
+    line << "sift_hull hull: " << std::fixed << std::setprecision(1) << seconds << " s, " << text;
+    std::cerr << "\r\033[K" << line.str() << std::flush;
+  }
+  void done() {
+    if (shown_) std::cerr << "\r\033[K" << std::flush;
+  }
+
+ private:
+  using Clock = std::chrono::steady_clock;
+  bool shown_;
+  Clock::time_point start_ = Clock::now();
 };
 
 /// Largest box edge over the cameras' mutual distance (largest distance between two centres).
@@ -162,6 +187,7 @@ int runHull(const std::vector<std::string>& args) {
                    "octree carving with signed distances, marching cubes.");
   addViewSetOptions(&parser);
   addHullOptions(&parser);
+  addInputReductionOption(&parser);
   parser.addOption("out-mesh", "PLY",
                    "write the mesh (binary PLY, world coordinates; with --images, each vertex "
                    "coloured by the views that see it)");
@@ -190,17 +216,24 @@ int runHull(const std::vector<std::string>& args) {
     throw UsageError("--out-color-octree needs --images");
   }
   PoorResults poor(parser.flag("allow-poor"));
+  Progress progress(!parser.flag("json"));
   ViewSilhouettes found;
-  HullInput input = runLengthViewSetFromArgs(parser, &found);
-  writeSilhouettesFromArgs(parser, input.names, [&](size_t i) { return input.mask(i); });
+  const std::optional<Box3d> box = boxFromArgs(parser);
+  const int max_reduction = maxInputReductionFromArgs(parser);
+  progress.stage("reading the views");
+  HullInput input = max_reduction > 1 ? reducedViewSetFromArgs(parser, config, box, max_reduction)
+                                      : runLengthViewSetFromArgs(parser, &found);
+  progress.stage("read " + std::to_string(input.viewCount()) + " views");
+  writeSilhouettesFromArgs(parser, input.names, [&](size_t i) { return fullSizeMask(input, i); });
   writeViewPriorsFromArgs(parser, input.names, found);
   for (const std::string& warning : found.warnings) poor.warn(warning);
   const std::optional<HeldOutView> held_out = holdOutView(parser, &input);
   for (const std::string& warning :
        runLengthSilhouetteWarnings(input.names, input.run_length_masks))
     poor.warn(warning);
-  const std::optional<Box3d> box = boxFromArgs(parser);
   if (box) checkBox(*box, input, &poor);
+  progress.stage("carving the octree to depth " + std::to_string(config.max_depth) +
+                 " and meshing");
   HullResult result = buildHull(input, config, box);
   if ((parser.flag("refine-with-matches") || parser.flag("photo-carve")) &&
       parser.has("out-render")) {
@@ -219,19 +252,22 @@ int runHull(const std::vector<std::string>& args) {
   }
   const double hull_peak_mib = peakMemoryMiB();
   const std::unique_ptr<octomap::OcTree> octree = toOctomap(result.hull);
-  const ReprojectionIoU iou = reprojectionIoU(result.mesh, result.hull.views());
+  progress.stage("checking the mesh against every view");
+  const ReprojectionIoU iou = reprojectionIoU(result.mesh, result.hull.views(), threads);
   for (const std::string& warning : disagreeingViewWarnings(input.names, iou.per_view)) {
     poor.warn(warning);
   }
   checkResult(result, iou, &poor);
   writeOutputs(parser, result, *octree);
   nlohmann::json json = hullJson(result, occupiedLeaves(*octree), iou);
+  json["input_reduction"] = inputReductionJson(input);
   json.update(refined);
   if (found.ball_centre_W || !found.background_reason.empty()) {
     json["silhouettes"] = viewSilhouettesJson(found);
   }
   json["warnings"] = poor.warnings();
   json["peak_memory_mib"] = {{"through_hull", hull_peak_mib}, {"total", peakMemoryMiB()}};
+  progress.done();
   printResult(parser.flag("json"), json, hullText(json));
   return 0;
 }

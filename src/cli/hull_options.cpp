@@ -1,6 +1,7 @@
 #include "hull_options.h"
 
 #include <algorithm>
+#include <opencv2/imgproc.hpp>
 #include <sstream>
 #include <stdexcept>
 
@@ -10,6 +11,7 @@
 #include "sift_hull/hull/hull_pipeline.h"
 #include "sift_hull/hull/hull_stream.h"
 #include "sift_hull/hull/silhouette.h"
+#include "sift_hull/io/reduced_images.h"
 #include "sift_hull/io/view_list.h"
 #include "silhouette_options.h"
 
@@ -68,6 +70,53 @@ HullInput runLengthViewSetFromArgs(const ArgParser& parser, ViewSilhouettes* rep
   return loadRunLengthHullInput(parser.get("calib"), parser.get("images"), masks,
                                 silhouetteConfigFromArgs(parser), viewNamesFromArgs(parser),
                                 report);
+}
+
+void addInputReductionOption(ArgParser* parser) {
+  parser->addOption("max-input-reduction", "N",
+                    "largest reduction (1, 2, 4 or 8) at which mask files (--silhouettes) are "
+                    "decoded, each view's following from its finest voxel's footprint; 1: full "
+                    "resolution",
+                    "8");
+}
+
+int maxInputReductionFromArgs(const ArgParser& parser) {
+  const int most = parser.getInt("max-input-reduction");
+  if (!isDecodableReduction(most)) {
+    throw UsageError("--max-input-reduction must be 1, 2, 4 or 8, not " + std::to_string(most));
+  }
+  const bool photographs = parser.flag("refine-with-matches") || parser.flag("photo-carve") ||
+                           parser.has("holdout-view");
+  return photographs || !parser.has("silhouettes") ? 1 : most;
+}
+
+HullInput reducedViewSetFromArgs(const ArgParser& parser, const HullConfig& config,
+                                 const std::optional<Box3d>& box, int max_reduction) {
+  return loadReducedHullInput(parser.get("calib"), parser.get("images"), parser.get("silhouettes"),
+                              viewNamesFromArgs(parser), config, box, max_reduction);
+}
+
+cv::Mat fullSizeMask(const HullInput& input, size_t view) {
+  const cv::Mat mask = input.mask(view);
+  const int reduction = input.reduction(view);
+  if (reduction == 1) return mask;
+  cv::Mat enlarged;
+  cv::resize(mask, enlarged, cv::Size(mask.cols * reduction, mask.rows * reduction), 0.0, 0.0,
+             cv::INTER_LINEAR);
+  return enlarged(cv::Rect(cv::Point(0, 0), input.image_sizes.at(view))) > 127;
+}
+
+nlohmann::json inputReductionJson(const HullInput& input) {
+  int smallest = 1, largest = 1;
+  if (!input.reductions.empty()) {
+    smallest = *std::min_element(input.reductions.begin(), input.reductions.end());
+    largest = *std::max_element(input.reductions.begin(), input.reductions.end());
+  }
+  nlohmann::json json = {{"min", smallest}, {"max", largest}};
+  if (!input.image_sizes.empty()) {
+    json["image_size"] = {input.image_sizes.front().width, input.image_sizes.front().height};
+  }
+  return json;
 }
 
 void addHullOptions(ArgParser* parser) {

@@ -22,6 +22,22 @@ HullInput viewSetFromArgs(const ArgParser& parser);
 /// The same views with their silhouettes run-length encoded (HullInput::run_length_masks).
 HullInput runLengthViewSetFromArgs(const ArgParser& parser, ViewSilhouettes* report = nullptr);
 
+/// --max-input-reduction: the largest reduction (1, 2, 4 or 8) at which `hull` decodes mask
+/// files, each view's following from its finest voxel's footprint (loadReducedHullInput).
+void addInputReductionOption(ArgParser* parser);
+/// Its value; 1 (full resolution) without --silhouettes, and with --refine-with-matches,
+/// --photo-carve or --holdout-view, which use the photographs at full resolution.
+int maxInputReductionFromArgs(const ArgParser& parser);
+/// The views with their masks decoded at the reductions their footprints allow, up to
+/// `max_reduction` (loadReducedHullInput; `box` is --box when given).
+HullInput reducedViewSetFromArgs(const ArgParser& parser, const HullConfig& config,
+                                 const std::optional<Box3d>& box, int max_reduction);
+/// View `view`'s mask at its image's full size: a reduced mask enlarged (its outline
+/// interpolated), else the mask itself.
+cv::Mat fullSizeMask(const HullInput& input, size_t view);
+/// {"min", "max"} of the views' input reductions, and "image_size" [width, height] of the first.
+nlohmann::json inputReductionJson(const HullInput& input);
+
 /// --max-depth, --carve-outside-image, --distance-slack-px, --distance-reduction, --threads, with
 /// HullConfig's defaults.
 void addHullOptions(ArgParser* parser);

@@ -16,6 +16,7 @@
 #include "sift_hull/filters/filter.h"
 #include "sift_hull/io/images.h"
 #include "sift_hull/io/ply.h"
+#include "sift_hull/io/reduced_images.h"
 #include "sift_hull/mvs/mesh_colour.h"
 #include "sift_hull/mvs/photo_carving.h"
 #include "sift_hull/pipeline/match_refinement.h"
@@ -95,7 +96,7 @@ RefineViews refineViews(const std::string& folder, const HullInput& input) {
   RefineViews views;
   views.cameras = input.cameras;
   views.image = [folder, &input](uint32_t view) {
-    return readImage(folder + "/" + input.names.at(view));
+    return readImageReduced(folder + "/" + input.names.at(view), input.reduction(view));
   };
   views.mask = [&input](uint32_t view) { return input.mask(view); };
   return views;

@@ -17,7 +17,10 @@ struct ReprojectionIoU {
   std::vector<double> per_view;
   double min = 0.0, mean = 0.0;
 };
-ReprojectionIoU reprojectionIoU(const TriangleMesh& mesh, const std::vector<HullView>& views);
+/// Each view at its mask's resolution (a reduced input's views at their reduction), on `threads`
+/// threads.
+ReprojectionIoU reprojectionIoU(const TriangleMesh& mesh, const std::vector<HullView>& views,
+                                int threads = 1);
 
 /// Dense voxel carving, the brute-force reference: a voxel is occupied when every view keeps its
 /// centre (HullView::keeps).

@@ -55,6 +55,11 @@ class PinholeCamera {
   PinholeCamera negated() const;
   /// True when det R = -1: the camera lives in a mirrored (left-handed) world frame.
   bool improper() const { return R_.determinant() < 0.0; }
+  /// The same camera for its image reduced `factor` times on each side, as libjpeg's scaled
+  /// decoding and cv::resize with INTER_AREA reduce it: reduced pixel u' covers full pixels
+  /// factor * u' .. factor * u' + factor - 1, so u' = (u + 0.5) / factor - 0.5. R, t and the
+  /// distortion are kept. Throws std::invalid_argument for a factor below 1.
+  PinholeCamera reduced(int factor) const;
   /// The same camera with this lens distortion. Throws std::invalid_argument for a non-finite
   /// coefficient.
   PinholeCamera withDistortion(const LensDistortion& distortion) const;

@@ -21,6 +21,13 @@ struct HullInput {
   /// The silhouettes run-length encoded, used when `masks` is empty (loadHullInput gives these,
   /// so that no full-resolution mask stays in memory).
   std::vector<RunLengthMask> run_length_masks;
+  /// Reduced loading (loadReducedHullInput): each view's reduction (its mask and camera are those
+  /// of its image reduced so many times) and its image's full size. Empty: every view at full
+  /// resolution, its image the size of its mask.
+  std::vector<int> reductions;
+  std::vector<cv::Size> image_sizes;
+  /// View `view`'s reduction (1 without reduced loading).
+  int reduction(size_t view) const { return reductions.empty() ? 1 : reductions.at(view); }
 
   /// Number of views: of `masks`, else of `run_length_masks`.
   size_t viewCount() const { return masks.empty() ? run_length_masks.size() : masks.size(); }

@@ -42,7 +42,8 @@ ViewImage loadViewImageWithAlpha(const std::string& directory, const CalibratedV
 /// then reports missing.
 std::string maskPath(const std::string& mask_directory, const std::string& image_name);
 
-/// Reads a mask file: any non-zero pixel is inside. Returns CV_8UC1 with 255 inside.
+/// Reads a mask file: inside where the value exceeds half the file's largest (maskInside: any
+/// non-zero pixel of a 0/1 or 0/255 mask, not a JPEG's ringing). Returns CV_8UC1 with 255 inside.
 /// Throws std::runtime_error naming the file when it is missing or unreadable.
 cv::Mat loadMask(const std::string& path);
 

@@ -1,16 +1,25 @@
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "sift_hull/hull/hull_pipeline.h"
 #include "sift_hull/hull/silhouette.h"
 #include "sift_hull/hull/view_silhouettes.h"
+#include "sift_hull/io/calibration.h"
 
 namespace sift_hull {
 
 /// Image names listed in a file, one per line; blank lines and '#' comments skipped.
 std::vector<std::string> readViewList(const std::string& path);
+
+/// The views of a calibration file named in `view_names` (all when empty), in the file's order,
+/// read by readCalibrationWithImages(calibration_path, image_directory). Throws
+/// std::runtime_error for a name that the calibration does not hold.
+std::vector<CalibratedView> hullViews(const std::string& calibration_path,
+                                      const std::string& image_directory,
+                                      const std::vector<std::string>& view_names);
 
 /// The views of a calibration file named in `view_names` (all when empty), in the file's order,
 /// with silhouettes as loadSilhouettes() finds them. Throws std::runtime_error for a name that the
@@ -29,5 +38,21 @@ HullInput loadRunLengthHullInput(const std::string& calibration_path,
                                  const std::string& mask_directory, const SilhouetteConfig& recipe,
                                  const std::vector<std::string>& view_names,
                                  ViewSilhouettes* report = nullptr);
+
+/// Reduced loading, for silhouettes given as mask files: each view's mask is decoded at the
+/// largest of the reductions 1, 2, 4 and 8, at most `max_reduction`, that the finest voxel's
+/// footprint in that view allows (distanceReduction()'s pixels per finest voxel at the box's far
+/// side, rounded down to one of them; 1 below 2 MP), and its camera is PinholeCamera::reduced()
+/// by it (HullInput::reductions, HullInput::image_sizes). The box is `box`, or the LP box of the
+/// masks decoded at `max_reduction` first. JPEG masks are decoded at their reduction directly
+/// (readMaskReduced); others are decoded once at full resolution and reduced from it. Image
+/// sizes (of `image_directory`'s images, when given, and of the masks) are read from the files'
+/// headers (imageFileSize) and checked as loadHullInput checks them. `max_reduction` 1 gives
+/// loadRunLengthHullInput's full-resolution input. The work runs on OpenCV's threads.
+HullInput loadReducedHullInput(const std::string& calibration_path,
+                               const std::string& image_directory,
+                               const std::string& mask_directory,
+                               const std::vector<std::string>& view_names, const HullConfig& config,
+                               const std::optional<Box3d>& box, int max_reduction);
 
 }  // namespace sift_hull

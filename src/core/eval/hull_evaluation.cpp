@@ -33,12 +33,14 @@ double maskIoU(const cv::Mat& a, const cv::Mat& b) {
   return union_count == 0 ? 1.0 : static_cast<double>(intersection) / union_count;
 }
 
-ReprojectionIoU reprojectionIoU(const TriangleMesh& mesh, const std::vector<HullView>& views) {
+ReprojectionIoU reprojectionIoU(const TriangleMesh& mesh, const std::vector<HullView>& views,
+                                int threads) {
   ReprojectionIoU result;
-  for (const HullView& view : views) {
-    result.per_view.push_back(
-        maskIoU(rasteriseMask(mesh, view.camera(), view.imageSize()), view.mask()));
-  }
+  result.per_view.assign(views.size(), 0.0);
+  detail::parallelFor(views.size(), std::max(1, threads), [&](size_t i) {
+    const HullView& view = views[i];
+    result.per_view[i] = maskIoU(rasteriseMask(mesh, view.camera(), view.imageSize()), view.mask());
+  });
   if (result.per_view.empty()) return result;
   result.min = *std::min_element(result.per_view.begin(), result.per_view.end());
   double sum = 0.0;

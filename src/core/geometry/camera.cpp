@@ -90,6 +90,18 @@ PinholeCamera PinholeCamera::negated() const {
   return camera;
 }
 
+PinholeCamera PinholeCamera::reduced(int factor) const {
+  if (factor < 1) throw std::invalid_argument("PinholeCamera::reduced: factor below 1");
+  if (factor == 1) return *this;
+  const double s = 1.0 / factor, shift = 0.5 * (s - 1.0);
+  Eigen::Matrix3d S;
+  S << s, 0.0, shift, 0.0, s, shift, 0.0, 0.0, 1.0;
+  PinholeCamera camera = *this;
+  camera.K_ = S * K_;
+  camera.K_inv_ = camera.K_.inverse();
+  return camera;
+}
+
 Matrix34d PinholeCamera::projectionMatrix() const {
   Matrix34d Rt;
   Rt << R_, t_;

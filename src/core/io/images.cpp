@@ -12,6 +12,7 @@
 #include <stdexcept>
 
 #include "sift_hull/hull/view_silhouettes.h"
+#include "sift_hull/io/reduced_images.h"
 
 namespace sift_hull {
 namespace {
@@ -144,9 +145,7 @@ std::string maskPath(const std::string& mask_directory, const std::string& image
 cv::Mat loadMask(const std::string& path) {
   const cv::Mat raw = readImageFile(path, cv::IMREAD_GRAYSCALE);
   if (raw.empty()) throw std::runtime_error(path + ": mask missing or unreadable");
-  cv::Mat mask;
-  cv::compare(raw, 0, mask, cv::CMP_GT);
-  return mask;
+  return maskInside(raw);
 }
 
 namespace {

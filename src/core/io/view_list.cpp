@@ -43,15 +43,14 @@ std::vector<std::string> readViewList(const std::string& path) {
   return names;
 }
 
-namespace {
-
-/// The selected views of a calibration file (loadHullInput).
 std::vector<CalibratedView> hullViews(const std::string& calibration_path,
                                       const std::string& image_directory,
                                       const std::vector<std::string>& view_names) {
   return selectViews(readCalibrationWithImages(calibration_path, image_directory), view_names,
                      calibration_path);
 }
+
+namespace {
 
 void addCameras(const std::vector<CalibratedView>& views, HullInput* input) {
   for (const CalibratedView& view : views) {
