@@ -42,23 +42,15 @@ std::string beforePath(const std::string& path) {
   return path.substr(0, dot) + "_before" + path.substr(dot);
 }
 
+/// `octree` is the hull's OctoMap when --out-octree or --out-color-octree asks for it.
 void writeOutputs(const ArgParser& parser, const HullResult& result,
-                  const octomap::OcTree& octree) {
+                  const octomap::OcTree* octree) {
   if (parser.has("out-mesh")) writePly(parser.get("out-mesh"), result.mesh);
-  if (parser.has("out-octree")) writeOctomap(octree, parser.get("out-octree"), result.box);
+  if (parser.has("out-octree")) writeOctomap(*octree, parser.get("out-octree"), result.box);
   if (parser.has("out-color-octree")) {
-    writeColourOctomap(*colourOctomap(octree, result.mesh), parser.get("out-color-octree"));
+    writeColourOctomap(*colourOctomap(*octree, result.mesh), parser.get("out-color-octree"));
   }
   if (parser.has("out-render")) writeRender(parser.get("out-render"), result.mesh);
-}
-
-/// The tree's occupied leaves (its free leaves, the carved space, aside).
-size_t occupiedLeaves(const octomap::OcTree& octree) {
-  size_t occupied = 0;
-  for (auto leaf = octree.begin_leafs(); leaf != octree.end_leafs(); ++leaf) {
-    occupied += octree.isNodeOccupied(*leaf);
-  }
-  return occupied;
 }
 
 /// A result that cannot be right: an error, or with --allow-poor a warning on stderr and in the
@@ -104,6 +96,10 @@ class Progress {
   bool shown_;
   Clock::time_point start_ = Clock::now();
 };
+
+/// The reprojection IoU compares at most this many pixels of a view (every k-th pixel of every
+/// k-th row of a larger mask).
+constexpr size_t kMaxIoUSamplesPerView = size_t{1} << 20;
 
 /// Largest box edge over the cameras' mutual distance (largest distance between two centres).
 constexpr double kMaxBoxEdgeOverCameraDistance = 100.0;
@@ -251,15 +247,23 @@ int runHull(const std::vector<std::string>& args) {
     refined["holdout_view"] = holdout;
   }
   const double hull_peak_mib = peakMemoryMiB();
-  const std::unique_ptr<octomap::OcTree> octree = toOctomap(result.hull);
+  // OctoMap's own nodes only for the files that need them; the count from the compact map.
+  std::unique_ptr<octomap::OcTree> octree;
+  if (parser.has("out-octree") || parser.has("out-color-octree")) {
+    progress.stage("converting the octree to OctoMap");
+    octree = toOctomap(result.hull);
+  }
+  const size_t occupied_leaves = compactOctomap(result.hull).occupied_centres_W.size();
   progress.stage("checking the mesh against every view");
-  const ReprojectionIoU iou = reprojectionIoU(result.mesh, result.hull.views(), threads);
+  const ReprojectionIoU iou =
+      reprojectionIoU(result.mesh, result.hull.views(), threads, kMaxIoUSamplesPerView);
   for (const std::string& warning : disagreeingViewWarnings(input.names, iou.per_view)) {
     poor.warn(warning);
   }
   checkResult(result, iou, &poor);
-  writeOutputs(parser, result, *octree);
-  nlohmann::json json = hullJson(result, occupiedLeaves(*octree), iou);
+  progress.stage("writing");
+  writeOutputs(parser, result, octree.get());
+  nlohmann::json json = hullJson(result, occupied_leaves, iou);
   json["input_reduction"] = inputReductionJson(input);
   json.update(refined);
   if (found.ball_centre_W || !found.background_reason.empty()) {

@@ -191,7 +191,11 @@ nlohmann::json hullJson(const HullResult& result, size_t occupied_leaves,
             {"octree", time.octree_ms},
             {"mesh", time.mesh_ms},
             {"total", time.total_ms}}},
-          {"reprojection_iou", {{"min", iou.min}, {"mean", iou.mean}, {"per_view", iou.per_view}}}};
+          {"reprojection_iou",
+           {{"min", iou.min},
+            {"mean", iou.mean},
+            {"per_view", iou.per_view},
+            {"sample_step_px", iou.sample_step_px}}}};
 }
 
 const std::vector<HullDataset>& hullDatasets() {

@@ -41,6 +41,17 @@ TEST(ImageFileSize, ReadsPngAndJpegHeadersAndDecodesOtherFormats) {
   std::filesystem::copy_file(dir + "/a.jpg", dir + "/jpeg.png");
   EXPECT_EQ(imageFileSize(dir + "/png.jpg"), cv::Size(333, 171));
   EXPECT_EQ(imageFileSize(dir + "/jpeg.png"), cv::Size(333, 171));
+  // A JPEG whose EXIF orientation (6: turned 90 degrees) cv::imread applies: the decoded size.
+  {
+    std::ifstream in(dir + "/a.jpg", std::ios::binary);
+    const std::string jpeg((std::istreambuf_iterator<char>(in)), {});
+    const std::string tiff("II*\0\x08\0\0\0\x01\0\x12\x01\x03\0\x01\0\0\0\x06\0\0\0\0\0\0\0", 26);
+    const std::string app1 = std::string("\xFF\xE1\0\x22", 4) + std::string("Exif\0\0", 6) + tiff;
+    std::ofstream(dir + "/turned.jpg", std::ios::binary)
+        << jpeg.substr(0, 2) + app1 + jpeg.substr(2);
+    ASSERT_EQ(cv::imread(dir + "/turned.jpg").size(), cv::Size(171, 333));
+    EXPECT_EQ(imageFileSize(dir + "/turned.jpg"), cv::Size(171, 333));
+  }
   EXPECT_THROW(imageFileSize(dir + "/missing.png"), std::runtime_error);
   std::ofstream(dir + "/empty.jpg") << "";
   EXPECT_THROW(imageFileSize(dir + "/empty.jpg"), std::runtime_error);
@@ -204,7 +215,8 @@ TEST_F(ReducedViewSet, TheHullCommandReportsItsReductionAndWritesFullSizeMasks) 
   EXPECT_EQ(result["input_reduction"]["max"], 4);
   EXPECT_EQ(result["input_reduction"]["image_size"], nlohmann::json({2400, 1800}));
   EXPECT_GT(result["reprojection_iou"]["mean"].get<double>(), 0.98);
-  const cv::Mat written = cv::imread(out + "/view_0000.png", cv::IMREAD_GRAYSCALE);  // written as PNG
+  const cv::Mat written =
+      cv::imread(out + "/view_0000.png", cv::IMREAD_GRAYSCALE);  // written as PNG
   ASSERT_EQ(written.size(), cv::Size(2400, 1800));
   const cv::Mat truth = cv::imread(*dir_ + "/view_0000.jpg", cv::IMREAD_GRAYSCALE) > 127;
   EXPECT_GT(maskIoU(written > 127, truth), 0.98);

@@ -16,11 +16,15 @@ double maskIoU(const cv::Mat& a, const cv::Mat& b);
 struct ReprojectionIoU {
   std::vector<double> per_view;
   double min = 0.0, mean = 0.0;
+  int sample_step_px = 1;  ///< the largest step between the pixels compared, in mask pixels
 };
 /// Each view at its mask's resolution (a reduced input's views at their reduction), on `threads`
-/// threads.
+/// threads. With `max_samples_per_view` > 0, a view of more pixels is compared at every k-th
+/// pixel of every k-th row (pixel (k u, k v) of the mask against the mesh rasterised with pixel
+/// centres there), k the smallest step that leaves at most that many: an unbiased sample of the
+/// same IoU, for which a fine mesh's faces mostly hold no sample.
 ReprojectionIoU reprojectionIoU(const TriangleMesh& mesh, const std::vector<HullView>& views,
-                                int threads = 1);
+                                int threads = 1, size_t max_samples_per_view = 0);
 
 /// Dense voxel carving, the brute-force reference: a voxel is occupied when every view keeps its
 /// centre (HullView::keeps).

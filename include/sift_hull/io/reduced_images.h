@@ -18,8 +18,9 @@ cv::Size reducedSize(cv::Size size, int reduction);
 /// True for a file whose name ends in .jpg, .jpeg, .jpe or .jfif (any case).
 bool hasJpegExtension(const std::string& path);
 
-/// The width and height of an image file: from a PNG's IHDR or a JPEG's frame header, else (other
-/// formats, or a header this reader does not understand) by decoding the file. Throws
+/// The width and height of an image file as cv::imread gives it: from a PNG's IHDR or a JPEG's
+/// frame header, else (other formats, a JPEG with EXIF data, whose orientation cv::imread applies,
+/// or a header this reader does not understand) by decoding the file. Throws
 /// std::runtime_error naming the path when the file is missing or unreadable.
 cv::Size imageFileSize(const std::string& path);
 

@@ -24,6 +24,16 @@ void carveSlice(const std::vector<HullView>& views, int k, DenseGrid* grid) {
   }
 }
 
+/// The camera whose pixel (u, v) is `camera`'s pixel (step u, step v).
+PinholeCamera sampledCamera(const PinholeCamera& camera, int step) {
+  const Eigen::Matrix3d K =
+      Eigen::DiagonalMatrix<double, 3>(1.0 / step, 1.0 / step, 1.0) * camera.K();
+  const PinholeCamera proper = camera.improper()
+                                   ? PinholeCamera(K, -camera.R(), -camera.t()).negated()
+                                   : PinholeCamera(K, camera.R(), camera.t());
+  return proper.withDistortion(camera.distortion());
+}
+
 }  // namespace
 
 double maskIoU(const cv::Mat& a, const cv::Mat& b) {
@@ -34,13 +44,37 @@ double maskIoU(const cv::Mat& a, const cv::Mat& b) {
 }
 
 ReprojectionIoU reprojectionIoU(const TriangleMesh& mesh, const std::vector<HullView>& views,
-                                int threads) {
+                                int threads, size_t max_samples_per_view) {
   ReprojectionIoU result;
   result.per_view.assign(views.size(), 0.0);
+  std::vector<int> steps(views.size(), 1);
   detail::parallelFor(views.size(), std::max(1, threads), [&](size_t i) {
     const HullView& view = views[i];
-    result.per_view[i] = maskIoU(rasteriseMask(mesh, view.camera(), view.imageSize()), view.mask());
+    const cv::Size size = view.imageSize();
+    int step = 1;
+    while (max_samples_per_view > 0 &&
+           static_cast<size_t>((size.width + step - 1) / step) *
+                   static_cast<size_t>((size.height + step - 1) / step) >
+               max_samples_per_view) {
+      ++step;
+    }
+    steps[i] = step;
+    if (step == 1) {
+      result.per_view[i] = maskIoU(rasteriseMask(mesh, view.camera(), size), view.mask());
+      return;
+    }
+    const cv::Size sampled((size.width + step - 1) / step, (size.height + step - 1) / step);
+    const cv::Mat full = view.mask();
+    cv::Mat mask(sampled, CV_8UC1);
+    for (int v = 0; v < sampled.height; ++v) {
+      const uchar* in = full.ptr<uchar>(v * step);
+      uchar* out = mask.ptr<uchar>(v);
+      for (int u = 0; u < sampled.width; ++u) out[u] = in[u * step];
+    }
+    result.per_view[i] =
+        maskIoU(rasteriseMask(mesh, sampledCamera(view.camera(), step), sampled), mask);
   });
+  if (!steps.empty()) result.sample_step_px = *std::max_element(steps.begin(), steps.end());
   if (result.per_view.empty()) return result;
   result.min = *std::min_element(result.per_view.begin(), result.per_view.end());
   double sum = 0.0;

@@ -37,17 +37,33 @@ struct ProjectedVertex {
   bool usable = false;
 };
 
+/// std::llround of a value within +-2^29, without the library call.
+int64_t roundedFixed(double value) {
+  return value >= 0.0 ? static_cast<int64_t>(value + 0.5) : -static_cast<int64_t>(0.5 - value);
+}
+
 std::vector<ProjectedVertex> projectVertices(const TriangleMesh& mesh,
                                              const PinholeCamera& camera) {
   std::vector<ProjectedVertex> projected(mesh.vertices_W.size());
+  // Without distortion, P = K [R | t] directly: its last row gives the depth (K's is (0, 0, 1)).
+  const bool ideal = !camera.distorted();
+  const Matrix34d P = camera.projectionMatrix();
   for (size_t v = 0; v < projected.size(); ++v) {
     const Eigen::Vector3d X_W = mesh.vertices_W[v].cast<double>();
-    projected[v].depth = camera.depth(X_W);
-    if (!(projected[v].depth > 0.0)) continue;
-    const Eigen::Vector2d pixel = camera.project(X_W);
+    Eigen::Vector2d pixel;
+    if (ideal) {
+      const Eigen::Vector3d p = P.leftCols<3>() * X_W + P.col(3);
+      projected[v].depth = p.z();
+      if (!(p.z() > 0.0)) continue;
+      pixel = p.head<2>() / p.z();
+    } else {
+      projected[v].depth = camera.depth(X_W);
+      if (!(projected[v].depth > 0.0)) continue;
+      pixel = camera.project(X_W);
+    }
     if (!(pixel.cwiseAbs().maxCoeff() <= kMaxProjectedPx)) continue;
-    projected[v].pixel = {std::llround(pixel.x() * kSubpixelScale),
-                          std::llround(pixel.y() * kSubpixelScale)};
+    projected[v].pixel = {roundedFixed(pixel.x() * kSubpixelScale),
+                          roundedFixed(pixel.y() * kSubpixelScale)};
     projected[v].usable = true;
   }
   return projected;
@@ -71,18 +87,27 @@ struct PixelRange {
 };
 
 PixelRange coveredRange(int64_t min_fixed, int64_t max_fixed, int pixels) {
-  const auto toPixel = [](int64_t fixed, bool up) {
-    const double pixel = static_cast<double>(fixed) / kSubpixelScale;
-    return static_cast<int64_t>(up ? std::ceil(pixel) : std::floor(pixel));
-  };
-  return {static_cast<int>(std::max<int64_t>(toPixel(min_fixed, true), 0)),
-          static_cast<int>(std::min<int64_t>(toPixel(max_fixed, false), pixels - 1))};
+  // Pixel centres at integer coordinates: the first at or after min_fixed, the last at or before
+  // max_fixed (arithmetic shifts round towards minus infinity).
+  const int64_t first = -((-min_fixed) >> kSubpixelBits);
+  const int64_t last = max_fixed >> kSubpixelBits;
+  return {static_cast<int>(std::max<int64_t>(first, 0)),
+          static_cast<int>(std::min<int64_t>(last, pixels - 1))};
 }
 
 // Calls visit(column, row, weights) for every pixel centre the triangle covers; weights are the
 // barycentric coordinates of the centre with respect to corners[0..2].
 template <typename Visit>
 void rasteriseTriangle(const std::array<FixedPoint, 3>& corners, cv::Size size, Visit&& visit) {
+  // The pixel centres of the bounding box first: most faces of a fine mesh hold none.
+  const PixelRange columns =
+      coveredRange(std::min({corners[0].x, corners[1].x, corners[2].x}),
+                   std::max({corners[0].x, corners[1].x, corners[2].x}), size.width);
+  if (columns.first > columns.last) return;
+  const PixelRange rows =
+      coveredRange(std::min({corners[0].y, corners[1].y, corners[2].y}),
+                   std::max({corners[0].y, corners[1].y, corners[2].y}), size.height);
+  if (rows.first > rows.last) return;
   std::array<int, 3> order = {0, 1, 2};
   int64_t doubled_area = edgeFunction(corners[0], corners[1], corners[2]);
   if (doubled_area == 0) return;
@@ -91,10 +116,6 @@ void rasteriseTriangle(const std::array<FixedPoint, 3>& corners, cv::Size size, 
   const FixedPoint& a = corners[order[0]];
   const FixedPoint& b = corners[order[1]];
   const FixedPoint& c = corners[order[2]];
-  const PixelRange columns =
-      coveredRange(std::min({a.x, b.x, c.x}), std::max({a.x, b.x, c.x}), size.width);
-  const PixelRange rows =
-      coveredRange(std::min({a.y, b.y, c.y}), std::max({a.y, b.y, c.y}), size.height);
   // Edge opposite each corner, and the bias implementing the boundary rule.
   const std::array<std::array<const FixedPoint*, 2>, 3> edges = {{{&b, &c}, {&c, &a}, {&a, &b}}};
   std::array<int64_t, 3> bias, step;
@@ -211,10 +232,30 @@ cv::Mat rasteriseMask(const TriangleMesh& mesh, const PinholeCamera& camera, cv:
   const auto fill = [&mask](int column, int row, const std::array<double, 3>&) {
     mask.at<uchar>(row, column) = 255;
   };
-  forEachProjectedFace(mesh, projectVertices(mesh, camera),
-                       [&](size_t, const std::array<FixedPoint, 3>& corners) {
-                         rasteriseTriangle(corners, size, fill);
-                       });
+  // The projected vertices in 8 bytes each (a fine mesh's faces are mostly read for nothing but
+  // their corners: the memory they take sets the pace); x = kUnusable where projectVertices says
+  // not usable.
+  constexpr int32_t kUnusable = std::numeric_limits<int32_t>::min();
+  std::vector<std::array<int32_t, 2>> corners_px;
+  {
+    const std::vector<ProjectedVertex> projected = projectVertices(mesh, camera);
+    corners_px.resize(projected.size());
+    for (size_t v = 0; v < projected.size(); ++v) {
+      corners_px[v] = projected[v].usable
+                          ? std::array<int32_t, 2>{static_cast<int32_t>(projected[v].pixel.x),
+                                                   static_cast<int32_t>(projected[v].pixel.y)}
+                          : std::array<int32_t, 2>{kUnusable, 0};
+    }
+  }
+  for (const Eigen::Vector3i& face : mesh.faces) {
+    const std::array<int32_t, 2>& a = corners_px[face[0]];
+    const std::array<int32_t, 2>& b = corners_px[face[1]];
+    const std::array<int32_t, 2>& c = corners_px[face[2]];
+    if (a[0] == kUnusable || b[0] == kUnusable || c[0] == kUnusable) continue;
+    rasteriseTriangle(std::array<FixedPoint, 3>{FixedPoint{a[0], a[1]}, FixedPoint{b[0], b[1]},
+                                                FixedPoint{c[0], c[1]}},
+                      size, fill);
+  }
   return mask;
 }
 

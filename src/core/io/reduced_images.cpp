@@ -42,7 +42,8 @@ cv::Size pngSize(std::ifstream& in) {
 }
 
 /// A JPEG's size from its first frame header (SOF0 to SOF15 but DHT, JPG and DAC); empty when the
-/// file is not a JPEG or the markers end first.
+/// file is not a JPEG, the markers end first, or an EXIF block comes first (its orientation may
+/// turn the image as cv::imread decodes it: the size is then the decoded one).
 cv::Size jpegSize(std::ifstream& in) {
   in.seekg(0);
   unsigned char soi[2];
@@ -66,6 +67,14 @@ cv::Size jpegSize(std::ifstream& in) {
       const uint32_t height = bigEndian(header + 1, 2), width = bigEndian(header + 3, 2);
       if (width == 0 || height == 0) return {};  // a height given later (DNL): decode instead
       return cv::Size(static_cast<int>(width), static_cast<int>(height));
+    }
+    if (marker == 0xE1 && length >= 8) {  // APP1: EXIF may turn the image (cv::imread does)
+      char id[6];
+      if (!in.read(id, 6)) return {};
+      if (std::equal(id, id + 6, "Exif\0\0")) return {};
+      in.seekg(static_cast<std::streamoff>(length) - 8, std::ios::cur);
+      if (!in) return {};
+      continue;
     }
     in.seekg(static_cast<std::streamoff>(length) - 2, std::ios::cur);
     if (!in) return {};
@@ -146,7 +155,7 @@ cv::Size imageFileSize(const std::string& path) {
     size = jpegSize(in);
   }
   if (!size.empty()) return size;
-  return readFile(path, cv::IMREAD_UNCHANGED).size();
+  return readFile(path, cv::IMREAD_GRAYSCALE).size();  // with its EXIF orientation applied
 }
 
 cv::Mat reduceMask(const cv::Mat& mask, int reduction) {
