@@ -255,8 +255,8 @@ int runHull(const std::vector<std::string>& args) {
   }
   const size_t occupied_leaves = compactOctomap(result.hull).occupied_centres_W.size();
   progress.stage("checking the mesh against every view");
-  const ReprojectionIoU iou =
-      reprojectionIoU(result.mesh, result.hull.views(), threads, kMaxIoUSamplesPerView);
+  const ReprojectionIoU iou = reprojectionIoU(result.mesh, result.hull.views(), threads,
+                                              kMaxIoUSamplesPerView, result.mesh_check.watertight);
   for (const std::string& warning : disagreeingViewWarnings(input.names, iou.per_view)) {
     poor.warn(warning);
   }

@@ -50,6 +50,22 @@ TEST(RasteriseTest, SphereMaskMatchesTheProjectedDisc) {
   EXPECT_EQ(holes, 0);
 }
 
+TEST(RasteriseTest, HalfTheFacesOfAClosedMeshDrawItsProjection) {
+  // Every ray through a closed mesh's projection crosses it both ways: the faces that turn one way
+  // in the image cover what all of them cover.
+  const TriangleMesh mesh = sphereMesh();
+  ASSERT_TRUE(checkMesh(mesh).watertight);
+  const PinholeCamera camera = sphereCamera();
+  const cv::Size size(320, 240);
+  for (const PinholeCamera& seen_by : {camera, camera.reduced(2)}) {
+    const cv::Mat all = rasteriseMask(mesh, seen_by, size);
+    const cv::Mat half = rasteriseMask(mesh, seen_by, size, true);
+    ASSERT_GT(cv::countNonZero(all), 1000);
+    // Pixel centres exactly on the outline may go either way; none here.
+    EXPECT_EQ(cv::countNonZero(all != half), 0);
+  }
+}
+
 TEST(RasteriseTest, PixelsOnASharedEdgeBelongToOneTriangle) {
   // A square from (2, 2) to (12, 12) split along its diagonal through pixel centres.
   TriangleMesh first, second, square;

@@ -167,6 +167,16 @@ TEST_F(ReducedViewSet, DecodesEachViewAtItsVoxelsFootprintAndKeepsTheHull) {
             << "; box edge " << full_hull.box.size().maxCoeff() << " and "
             << reduced_hull.box.size().maxCoeff() << '\n';
   EXPECT_NEAR(reduced_iou.mean, full_iou.mean, 0.002);
+  // The IoU sampled at every k-th pixel (as `hull` does for views over 2^20 pixels), and drawn
+  // with half the faces of the watertight mesh: the same within a thousandth.
+  ASSERT_TRUE(reduced_hull.mesh_check.watertight);
+  const ReprojectionIoU sampled =
+      reprojectionIoU(reduced_hull.mesh, reduced_hull.hull.views(), 2, 40000, true);
+  EXPECT_EQ(sampled.sample_step_px, 3);  // 600x450 views: 200x150 samples
+  EXPECT_NEAR(sampled.mean, reduced_iou.mean, 0.001);
+  const ReprojectionIoU half =
+      reprojectionIoU(reduced_hull.mesh, reduced_hull.hull.views(), 2, 0, true);
+  EXPECT_NEAR(half.mean, reduced_iou.mean, 1e-4);
   EXPECT_LT((reduced_hull.box.min_W - full_hull.box.min_W).norm(),
             0.01 * full_hull.box.size().maxCoeff());
   // A finer octree asks for finer masks; max_reduction 1 is the full-resolution input.

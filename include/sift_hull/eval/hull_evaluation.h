@@ -22,9 +22,11 @@ struct ReprojectionIoU {
 /// threads. With `max_samples_per_view` > 0, a view of more pixels is compared at every k-th
 /// pixel of every k-th row (pixel (k u, k v) of the mask against the mesh rasterised with pixel
 /// centres there), k the smallest step that leaves at most that many: an unbiased sample of the
-/// same IoU, for which a fine mesh's faces mostly hold no sample.
+/// same IoU, for which a fine mesh's faces mostly hold no sample. `closed`: the mesh is
+/// watertight (HullResult::mesh_check), and half its faces draw its projection (rasteriseMask).
 ReprojectionIoU reprojectionIoU(const TriangleMesh& mesh, const std::vector<HullView>& views,
-                                int threads = 1, size_t max_samples_per_view = 0);
+                                int threads = 1, size_t max_samples_per_view = 0,
+                                bool closed = false);
 
 /// Dense voxel carving, the brute-force reference: a voxel is occupied when every view keeps its
 /// centre (HullView::keeps).

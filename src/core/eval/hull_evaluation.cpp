@@ -44,9 +44,10 @@ double maskIoU(const cv::Mat& a, const cv::Mat& b) {
 }
 
 ReprojectionIoU reprojectionIoU(const TriangleMesh& mesh, const std::vector<HullView>& views,
-                                int threads, size_t max_samples_per_view) {
+                                int threads, size_t max_samples_per_view, bool closed) {
   ReprojectionIoU result;
   result.per_view.assign(views.size(), 0.0);
+  requireValidFaces(mesh, "reprojectionIoU");
   std::vector<int> steps(views.size(), 1);
   detail::parallelFor(views.size(), std::max(1, threads), [&](size_t i) {
     const HullView& view = views[i];
@@ -60,7 +61,8 @@ ReprojectionIoU reprojectionIoU(const TriangleMesh& mesh, const std::vector<Hull
     }
     steps[i] = step;
     if (step == 1) {
-      result.per_view[i] = maskIoU(rasteriseMask(mesh, view.camera(), size), view.mask());
+      result.per_view[i] =
+          maskIoU(rasteriseMask(mesh, view.camera(), size, closed, true), view.mask());
       return;
     }
     const cv::Size sampled((size.width + step - 1) / step, (size.height + step - 1) / step);
@@ -71,8 +73,8 @@ ReprojectionIoU reprojectionIoU(const TriangleMesh& mesh, const std::vector<Hull
       uchar* out = mask.ptr<uchar>(v);
       for (int u = 0; u < sampled.width; ++u) out[u] = in[u * step];
     }
-    result.per_view[i] =
-        maskIoU(rasteriseMask(mesh, sampledCamera(view.camera(), step), sampled), mask);
+    result.per_view[i] = maskIoU(
+        rasteriseMask(mesh, sampledCamera(view.camera(), step), sampled, closed, true), mask);
   });
   if (!steps.empty()) result.sample_step_px = *std::max_element(steps.begin(), steps.end());
   if (result.per_view.empty()) return result;

@@ -225,33 +225,46 @@ PinholeCamera turntableCamera(const BoundingSphere& sphere, double azimuth_rad, 
 
 }  // namespace
 
-cv::Mat rasteriseMask(const TriangleMesh& mesh, const PinholeCamera& camera, cv::Size size) {
+cv::Mat rasteriseMask(const TriangleMesh& mesh, const PinholeCamera& camera, cv::Size size,
+                      bool closed, bool faces_checked) {
   requireImageSize(size, "rasteriseMask");
-  requireValidFaces(mesh, "rasteriseMask");
+  if (!faces_checked) requireValidFaces(mesh, "rasteriseMask");
   cv::Mat mask = cv::Mat::zeros(size, CV_8UC1);
   const auto fill = [&mask](int column, int row, const std::array<double, 3>&) {
     mask.at<uchar>(row, column) = 255;
   };
   // The projected vertices in 8 bytes each (a fine mesh's faces are mostly read for nothing but
-  // their corners: the memory they take sets the pace); x = kUnusable where projectVertices says
-  // not usable.
+  // their corners: the memory they take sets the pace); x = kUnusable where projectVertices would
+  // call the vertex not usable.
   constexpr int32_t kUnusable = std::numeric_limits<int32_t>::min();
-  std::vector<std::array<int32_t, 2>> corners_px;
-  {
-    const std::vector<ProjectedVertex> projected = projectVertices(mesh, camera);
-    corners_px.resize(projected.size());
-    for (size_t v = 0; v < projected.size(); ++v) {
-      corners_px[v] = projected[v].usable
-                          ? std::array<int32_t, 2>{static_cast<int32_t>(projected[v].pixel.x),
-                                                   static_cast<int32_t>(projected[v].pixel.y)}
-                          : std::array<int32_t, 2>{kUnusable, 0};
+  std::vector<std::array<int32_t, 2>> corners_px(mesh.vertices_W.size());
+  const bool ideal = !camera.distorted();
+  const Matrix34d P = camera.projectionMatrix();
+  for (size_t v = 0; v < corners_px.size(); ++v) {
+    const Eigen::Vector3d X_W = mesh.vertices_W[v].cast<double>();
+    Eigen::Vector2d pixel;
+    corners_px[v] = {kUnusable, 0};
+    if (ideal) {
+      const Eigen::Vector3d p = P.leftCols<3>() * X_W + P.col(3);
+      if (!(p.z() > 0.0)) continue;
+      pixel = p.head<2>() / p.z();
+    } else {
+      if (!(camera.depth(X_W) > 0.0)) continue;
+      pixel = camera.project(X_W);
     }
+    if (!(pixel.cwiseAbs().maxCoeff() <= kMaxProjectedPx)) continue;
+    corners_px[v] = {static_cast<int32_t>(roundedFixed(pixel.x() * kSubpixelScale)),
+                     static_cast<int32_t>(roundedFixed(pixel.y() * kSubpixelScale))};
   }
   for (const Eigen::Vector3i& face : mesh.faces) {
     const std::array<int32_t, 2>& a = corners_px[face[0]];
     const std::array<int32_t, 2>& b = corners_px[face[1]];
     const std::array<int32_t, 2>& c = corners_px[face[2]];
     if (a[0] == kUnusable || b[0] == kUnusable || c[0] == kUnusable) continue;
+    if (closed &&
+        int64_t{b[0] - a[0]} * (c[1] - a[1]) - int64_t{b[1] - a[1]} * (c[0] - a[0]) <= 0) {
+      continue;  // turned the other way: a face turned this way covers its pixels
+    }
     rasteriseTriangle(std::array<FixedPoint, 3>{FixedPoint{a[0], a[1]}, FixedPoint{b[0], b[1]},
                                                 FixedPoint{c[0], c[1]}},
                       size, fill);
