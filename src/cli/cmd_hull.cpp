@@ -4,6 +4,7 @@
 #include <chrono>
 #include <iomanip>
 #include <iostream>
+#include <mutex>
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
@@ -76,16 +77,21 @@ class PoorResults {
 };
 
 /// The stage a run has reached, on stderr when it is a terminal and the result is not JSON: one
-/// line rewritten in place, with the seconds since the start; cleared at the end.
+/// line rewritten in place, with the seconds since the start; cleared at the end. Counts (views
+/// read) may come from several threads; they are shown at most ten times a second.
 class Progress {
  public:
   explicit Progress(bool wanted) : shown_(wanted && isatty(STDERR_FILENO) == 1) {}
   void stage(const std::string& text) {
     if (!shown_) return;
-    const double seconds = std::chrono::duration<double>(Clock::now() - start_).count();
-    std::ostringstream line;
-    line << "sift_hull hull: " << std::fixed << std::setprecision(1) << seconds << " s, " << text;
-    std::cerr << "\r\033[K" << line.str() << std::flush;
+    std::lock_guard<std::mutex> lock(mutex_);
+    show(text);
+  }
+  void count(const std::string& text, size_t done, size_t total) {
+    if (!shown_) return;
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (done < total && Clock::now() - last_ < std::chrono::milliseconds(100)) return;
+    show(text + " " + std::to_string(done) + " of " + std::to_string(total));
   }
   void done() {
     if (shown_) std::cerr << "\r\033[K" << std::flush;
@@ -93,8 +99,16 @@ class Progress {
 
  private:
   using Clock = std::chrono::steady_clock;
+  void show(const std::string& text) {
+    last_ = Clock::now();
+    const double seconds = std::chrono::duration<double>(last_ - start_).count();
+    std::ostringstream line;
+    line << "sift_hull hull: " << std::fixed << std::setprecision(1) << seconds << " s, " << text;
+    std::cerr << "\r\033[K" << line.str() << std::flush;
+  }
   bool shown_;
-  Clock::time_point start_ = Clock::now();
+  std::mutex mutex_;
+  Clock::time_point start_ = Clock::now(), last_ = start_;
 };
 
 /// The reprojection IoU compares at most this many pixels of a view (every k-th pixel of every
@@ -217,8 +231,12 @@ int runHull(const std::vector<std::string>& args) {
   const std::optional<Box3d> box = boxFromArgs(parser);
   const int max_reduction = maxInputReductionFromArgs(parser);
   progress.stage("reading the views");
-  HullInput input = max_reduction > 1 ? reducedViewSetFromArgs(parser, config, box, max_reduction)
-                                      : runLengthViewSetFromArgs(parser, &found);
+  const auto on_view_read = [&](size_t read, size_t total) {
+    progress.count("views read", read, total);
+  };
+  HullInput input = max_reduction > 1
+                        ? reducedViewSetFromArgs(parser, config, box, max_reduction, on_view_read)
+                        : runLengthViewSetFromArgs(parser, &found);
   progress.stage("read " + std::to_string(input.viewCount()) + " views");
   writeSilhouettesFromArgs(parser, input.names, [&](size_t i) { return fullSizeMask(input, i); });
   writeViewPriorsFromArgs(parser, input.names, found);

@@ -90,10 +90,12 @@ int maxInputReductionFromArgs(const ArgParser& parser) {
   return photographs || !parser.has("silhouettes") ? 1 : most;
 }
 
-HullInput reducedViewSetFromArgs(const ArgParser& parser, const HullConfig& config,
-                                 const std::optional<Box3d>& box, int max_reduction) {
-  return loadReducedHullInput(parser.get("calib"), parser.get("images"), parser.get("silhouettes"),
-                              viewNamesFromArgs(parser), config, box, max_reduction);
+HullInput reducedViewSetFromArgs(
+    const ArgParser& parser, const HullConfig& config, const std::optional<Box3d>& box,
+    int max_reduction, const std::function<void(size_t read, size_t total)>& on_view_read) {
+  return loadReducedHullInput(parser.get("calib"), parser.get("images"),
+                              parser.get("silhouettes"), viewNamesFromArgs(parser), config, box,
+                              max_reduction, on_view_read);
 }
 
 cv::Mat fullSizeMask(const HullInput& input, size_t view) {

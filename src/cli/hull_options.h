@@ -1,6 +1,7 @@
 #pragma once
 
 #include <nlohmann/json.hpp>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -30,8 +31,9 @@ void addInputReductionOption(ArgParser* parser);
 int maxInputReductionFromArgs(const ArgParser& parser);
 /// The views with their masks decoded at the reductions their footprints allow, up to
 /// `max_reduction` (loadReducedHullInput; `box` is --box when given).
-HullInput reducedViewSetFromArgs(const ArgParser& parser, const HullConfig& config,
-                                 const std::optional<Box3d>& box, int max_reduction);
+HullInput reducedViewSetFromArgs(
+    const ArgParser& parser, const HullConfig& config, const std::optional<Box3d>& box,
+    int max_reduction, const std::function<void(size_t read, size_t total)>& on_view_read = {});
 /// View `view`'s mask at its image's full size: a reduced mask enlarged (its outline
 /// interpolated), else the mask itself.
 cv::Mat fullSizeMask(const HullInput& input, size_t view);

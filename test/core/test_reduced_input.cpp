@@ -3,6 +3,7 @@
 // view set against the full-resolution one.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -181,7 +182,19 @@ TEST_F(ReducedViewSet, DecodesEachViewAtItsVoxelsFootprintAndKeepsTheHull) {
             0.01 * full_hull.box.size().maxCoeff());
   // A finer octree asks for finer masks; max_reduction 1 is the full-resolution input.
   EXPECT_EQ(loadReducedHullInput(par, *dir_, *dir_, {}, depth(9), {}, 8).reduction(0), 1);
-  EXPECT_EQ(loadReducedHullInput(par, *dir_, *dir_, {}, depth(7), {}, 2).reduction(0), 2);
+  // Each view reported once as it is read, from the reading threads.
+  std::atomic<size_t> reported{0}, largest{0};
+  const HullInput by_two =
+      loadReducedHullInput(par, *dir_, *dir_, {}, depth(7), {}, 2, [&](size_t read, size_t total) {
+        ++reported;
+        EXPECT_EQ(total, 24u);
+        size_t seen = largest;
+        while (read > seen && !largest.compare_exchange_weak(seen, read)) {
+        }
+      });
+  EXPECT_EQ(by_two.reduction(0), 2);
+  EXPECT_EQ(reported, 24u);
+  EXPECT_EQ(largest, 24u);
   const HullInput same = loadReducedHullInput(par, *dir_, *dir_, {}, depth(7), {}, 1);
   EXPECT_EQ(same.reduction(0), 1);
   EXPECT_EQ(cv::countNonZero(same.mask(0) != full.mask(0)), 0);

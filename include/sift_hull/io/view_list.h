@@ -1,5 +1,6 @@
 #pragma once
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -48,11 +49,13 @@ HullInput loadRunLengthHullInput(const std::string& calibration_path,
 /// (readMaskReduced); others are decoded once at full resolution and reduced from it. Image
 /// sizes (of `image_directory`'s images, when given, and of the masks) are read from the files'
 /// headers (imageFileSize) and checked as loadHullInput checks them. `max_reduction` 1 gives
-/// loadRunLengthHullInput's full-resolution input. The work runs on OpenCV's threads.
-HullInput loadReducedHullInput(const std::string& calibration_path,
-                               const std::string& image_directory,
-                               const std::string& mask_directory,
-                               const std::vector<std::string>& view_names, const HullConfig& config,
-                               const std::optional<Box3d>& box, int max_reduction);
+/// loadRunLengthHullInput's full-resolution input. The work runs on OpenCV's threads;
+/// `on_view_read(read, total)`, when given, is called from them (at times at once) as each view's
+/// mask is read at its reduction.
+HullInput loadReducedHullInput(
+    const std::string& calibration_path, const std::string& image_directory,
+    const std::string& mask_directory, const std::vector<std::string>& view_names,
+    const HullConfig& config, const std::optional<Box3d>& box, int max_reduction,
+    const std::function<void(size_t read, size_t total)>& on_view_read = {});
 
 }  // namespace sift_hull

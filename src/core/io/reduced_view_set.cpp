@@ -1,6 +1,7 @@
 // Reduced loading of a view set with mask files (sift_hull/io/view_list.h,
 // loadReducedHullInput).
 
+#include <atomic>
 #include <exception>
 #include <opencv2/core/utility.hpp>
 #include <stdexcept>
@@ -111,11 +112,11 @@ std::optional<Box3d> coarseBox(const std::vector<CalibratedView>& views,
 
 }  // namespace
 
-HullInput loadReducedHullInput(const std::string& calibration_path,
-                               const std::string& image_directory,
-                               const std::string& mask_directory,
-                               const std::vector<std::string>& view_names, const HullConfig& config,
-                               const std::optional<Box3d>& box, int max_reduction) {
+HullInput loadReducedHullInput(
+    const std::string& calibration_path, const std::string& image_directory,
+    const std::string& mask_directory, const std::vector<std::string>& view_names,
+    const HullConfig& config, const std::optional<Box3d>& box, int max_reduction,
+    const std::function<void(size_t read, size_t total)>& on_view_read) {
   if (!isDecodableReduction(max_reduction)) {
     throw std::invalid_argument("loadReducedHullInput: max_reduction must be 1, 2, 4 or 8");
   }
@@ -161,11 +162,14 @@ HullInput loadReducedHullInput(const std::string& calibration_path,
     }
   }
   std::vector<std::exception_ptr> errors(views.size());
+  std::atomic<size_t> views_read{0};
   cv::parallel_for_(cv::Range(0, static_cast<int>(views.size())), [&](const cv::Range& range) {
     for (int i = range.start; i < range.end; ++i) {
       try {
         input.run_length_masks[i] = readSecond(read[i], input.reductions[i]);
         read[i].full = RunLengthMask();  // each view's full mask freed once reduced
+        const size_t done = ++views_read;
+        if (on_view_read) on_view_read(done, views.size());
       } catch (...) {
         errors[i] = std::current_exception();
       }
