@@ -246,9 +246,12 @@ int runHull(const std::vector<std::string>& args) {
        runLengthSilhouetteWarnings(input.names, input.run_length_masks))
     poor.warn(warning);
   if (box) checkBox(*box, input, &poor);
-  progress.stage("carving the octree to depth " + std::to_string(config.max_depth) +
-                 " and meshing");
-  HullResult result = buildHull(input, config, box);
+  HullResult result = buildHull(input, config, box, [&](const std::string& stage) {
+    progress.stage(
+        stage == "octree" ? "carving the octree to depth " + std::to_string(config.max_depth)
+        : stage == "mesh" ? "marching cubes"
+                          : stage + " of " + std::to_string(input.viewCount()) + " views");
+  });
   if ((parser.flag("refine-with-matches") || parser.flag("photo-carve")) &&
       parser.has("out-render")) {
     writeRender(beforePath(parser.get("out-render")), result.mesh);

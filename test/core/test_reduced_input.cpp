@@ -160,7 +160,10 @@ TEST_F(ReducedViewSet, DecodesEachViewAtItsVoxelsFootprintAndKeepsTheHull) {
     // No finer than the distance maps the full-resolution hull chose.
     EXPECT_LE(r, full_hull.hull.views()[i].distanceReduction());
   }
-  const HullResult reduced_hull = buildHull(reduced, depth(7));
+  std::vector<std::string> stages;
+  const HullResult reduced_hull =
+      buildHull(reduced, depth(7), {}, [&](const std::string& stage) { stages.push_back(stage); });
+  EXPECT_EQ(stages, std::vector<std::string>({"distance maps", "octree", "mesh"}));
   const ReprojectionIoU full_iou = reprojectionIoU(full_hull.mesh, full_hull.hull.views(), 2);
   const ReprojectionIoU reduced_iou =
       reprojectionIoU(reduced_hull.mesh, reduced_hull.hull.views(), 2);

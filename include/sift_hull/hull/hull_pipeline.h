@@ -1,5 +1,6 @@
 #pragma once
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -56,8 +57,11 @@ struct HullResult {
 /// threads), the bounding box (the LP of eq. 8 unless `box` is given), each view's distance map
 /// at the reduction distanceReduction() chooses for the box (in parallel), octree carving and
 /// marching cubes. Throws HullBoxError when no box exists, std::invalid_argument for bad input.
+/// `on_stage`, when given, is told each stage as it starts ("distance maps", "octree",
+/// "mesh"), for a progress display.
 HullResult buildHull(const HullInput& input, const HullConfig& config,
-                     const std::optional<Box3d>& box = std::nullopt);
+                     const std::optional<Box3d>& box = std::nullopt,
+                     const std::function<void(const std::string& stage)>& on_stage = {});
 
 /// The LP box of prepared views (hullBoundingBox of their cameras and bounds).
 Box3d boundingBoxOf(const std::vector<HullView>& views);

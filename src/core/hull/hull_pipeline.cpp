@@ -58,7 +58,11 @@ Box3d boundingBoxOf(const std::vector<HullView>& views) {
 }
 
 HullResult buildHull(const HullInput& input, const HullConfig& config,
-                     const std::optional<Box3d>& box) {
+                     const std::optional<Box3d>& box,
+                     const std::function<void(const std::string& stage)>& on_stage) {
+  const auto starting = [&](const std::string& stage) {
+    if (on_stage) on_stage(stage);
+  };
   validate(config);
   HullTimings time;
   const size_t count = input.viewCount();
@@ -80,15 +84,18 @@ HullResult buildHull(const HullInput& input, const HullConfig& config,
   const Box3d hull_box = box ? *box : hullBoundingBox(input.cameras, bounds, input.names);
   time.bbox_ms = millisecondsSince(stage);
 
+  starting("distance maps");
   stage = Clock::now();
   std::vector<HullView> views = viewsFor(input, &masks, hull_box, config);
   time.distance_ms = millisecondsSince(stage);
 
+  starting("octree");
   stage = Clock::now();
   VisualHull hull(hull_box, config);
   hull.addViews(std::move(views));
   time.octree_ms = millisecondsSince(stage);
 
+  starting("mesh");
   stage = Clock::now();
   TriangleMesh mesh = hull.mesh();
   time.mesh_ms = millisecondsSince(stage);
