@@ -56,23 +56,23 @@ void writeOutputs(const ArgParser& parser, const HullResult& result,
 
 /// A result that cannot be right: an error, or with --allow-poor a warning on stderr and in the
 /// JSON's `warnings`.
+/// `clear_line`: a progress line may stand on stderr; each warning clears it first.
 class PoorResults {
  public:
-  explicit PoorResults(bool allow) : allow_(allow) {}
+  PoorResults(bool allow, bool clear_line) : allow_(allow), clear_line_(clear_line) {}
   void report(const std::string& reason) {
     if (!allow_) throw std::runtime_error(reason + " (--allow-poor accepts it)");
-    std::cerr << "sift_hull hull: warning: " << reason << '\n';
-    warnings_.push_back(reason);
+    warn(reason);
   }
   /// A warning whatever --allow-poor says (a suspect view, for instance).
   void warn(const std::string& reason) {
-    std::cerr << "sift_hull hull: warning: " << reason << '\n';
+    std::cerr << (clear_line_ ? "\r\033[K" : "") << "sift_hull hull: warning: " << reason << '\n';
     warnings_.push_back(reason);
   }
   const std::vector<std::string>& warnings() const { return warnings_; }
 
  private:
-  bool allow_;
+  bool allow_, clear_line_;
   std::vector<std::string> warnings_;
 };
 
@@ -82,19 +82,25 @@ class PoorResults {
 class Progress {
  public:
   explicit Progress(bool wanted) : shown_(wanted && isatty(STDERR_FILENO) == 1) {}
+  Progress(const Progress&) = delete;
+  Progress& operator=(const Progress&) = delete;
+  /// An error on its way out clears the line before it is printed.
+  ~Progress() { done(); }
+  bool shown() const { return shown_; }
   void stage(const std::string& text) {
-    if (!shown_) return;
     std::lock_guard<std::mutex> lock(mutex_);
-    show(text);
+    if (shown_) show(text);
   }
   void count(const std::string& text, size_t done, size_t total) {
-    if (!shown_) return;
     std::lock_guard<std::mutex> lock(mutex_);
+    if (!shown_) return;
     if (done < total && Clock::now() - last_ < std::chrono::milliseconds(100)) return;
     show(text + " " + std::to_string(done) + " of " + std::to_string(total));
   }
   void done() {
+    std::lock_guard<std::mutex> lock(mutex_);
     if (shown_) std::cerr << "\r\033[K" << std::flush;
+    shown_ = false;
   }
 
  private:
@@ -225,8 +231,8 @@ int runHull(const std::vector<std::string>& args) {
   if (parser.has("out-color-octree") && !parser.has("images")) {
     throw UsageError("--out-color-octree needs --images");
   }
-  PoorResults poor(parser.flag("allow-poor"));
   Progress progress(!parser.flag("json"));
+  PoorResults poor(parser.flag("allow-poor"), progress.shown());
   ViewSilhouettes found;
   const std::optional<Box3d> box = boxFromArgs(parser);
   const int max_reduction = maxInputReductionFromArgs(parser);
