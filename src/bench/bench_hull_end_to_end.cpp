@@ -21,10 +21,10 @@
 #include "args.h"
 #include "bench_measure.h"
 #include "bench_report.h"
+#include "bench_scene.h"
 #include "commands.h"
 #include "sift_hull/io/calibration.h"
 #include "sift_hull/synthetic/mask_render.h"
-#include "sift_hull/synthetic/scene.h"
 
 extern char** environ;
 
@@ -37,25 +37,18 @@ namespace fs = std::filesystem;
 /// The default sculpture on the sphere layout: each view's mask as a JPEG (quality 95, as cameras
 /// and tools write them), named view_NNNN.jpg, and scene_par.txt. Returns the files' MiB.
 double writeCase(const EndToEndCase& config, const fs::path& directory) {
-  SceneConfig scene;
-  scene.views = config.views;
-  scene.layout = "sphere";
-  scene.width_px = config.width_px;
-  scene.height_px = config.height_px;
-  const Shape shape = Shape::byName(scene.shape);
-  std::vector<CalibratedView> cameras = sceneCameras(scene, shape);
+  BenchScene scene = benchScene(config.views, config.width_px, config.height_px);
   double bytes = 0.0;
-  for (CalibratedView& view : cameras) {  // renderMask runs on OpenCV's threads
+  for (CalibratedView& view : scene.cameras) {  // renderMask runs on OpenCV's threads
     view.name = fs::path(view.name).stem().string() + ".jpg";
     const std::string path = (directory / view.name).string();
-    const cv::Mat mask =
-        renderMask(shape, view.camera, cv::Size(config.width_px, config.height_px));
+    const cv::Mat mask = renderMask(scene.shape, view.camera, scene.size);
     if (!cv::imwrite(path, mask, {cv::IMWRITE_JPEG_QUALITY, 95})) {
       throw std::runtime_error(path + ": cannot write the mask");
     }
     bytes += static_cast<double>(fs::file_size(path));
   }
-  writeMiddleburyPar((directory / "scene_par.txt").string(), cameras);
+  writeMiddleburyPar((directory / "scene_par.txt").string(), scene.cameras);
   return bytes / (1024.0 * 1024.0);
 }
 
@@ -136,11 +129,8 @@ std::string runRow(const EndToEndRun& run) {
 }  // namespace
 
 void addEndToEndOptions(ArgParser* parser) {
-  parser->addOption("end-to-end-views", "N", "views of the end-to-end case",
-                    std::to_string(EndToEndCase().views));
-  parser->addOption(
-      "end-to-end-size", "WxH", "image size of the end-to-end case",
-      std::to_string(EndToEndCase().width_px) + "x" + std::to_string(EndToEndCase().height_px));
+  addSceneOptions(parser, "end-to-end", "end-to-end case", EndToEndCase().views,
+                  EndToEndCase().width_px, EndToEndCase().height_px);
   parser->addOption("end-to-end-baseline-runs", "N",
                     "full-resolution processes of the end-to-end case (0 leaves the baseline out)",
                     std::to_string(EndToEndCase().baseline_runs));
@@ -148,16 +138,8 @@ void addEndToEndOptions(ArgParser* parser) {
 
 EndToEndCase endToEndCaseFromArgs(const ArgParser& parser) {
   EndToEndCase end_to_end;
-  end_to_end.views = parser.getInt("end-to-end-views");
-  if (end_to_end.views < 2) throw UsageError("--end-to-end-views must be at least 2");
-  const std::string size = parser.get("end-to-end-size");
-  const cv::Size parsed = parseSizeOption("--end-to-end-size", size);
-  if (parsed.width < 8 || parsed.height < 8 || parsed.width > 8192 || parsed.height > 8192) {
-    throw UsageError("--end-to-end-size expects WIDTHxHEIGHT, each side in [8, 8192], got '" +
-                     size + "'");
-  }
-  end_to_end.width_px = parsed.width;
-  end_to_end.height_px = parsed.height;
+  sceneFromArgs(parser, "end-to-end", &end_to_end.views, &end_to_end.width_px,
+                &end_to_end.height_px);
   end_to_end.baseline_runs = parser.getInt("end-to-end-baseline-runs");
   if (end_to_end.baseline_runs < 0) {
     throw UsageError("--end-to-end-baseline-runs must not be negative");

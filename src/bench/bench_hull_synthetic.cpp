@@ -14,10 +14,10 @@
 
 #include "bench_measure.h"
 #include "bench_report.h"
+#include "bench_scene.h"
 #include "bench_timing.h"
 #include "sift_hull/hull/reduced_distance_map.h"
 #include "sift_hull/synthetic/mask_render.h"
-#include "sift_hull/synthetic/scene.h"
 
 namespace sift_hull {
 namespace cli {
@@ -27,20 +27,13 @@ using Clock = std::chrono::steady_clock;
 
 /// The case's cameras and masks, each mask run-length encoded as soon as it is rendered.
 HullInput renderCase(const SyntheticHullCase& config, double* masks_mib) {
-  SceneConfig scene;
-  scene.views = config.views;
-  scene.layout = "sphere";
-  scene.width_px = config.width_px;
-  scene.height_px = config.height_px;
-  const Shape shape = Shape::byName(scene.shape);
-  const std::vector<CalibratedView> cameras = sceneCameras(scene, shape);
+  const BenchScene scene = benchScene(config.views, config.width_px, config.height_px);
   HullInput input;
   size_t bytes = 0;
-  for (const CalibratedView& view : cameras) {  // renderMask runs on OpenCV's threads
+  for (const CalibratedView& view : scene.cameras) {  // renderMask runs on OpenCV's threads
     input.names.push_back(view.name);
     input.cameras.push_back(view.camera);
-    input.run_length_masks.emplace_back(
-        renderMask(shape, view.camera, cv::Size(config.width_px, config.height_px)));
+    input.run_length_masks.emplace_back(renderMask(scene.shape, view.camera, scene.size));
   }
   for (const RunLengthMask& mask : input.run_length_masks) bytes += mask.memoryBytes();
   *masks_mib = bytes / (1024.0 * 1024.0);

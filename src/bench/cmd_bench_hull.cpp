@@ -18,6 +18,7 @@
 #include "bench_hull_synthetic.h"
 #include "bench_measure.h"
 #include "bench_report.h"
+#include "bench_scene.h"
 #include "commands.h"
 #include "hull_options.h"
 #include "pair_data.h"
@@ -345,17 +346,8 @@ int reportBench(const ArgParser& parser, const std::vector<DatasetRuns>& all,
 /// The synthetic case of --synthetic-views and --synthetic-size.
 SyntheticHullCase syntheticCase(const ArgParser& parser) {
   SyntheticHullCase synthetic_case;
-  synthetic_case.views = parser.getInt("synthetic-views");
-  if (synthetic_case.views < 2) throw UsageError("--synthetic-views must be at least 2");
-  const std::string size = parser.get("synthetic-size");
-  const cv::Size parsed = parseSizeOption("--synthetic-size", size);
-  synthetic_case.width_px = parsed.width;
-  synthetic_case.height_px = parsed.height;
-  if (synthetic_case.width_px < 8 || synthetic_case.height_px < 8 ||
-      synthetic_case.width_px > 8192 || synthetic_case.height_px > 8192) {
-    throw UsageError("--synthetic-size expects WIDTHxHEIGHT, each side in [8, 8192], got '" + size +
-                     "'");
-  }
+  sceneFromArgs(parser, "synthetic", &synthetic_case.views, &synthetic_case.width_px,
+                &synthetic_case.height_px);
   return synthetic_case;
 }
 
@@ -373,11 +365,8 @@ int runBenchHull(const std::vector<std::string>& args) {
   parser.addFlag("json", "print the result as one JSON object");
   parser.addFlag("synthetic-only", "run only the synthetic case (120 views of 4000x3000)");
   parser.addFlag("skip-synthetic", "leave the synthetic case out");
-  parser.addOption("synthetic-views", "N", "views of the synthetic case",
-                   std::to_string(SyntheticHullCase().views));
-  parser.addOption("synthetic-size", "WxH", "image size of the synthetic case",
-                   std::to_string(SyntheticHullCase().width_px) + "x" +
-                       std::to_string(SyntheticHullCase().height_px));
+  addSceneOptions(&parser, "synthetic", "synthetic case", SyntheticHullCase().views,
+                  SyntheticHullCase().width_px, SyntheticHullCase().height_px);
   parser.addFlag("end-to-end-only",
                  "run only the end-to-end case (whole hull processes on 120 JPEG masks of "
                  "4000x3000)");

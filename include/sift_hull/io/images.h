@@ -1,6 +1,7 @@
 #pragma once
 
 #include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <string>
 #include <vector>
 
@@ -11,8 +12,9 @@
 
 namespace sift_hull {
 
-/// Reads a colour image; throws std::runtime_error "PATH: image missing or unreadable".
-cv::Mat readImage(const std::string& path);
+/// Reads an image with cv::imread's `imread_flags` (a colour image by default); throws
+/// std::runtime_error "PATH: image missing or unreadable".
+cv::Mat readImage(const std::string& path, int imread_flags = cv::IMREAD_COLOR);
 
 /// Throws std::runtime_error naming the camera line (view.size_source) with its size and the image
 /// `image_path` with its own when the view's calibration gives an image size (width_px x

@@ -42,30 +42,40 @@ int64_t roundedFixed(double value) {
   return value >= 0.0 ? static_cast<int64_t>(value + 0.5) : -static_cast<int64_t>(0.5 - value);
 }
 
-std::vector<ProjectedVertex> projectVertices(const TriangleMesh& mesh,
-                                             const PinholeCamera& camera) {
-  std::vector<ProjectedVertex> projected(mesh.vertices_W.size());
+/// Calls visit(v, depth, x, y) for each vertex v of `mesh` in front of `camera` whose pixel lies
+/// within +-kMaxProjectedPx: its depth and its pixel in fixed point (kSubpixelScale).
+template <typename Visit>
+void forEachProjectedVertex(const TriangleMesh& mesh, const PinholeCamera& camera,
+                            const Visit& visit) {
   // Without distortion, P = K [R | t] directly: its last row gives the depth (K's is (0, 0, 1)).
   const bool ideal = !camera.distorted();
   const Matrix34d P = camera.projectionMatrix();
-  for (size_t v = 0; v < projected.size(); ++v) {
+  for (size_t v = 0; v < mesh.vertices_W.size(); ++v) {
     const Eigen::Vector3d X_W = mesh.vertices_W[v].cast<double>();
     Eigen::Vector2d pixel;
+    double depth = 0.0;
     if (ideal) {
       const Eigen::Vector3d p = P.leftCols<3>() * X_W + P.col(3);
-      projected[v].depth = p.z();
-      if (!(p.z() > 0.0)) continue;
-      pixel = p.head<2>() / p.z();
+      depth = p.z();
+      if (!(depth > 0.0)) continue;
+      pixel = p.head<2>() / depth;
     } else {
-      projected[v].depth = camera.depth(X_W);
-      if (!(projected[v].depth > 0.0)) continue;
+      depth = camera.depth(X_W);
+      if (!(depth > 0.0)) continue;
       pixel = camera.project(X_W);
     }
     if (!(pixel.cwiseAbs().maxCoeff() <= kMaxProjectedPx)) continue;
-    projected[v].pixel = {roundedFixed(pixel.x() * kSubpixelScale),
-                          roundedFixed(pixel.y() * kSubpixelScale)};
-    projected[v].usable = true;
+    visit(v, depth, roundedFixed(pixel.x() * kSubpixelScale),
+          roundedFixed(pixel.y() * kSubpixelScale));
   }
+}
+
+std::vector<ProjectedVertex> projectVertices(const TriangleMesh& mesh,
+                                             const PinholeCamera& camera) {
+  std::vector<ProjectedVertex> projected(mesh.vertices_W.size());
+  forEachProjectedVertex(mesh, camera, [&](size_t v, double depth, int64_t x, int64_t y) {
+    projected[v] = {{x, y}, depth, true};
+  });
   return projected;
 }
 
@@ -237,25 +247,10 @@ cv::Mat rasteriseMask(const TriangleMesh& mesh, const PinholeCamera& camera, cv:
   // their corners: the memory they take sets the pace); x = kUnusable where projectVertices would
   // call the vertex not usable.
   constexpr int32_t kUnusable = std::numeric_limits<int32_t>::min();
-  std::vector<std::array<int32_t, 2>> corners_px(mesh.vertices_W.size());
-  const bool ideal = !camera.distorted();
-  const Matrix34d P = camera.projectionMatrix();
-  for (size_t v = 0; v < corners_px.size(); ++v) {
-    const Eigen::Vector3d X_W = mesh.vertices_W[v].cast<double>();
-    Eigen::Vector2d pixel;
-    corners_px[v] = {kUnusable, 0};
-    if (ideal) {
-      const Eigen::Vector3d p = P.leftCols<3>() * X_W + P.col(3);
-      if (!(p.z() > 0.0)) continue;
-      pixel = p.head<2>() / p.z();
-    } else {
-      if (!(camera.depth(X_W) > 0.0)) continue;
-      pixel = camera.project(X_W);
-    }
-    if (!(pixel.cwiseAbs().maxCoeff() <= kMaxProjectedPx)) continue;
-    corners_px[v] = {static_cast<int32_t>(roundedFixed(pixel.x() * kSubpixelScale)),
-                     static_cast<int32_t>(roundedFixed(pixel.y() * kSubpixelScale))};
-  }
+  std::vector<std::array<int32_t, 2>> corners_px(mesh.vertices_W.size(), {kUnusable, 0});
+  forEachProjectedVertex(mesh, camera, [&](size_t v, double, int64_t x, int64_t y) {
+    corners_px[v] = {static_cast<int32_t>(x), static_cast<int32_t>(y)};
+  });
   for (const Eigen::Vector3i& face : mesh.faces) {
     const std::array<int32_t, 2>& a = corners_px[face[0]];
     const std::array<int32_t, 2>& b = corners_px[face[1]];

@@ -40,8 +40,8 @@ void checkImageSize(const CalibratedView& view, cv::Size image_size,
                            std::to_string(image_size.height));
 }
 
-cv::Mat readImage(const std::string& path) {
-  cv::Mat image = readImageFile(path, cv::IMREAD_COLOR);
+cv::Mat readImage(const std::string& path, int imread_flags) {
+  cv::Mat image = readImageFile(path, imread_flags);
   if (image.empty()) throw std::runtime_error(path + ": image missing or unreadable");
   return image;
 }

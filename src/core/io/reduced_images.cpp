@@ -10,6 +10,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include "sift_hull/io/images.h"
+
 namespace sift_hull {
 namespace {
 
@@ -95,12 +97,6 @@ int reducedFlag(int reduction, bool colour) {
   }
 }
 
-cv::Mat readFile(const std::string& path, int flags) {
-  cv::Mat image = std::ifstream(path).good() ? cv::imread(path, flags) : cv::Mat();
-  if (image.empty()) throw std::runtime_error(path + ": image missing or unreadable");
-  return image;
-}
-
 void checkReduction(int reduction) {
   if (!isDecodableReduction(reduction)) {
     throw std::invalid_argument("a reduction of " + std::to_string(reduction) +
@@ -155,7 +151,7 @@ cv::Size imageFileSize(const std::string& path) {
     size = jpegSize(in);
   }
   if (!size.empty()) return size;
-  return readFile(path, cv::IMREAD_GRAYSCALE).size();  // with its EXIF orientation applied
+  return readImage(path, cv::IMREAD_GRAYSCALE).size();  // with its EXIF orientation applied
 }
 
 cv::Mat reduceMask(const cv::Mat& mask, int reduction) {
@@ -168,17 +164,17 @@ cv::Mat reduceMask(const cv::Mat& mask, int reduction) {
 cv::Mat readMaskReduced(const std::string& path, int reduction) {
   checkReduction(reduction);
   if (reduction > 1 && hasJpegExtension(path)) {
-    return maskInside(readFile(path, reducedFlag(reduction, false)));
+    return maskInside(readImage(path, reducedFlag(reduction, false)));
   }
-  return reduceMask(readFile(path, cv::IMREAD_GRAYSCALE), reduction);
+  return reduceMask(readImage(path, cv::IMREAD_GRAYSCALE), reduction);
 }
 
 cv::Mat readImageReduced(const std::string& path, int reduction) {
   checkReduction(reduction);
   if (reduction > 1 && hasJpegExtension(path)) {
-    return readFile(path, reducedFlag(reduction, true));
+    return readImage(path, reducedFlag(reduction, true));
   }
-  const cv::Mat image = readFile(path, cv::IMREAD_COLOR);
+  const cv::Mat image = readImage(path, cv::IMREAD_COLOR);
   return reduction == 1 ? image : reducedByArea(image, reduction);
 }
 
