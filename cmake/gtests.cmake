@@ -49,6 +49,7 @@ set(SIFT_HULL_CORE_GTESTS
   test_pair_pipeline eval
   test_reduced_distance eval
   test_reduced_input eval
+  test_reduced_photographs eval
   test_hull_data eval
   test_hull_stream eval
   test_hull_stream_refusals eval

@@ -79,6 +79,7 @@ set(SIFT_HULL_IO_SOURCES
   src/core/io/ply.cpp
   src/core/io/reduced_images.cpp
   src/core/io/reduced_view_set.cpp
+  src/core/io/silhouette_loading.cpp
   src/core/io/view_list.cpp
   src/core/io/view_orientation.cpp
 )

@@ -87,11 +87,14 @@ excluded[test_silhouette_choice]+=":SilhouetteChoice.ViewsArrivingOneAtATimeAreS
 # Middlebury rings with the background method (60 s; the method runs on every background in
 # ComeCloseToTheExactMasksOnEveryBackground), the distorted 1600x1200 set at depth 8 (44 s; the
 # reduced maps run in test_reduced_distance, the distortion in the other cases) and the pocket
-# left by exact covisible points (65 s; carving with points runs in test_refine).
+# left by exact covisible points (65 s; carving with points runs in test_refine), and photographs
+# segmented at full resolution to compare with their reduced reading (the reduced reading runs in
+# ReducedPhotoHullInput.ReadsAndSegmentsEachViewAtTheReduction).
 excluded[test_cut_shapes]="Shape.CutShapesAreRenderedWhereTheirRaysFirstEnterTheSolid"
 excluded[test_silhouettes]="BackgroundSilhouettes.GiveTheMiddleburyRingsTheirHullWithoutAThreshold"
 excluded[test_distorted_scene]="DistortedScene.ReducedDistanceMapsKeepTheHullOfADistortedHighResolutionSet"
 excluded[test_dense_matching]="PairCovisiblePoints.CarveLessOfThePocketThanEachViewsOwnPoints"
+excluded[test_reduced_photographs]="ReducedPhotoHullInput.SegmentsAsWellAsAtFullResolution"
 # The binaries that took longest under the sanitizers, the longest first: they start first when
 # no earlier timing.txt gives the binaries' seconds.
 long_first=(test_photo_carving test_scene test_photo_stream test_point_carved_stream test_cut_shapes

@@ -240,9 +240,10 @@ int runHull(const std::vector<std::string>& args) {
   const auto on_view_read = [&](size_t read, size_t total) {
     progress.count("views read", read, total);
   };
-  HullInput input = max_reduction > 1
-                        ? reducedViewSetFromArgs(parser, config, box, max_reduction, on_view_read)
-                        : runLengthViewSetFromArgs(parser, &found);
+  HullInput input =
+      max_reduction > 1 || !parser.has("silhouettes")
+          ? reducedViewSetFromArgs(parser, config, box, max_reduction, &found, on_view_read)
+          : runLengthViewSetFromArgs(parser, &found);
   progress.stage("read " + std::to_string(input.viewCount()) + " views");
   writeSilhouettesFromArgs(parser, input.names, [&](size_t i) { return fullSizeMask(input, i); });
   writeViewPriorsFromArgs(parser, input.names, found);

@@ -75,8 +75,8 @@ HullInput runLengthViewSetFromArgs(const ArgParser& parser, ViewSilhouettes* rep
 void addInputReductionOption(ArgParser* parser) {
   parser->addOption("max-input-reduction", "N",
                     "largest reduction (1, 2, 4 or 8) at which mask files (--silhouettes) are "
-                    "decoded, each view's following from its finest voxel's footprint; 1: full "
-                    "resolution",
+                    "decoded, each view's following from its finest voxel's footprint, and at "
+                    "which photographs are segmented; 1: full resolution",
                     "8");
 }
 
@@ -87,15 +87,20 @@ int maxInputReductionFromArgs(const ArgParser& parser) {
   }
   const bool photographs = parser.flag("refine-with-matches") || parser.flag("photo-carve") ||
                            parser.has("holdout-view");
-  return photographs || !parser.has("silhouettes") ? 1 : most;
+  return photographs ? 1 : most;
 }
 
 HullInput reducedViewSetFromArgs(
     const ArgParser& parser, const HullConfig& config, const std::optional<Box3d>& box,
-    int max_reduction, const std::function<void(size_t read, size_t total)>& on_view_read) {
-  return loadReducedHullInput(parser.get("calib"), parser.get("images"),
-                              parser.get("silhouettes"), viewNamesFromArgs(parser), config, box,
-                              max_reduction, on_view_read);
+    int max_reduction, ViewSilhouettes* report,
+    const std::function<void(size_t read, size_t total)>& on_view_read) {
+  if (!parser.has("silhouettes")) {
+    return loadReducedPhotoHullInput(parser.get("calib"), parser.get("images"),
+                                     viewNamesFromArgs(parser), silhouetteConfigFromArgs(parser),
+                                     config, max_reduction, report, on_view_read);
+  }
+  return loadReducedHullInput(parser.get("calib"), parser.get("images"), parser.get("silhouettes"),
+                              viewNamesFromArgs(parser), config, box, max_reduction, on_view_read);
 }
 
 cv::Mat fullSizeMask(const HullInput& input, size_t view) {

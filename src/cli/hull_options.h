@@ -1,7 +1,7 @@
 #pragma once
 
-#include <nlohmann/json.hpp>
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -24,16 +24,20 @@ HullInput viewSetFromArgs(const ArgParser& parser);
 HullInput runLengthViewSetFromArgs(const ArgParser& parser, ViewSilhouettes* report = nullptr);
 
 /// --max-input-reduction: the largest reduction (1, 2, 4 or 8) at which `hull` decodes mask
-/// files, each view's following from its finest voxel's footprint (loadReducedHullInput).
+/// files, each view's following from its finest voxel's footprint (loadReducedHullInput), and at
+/// which it reads and segments photographs (loadReducedPhotoHullInput).
 void addInputReductionOption(ArgParser* parser);
-/// Its value; 1 (full resolution) without --silhouettes, and with --refine-with-matches,
-/// --photo-carve or --holdout-view, which use the photographs at full resolution.
+/// Its value; 1 (full resolution) with --refine-with-matches, --photo-carve or --holdout-view,
+/// which use the photographs at full resolution.
 int maxInputReductionFromArgs(const ArgParser& parser);
 /// The views with their masks decoded at the reductions their footprints allow, up to
-/// `max_reduction` (loadReducedHullInput; `box` is --box when given).
+/// `max_reduction` (loadReducedHullInput; `box` is --box when given); without --silhouettes, the
+/// photographs read and segmented at photographReduction() (loadReducedPhotoHullInput, which
+/// fills `report`).
 HullInput reducedViewSetFromArgs(
     const ArgParser& parser, const HullConfig& config, const std::optional<Box3d>& box,
-    int max_reduction, const std::function<void(size_t read, size_t total)>& on_view_read = {});
+    int max_reduction, ViewSilhouettes* report = nullptr,
+    const std::function<void(size_t read, size_t total)>& on_view_read = {});
 /// View `view`'s mask at its image's full size: a reduced mask enlarged (its outline
 /// interpolated), else the mask itself.
 cv::Mat fullSizeMask(const HullInput& input, size_t view);

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <functional>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <string>
@@ -38,6 +39,13 @@ struct ViewImage {
 /// NeRF synthetic scenes' RGBA images, cut-outs). Other files are decoded as loadViewImage does.
 ViewImage loadViewImageWithAlpha(const std::string& directory, const CalibratedView& view);
 
+/// loadViewImageWithAlpha() reduced `reduction` times (1, 2, 4 or 8), the image and its alpha mask
+/// alike: a JPEG decoded at that scale (readImageReduced), another file decoded whole and reduced
+/// by area (reduceImage, reduceMask). `full_size` gets the image's full size, which is checked
+/// against the view's calibration (checkImageSize). Throws as loadViewImageWithAlpha() does.
+ViewImage loadReducedViewImage(const std::string& directory, const CalibratedView& view,
+                               int reduction, cv::Size* full_size);
+
 /// The mask file of an image in `mask_directory`: the image's own name when that file exists,
 /// else the one file whose name is the same number under another width or extension
 /// (image/000012.png and mask/012.png in IDR / DTU sets); else the own name, which the reader
@@ -71,5 +79,17 @@ std::vector<RunLengthMask> loadRunLengthSilhouettes(const std::vector<Calibrated
                                                     const std::string& mask_directory,
                                                     const SilhouetteConfig& recipe,
                                                     ViewSilhouettes* report = nullptr);
+
+/// loadRunLengthSilhouettes() of photographs read `reduction` times reduced (1, 2, 4 or 8;
+/// loadReducedViewImage): the silhouettes are made at that size, by the recipe with its radii
+/// (dilate_px, erode_px, in full-resolution pixels) divided by it, the "views" method with the
+/// cameras PinholeCamera::reduced() alike; each is reducedSize(image size, reduction). A mask
+/// directory needs `reduction` 1. `on_view_read(read, total)`, when given, is called from
+/// OpenCV's threads (at times at once) as each view is read.
+std::vector<RunLengthMask> loadReducedRunLengthSilhouettes(
+    const std::vector<CalibratedView>& views, const std::string& image_directory,
+    const std::string& mask_directory, const SilhouetteConfig& recipe, int reduction,
+    ViewSilhouettes* report = nullptr,
+    const std::function<void(size_t read, size_t total)>& on_view_read = {});
 
 }  // namespace sift_hull

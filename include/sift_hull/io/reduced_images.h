@@ -42,4 +42,8 @@ cv::Mat reduceMask(const cv::Mat& mask, int reduction);
 /// std::runtime_error naming the path when it is unreadable.
 cv::Mat readImageReduced(const std::string& path, int reduction);
 
+/// An image reduced by area `reduction` times (1, 2, 4 or 8) to reducedSize() (the last row and
+/// column from what is left), as readImageReduced() reduces a file it cannot decode at scale.
+cv::Mat reduceImage(const cv::Mat& image, int reduction);
+
 }  // namespace sift_hull

@@ -58,4 +58,22 @@ HullInput loadReducedHullInput(
     const HullConfig& config, const std::optional<Box3d>& box, int max_reduction,
     const std::function<void(size_t read, size_t total)>& on_view_read = {});
 
+/// The reduction (1, 2, 4 or 8, at most `max_reduction`) at which photographs of `image_size` are
+/// read and segmented for a hull of `max_depth`: the largest at which the finest voxel still
+/// covers a pixel when the hull's box spans half the image's longest side, and the image keeps
+/// `segment_side_px` (the "views" method's working size) on its longest side; 1 below 2 MP
+/// (kMinReducedImagePixels), as for mask files.
+int photographReduction(cv::Size image_size, int max_depth, int segment_side_px, int max_reduction);
+
+/// Reduced loading, for silhouettes segmented from the photographs (no mask files): every view is
+/// read at photographReduction() of the first image's size (from its header) and segmented at that
+/// size (loadReducedRunLengthSilhouettes), its camera PinholeCamera::reduced() alike
+/// (HullInput::reductions, HullInput::image_sizes). `report` and `on_view_read` as there;
+/// `max_reduction` 1 gives loadRunLengthHullInput's input.
+HullInput loadReducedPhotoHullInput(
+    const std::string& calibration_path, const std::string& image_directory,
+    const std::vector<std::string>& view_names, const SilhouetteConfig& recipe,
+    const HullConfig& config, int max_reduction, ViewSilhouettes* report = nullptr,
+    const std::function<void(size_t read, size_t total)>& on_view_read = {});
+
 }  // namespace sift_hull

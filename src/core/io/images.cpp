@@ -112,6 +112,25 @@ ViewImage loadViewImageWithAlpha(const std::string& directory, const CalibratedV
   return image;
 }
 
+ViewImage loadReducedViewImage(const std::string& directory, const CalibratedView& view,
+                               int reduction, cv::Size* full_size) {
+  const std::string path = directory + "/" + view.name;
+  if (reduction > 1 && !view.name.empty() && hasJpegExtension(path) && std::ifstream(path).good()) {
+    *full_size = imageFileSize(path);
+    checkImageSize(view, *full_size, path);
+    cv::Mat bgr = readImageReduced(path, reduction);
+    if (bgr.size() == reducedSize(*full_size, reduction)) return {bgr, cv::Mat()};
+    // Named .jpg but not decoded at scale (not a JPEG): decoded whole below.
+  }
+  ViewImage image = loadViewImageWithAlpha(directory, view);
+  *full_size = image.bgr.size();
+  if (reduction > 1) {
+    image.bgr = reduceImage(image.bgr, reduction);
+    if (!image.alpha_mask.empty()) image.alpha_mask = reduceMask(image.alpha_mask, reduction);
+  }
+  return image;
+}
+
 std::string maskPath(const std::string& mask_directory, const std::string& image_name) {
   const std::string same = mask_directory + "/" + image_name;
   if (std::ifstream(same).good()) return same;
@@ -146,157 +165,6 @@ cv::Mat loadMask(const std::string& path) {
   const cv::Mat raw = readImageFile(path, cv::IMREAD_GRAYSCALE);
   if (raw.empty()) throw std::runtime_error(path + ": mask missing or unreadable");
   return maskInside(raw);
-}
-
-namespace {
-
-/// loadSilhouettes, each silhouette converted by `keep` (cv::Mat -> Kept) as soon as it is made.
-template <typename Kept, typename Keep>
-std::vector<Kept> loadSilhouettesAs(const std::vector<CalibratedView>& views,
-                                    const std::string& image_directory,
-                                    const std::string& mask_directory,
-                                    const SilhouetteConfig& recipe, const Keep& keep,
-                                    ViewSilhouettes* report) {
-  bool choose = recipe.silhouette_method == "auto";
-  const bool together = mask_directory.empty() && (choose || recipe.silhouette_method == "views") &&
-                        views.size() >= 2;
-  // Each view read and its silhouette made on OpenCV's threads, one image in memory per thread;
-  // then the checks in view order, so the first error is the one a sequential read would meet.
-  struct Loaded {
-    cv::Size image_size, silhouette_size;
-    Kept silhouette;
-    cv::Mat working;  ///< the "views" method: the image at the working size, until all are read
-    cv::Mat plain;    ///< the "auto" method: the background method's silhouette, plain borders
-    bool pending = false;
-    std::exception_ptr error;
-  };
-  std::vector<Loaded> loaded(views.size());
-  cv::parallel_for_(cv::Range(0, static_cast<int>(views.size())), [&](const cv::Range& range) {
-    for (int i = range.start; i < range.end; ++i) {
-      try {
-        cv::Mat silhouette;
-        if (mask_directory.empty()) {
-          // An image with an alpha channel carries its own silhouette.
-          const ViewImage image = loadViewImageWithAlpha(image_directory, views[i]);
-          loaded[i].image_size = image.bgr.size();
-          if (!image.alpha_mask.empty()) {
-            silhouette = image.alpha_mask;
-          } else if (together) {
-            cv::resize(image.bgr, loaded[i].working,
-                       workingSize(image.bgr.size(), recipe.segment_side_px), 0, 0, cv::INTER_AREA);
-            if (choose) loaded[i].plain = plainBackgroundSilhouette(image.bgr, recipe);
-            loaded[i].pending = true;
-            continue;
-          } else {
-            silhouette = silhouetteFromImage(image.bgr, recipe);
-          }
-        } else {
-          loaded[i].image_size = loadViewImage(image_directory, views[i]).size();
-          silhouette = loadMask(maskPath(mask_directory, views[i].name));
-        }
-        loaded[i].silhouette_size = silhouette.size();
-        loaded[i].silhouette = keep(silhouette);
-      } catch (...) {
-        loaded[i].error = std::current_exception();
-      }
-    }
-  });
-  std::vector<Kept> silhouettes;
-  for (size_t i = 0; i < views.size(); ++i) {
-    const CalibratedView& view = views[i];
-    // A sequential read meets a bad image, then a size other than the first's, then a bad mask.
-    if (loaded[i].error && loaded[i].image_size.empty()) std::rethrow_exception(loaded[i].error);
-    const cv::Size size = loaded[i].image_size;
-    if (i > 0 && size != loaded[0].image_size) {
-      throw std::runtime_error(image_directory + "/" + view.name + ": image size differs from " +
-                               views.front().name + "'s (" + std::to_string(size.width) + "x" +
-                               std::to_string(size.height) + ", not " +
-                               std::to_string(loaded[0].image_size.width) + "x" +
-                               std::to_string(loaded[0].image_size.height) +
-                               "): one calibration set is for one image size");
-    }
-    if (loaded[i].error) std::rethrow_exception(loaded[i].error);
-    if (loaded[i].pending) {
-      silhouettes.emplace_back();
-      continue;
-    }
-    if (loaded[i].silhouette_size != size) {
-      throw std::runtime_error(mask_directory + "/" + view.name +
-                               ": mask size differs from the image's");
-    }
-    silhouettes.push_back(std::move(loaded[i].silhouette));
-  }
-  const bool any_pending =
-      std::any_of(loaded.begin(), loaded.end(), [](const Loaded& l) { return l.pending; });
-  if (!any_pending) return silhouettes;
-  // The "views" method: every view's working-size image at once, with the cameras.
-  std::vector<cv::Mat> working;
-  std::vector<PinholeCamera> cameras;
-  std::vector<std::string> names;
-  const cv::Size size = workingSize(loaded[0].image_size, recipe.segment_side_px);
-  for (size_t i = 0; i < views.size(); ++i) {
-    if (loaded[i].working.empty()) {  // a view with its own alpha mask: read again, small
-      cv::resize(loadViewImage(image_directory, views[i]), loaded[i].working, size, 0, 0,
-                 cv::INTER_AREA);
-    }
-    working.push_back(std::move(loaded[i].working));
-    cameras.push_back(views[i].camera);
-    names.push_back(views[i].name);
-  }
-  ViewSilhouettes found;
-  try {
-    found = silhouettesFromViews(working, cameras, names, loaded[0].image_size, recipe);
-  } catch (const std::runtime_error& e) {
-    if (!choose) throw;
-    // auto: each view's own silhouette by the background method, as for one image alone.
-    found = {};
-    found.method = "background";
-    found.background_reason = std::string("the views method failed: ") + e.what();
-    found.warnings.push_back(found.background_reason + "; each view's own silhouette is used");
-    SilhouetteConfig background = recipe;
-    background.silhouette_method = "background";
-    for (size_t i = 0; i < views.size(); ++i) {
-      found.masks.push_back(
-          !loaded[i].pending || !loaded[i].plain.empty()
-              ? loaded[i].plain
-              : silhouetteFromImage(loadViewImage(image_directory, views[i]), background));
-    }
-    choose = false;
-  }
-  if (choose) {
-    std::vector<cv::Mat> plain;
-    for (Loaded& l : loaded) plain.push_back(l.pending ? std::move(l.plain) : cv::Mat());
-    chooseBackgroundWhereItAgrees(&found, std::move(plain), names, cameras, recipe);
-  }
-  for (size_t i = 0; i < views.size(); ++i) {
-    if (loaded[i].pending) silhouettes[i] = keep(found.masks[i]);
-  }
-  if (report != nullptr) {
-    found.masks.clear();
-    *report = std::move(found);
-  }
-  return silhouettes;
-}
-
-}  // namespace
-
-std::vector<cv::Mat> loadSilhouettes(const std::vector<CalibratedView>& views,
-                                     const std::string& image_directory,
-                                     const std::string& mask_directory,
-                                     const SilhouetteConfig& recipe, ViewSilhouettes* report) {
-  return loadSilhouettesAs<cv::Mat>(
-      views, image_directory, mask_directory, recipe,
-      [](const cv::Mat& silhouette) { return silhouette; }, report);
-}
-
-std::vector<RunLengthMask> loadRunLengthSilhouettes(const std::vector<CalibratedView>& views,
-                                                    const std::string& image_directory,
-                                                    const std::string& mask_directory,
-                                                    const SilhouetteConfig& recipe,
-                                                    ViewSilhouettes* report) {
-  return loadSilhouettesAs<RunLengthMask>(
-      views, image_directory, mask_directory, recipe,
-      [](const cv::Mat& silhouette) { return RunLengthMask(silhouette); }, report);
 }
 
 }  // namespace sift_hull

@@ -174,7 +174,11 @@ cv::Mat readImageReduced(const std::string& path, int reduction) {
   if (reduction > 1 && hasJpegExtension(path)) {
     return readImage(path, reducedFlag(reduction, true));
   }
-  const cv::Mat image = readImage(path, cv::IMREAD_COLOR);
+  return reduceImage(readImage(path, cv::IMREAD_COLOR), reduction);
+}
+
+cv::Mat reduceImage(const cv::Mat& image, int reduction) {
+  checkReduction(reduction);
   return reduction == 1 ? image : reducedByArea(image, reduction);
 }
 

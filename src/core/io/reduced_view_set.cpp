@@ -1,7 +1,9 @@
-// Reduced loading of a view set with mask files (sift_hull/io/view_list.h,
-// loadReducedHullInput).
+// Reduced loading of a view set (sift_hull/io/view_list.h): with mask files
+// (loadReducedHullInput), or with photographs to segment (loadReducedPhotoHullInput).
 
+#include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <exception>
 #include <opencv2/core/utility.hpp>
 #include <stdexcept>
@@ -112,11 +114,12 @@ std::optional<Box3d> coarseBox(const std::vector<CalibratedView>& views,
 
 }  // namespace
 
-HullInput loadReducedHullInput(
-    const std::string& calibration_path, const std::string& image_directory,
-    const std::string& mask_directory, const std::vector<std::string>& view_names,
-    const HullConfig& config, const std::optional<Box3d>& box, int max_reduction,
-    const std::function<void(size_t read, size_t total)>& on_view_read) {
+HullInput loadReducedHullInput(const std::string& calibration_path,
+                               const std::string& image_directory,
+                               const std::string& mask_directory,
+                               const std::vector<std::string>& view_names, const HullConfig& config,
+                               const std::optional<Box3d>& box, int max_reduction,
+                               const std::function<void(size_t read, size_t total)>& on_view_read) {
   if (!isDecodableReduction(max_reduction)) {
     throw std::invalid_argument("loadReducedHullInput: max_reduction must be 1, 2, 4 or 8");
   }
@@ -182,6 +185,49 @@ HullInput loadReducedHullInput(
     input.names.push_back(views[i].name);
     input.cameras.push_back(views[i].camera.reduced(input.reductions[i]));
     input.image_sizes.push_back(read[i].size);
+  }
+  return input;
+}
+
+int photographReduction(cv::Size image_size, int max_depth, int segment_side_px,
+                        int max_reduction) {
+  if (!isDecodableReduction(max_reduction)) {
+    throw std::invalid_argument("photographReduction: max_reduction must be 1, 2, 4 or 8");
+  }
+  if (image_size.area() < kMinReducedImagePixels || max_depth < 0 || max_depth > 30) return 1;
+  // The finest voxel's footprint when the box spans half the image's longest side.
+  const double needed_px =
+      std::max(std::ldexp(1.0, max_depth + 1), static_cast<double>(segment_side_px));
+  const double longest_px = std::max(image_size.width, image_size.height);
+  const int allowed = static_cast<int>(std::clamp(std::floor(longest_px / needed_px), 1.0, 8.0));
+  return decodableAtMost(std::min(allowed, max_reduction));
+}
+
+HullInput loadReducedPhotoHullInput(
+    const std::string& calibration_path, const std::string& image_directory,
+    const std::vector<std::string>& view_names, const SilhouetteConfig& recipe,
+    const HullConfig& config, int max_reduction, ViewSilhouettes* report,
+    const std::function<void(size_t read, size_t total)>& on_view_read) {
+  const std::vector<CalibratedView> views =
+      hullViews(calibration_path, image_directory, view_names);
+  cv::Size size;  // the first image's, from its header; the loader checks the others against it
+  if (!views.empty() && !views.front().name.empty()) {
+    try {
+      size = imageFileSize(image_directory + "/" + views.front().name);
+    } catch (const std::runtime_error&) {
+      // Missing or unreadable: the loader names it as it names any other view.
+    }
+  }
+  const int reduction =
+      photographReduction(size, config.max_depth, recipe.segment_side_px, max_reduction);
+  HullInput input;
+  input.run_length_masks = loadReducedRunLengthSilhouettes(views, image_directory, "", recipe,
+                                                           reduction, report, on_view_read);
+  for (const CalibratedView& view : views) {
+    input.names.push_back(view.name);
+    input.cameras.push_back(view.camera.reduced(reduction));
+    input.reductions.push_back(reduction);
+    input.image_sizes.push_back(size);
   }
   return input;
 }
