@@ -78,7 +78,7 @@ TEST_F(CupStream, PointsWaitForTheBoxThenCarveTheCavityAndNothingOfTheSolid) {
 }
 
 TEST_F(CupStream, ARefinementInSlicesCarvesWhatOneAtOnceCarves) {
-  PointCarvedStream whole(streamConfig(7), {}), sliced(streamConfig(7), {});
+  PointCarvedStream whole(streamConfig(6), {}), sliced(streamConfig(6), {});
   for (PointCarvedStream* stream : {&whole, &sliced}) {
     for (uint32_t v = 0; v < scene.views.size(); ++v) addPoints(stream, v);
     for (size_t v = 0; v < scene.views.size(); ++v) addView(stream, v);
