@@ -25,6 +25,7 @@
 #include "commands.h"
 #include "sift_hull/io/calibration.h"
 #include "sift_hull/synthetic/mask_render.h"
+#include "sift_hull/synthetic/scene.h"
 
 extern char** environ;
 
@@ -35,17 +36,23 @@ namespace {
 namespace fs = std::filesystem;
 
 /// The default sculpture on the sphere layout: each view's mask as a JPEG (quality 95, as cameras
-/// and tools write them), named view_NNNN.jpg, and scene_par.txt. Returns the files' MiB.
+/// and tools write them), or its photograph on a floor (quality 92), named view_NNNN.jpg, and
+/// scene_par.txt. Returns the files' MiB.
 double writeCase(const EndToEndCase& config, const fs::path& directory) {
-  BenchScene scene = benchScene(config.views, config.width_px, config.height_px);
+  BenchScene scene = benchScene(config.views, config.width_px, config.height_px,
+                                config.photographs ? "floor" : "none");
   double bytes = 0.0;
-  for (CalibratedView& view : scene.cameras) {  // renderMask runs on OpenCV's threads
+  for (CalibratedView& view : scene.cameras) {  // the renderers run on OpenCV's threads
     view.name = fs::path(view.name).stem().string() + ".jpg";
     const std::string path = (directory / view.name).string();
-    const cv::Mat mask = renderMask(scene.shape, view.camera, scene.size);
-    if (!cv::imwrite(path, mask, {cv::IMWRITE_JPEG_QUALITY, 95})) {
-      throw std::runtime_error(path + ": cannot write the mask");
-    }
+    const bool written =
+        config.photographs
+            ? cv::imwrite(path,
+                          renderView(scene.shape, view, scene.size, 1, "black", "floor").image,
+                          {cv::IMWRITE_JPEG_QUALITY, 92})
+            : cv::imwrite(path, renderMask(scene.shape, view.camera, scene.size),
+                          {cv::IMWRITE_JPEG_QUALITY, 95});
+    if (!written) throw std::runtime_error(path + ": cannot write the image");
     bytes += static_cast<double>(fs::file_size(path));
   }
   writeMiddleburyPar((directory / "scene_par.txt").string(), scene.cameras);
@@ -134,6 +141,9 @@ void addEndToEndOptions(ArgParser* parser) {
   parser->addOption("end-to-end-baseline-runs", "N",
                     "full-resolution processes of the end-to-end case (0 leaves the baseline out)",
                     std::to_string(EndToEndCase().baseline_runs));
+  parser->addFlag("end-to-end-photographs",
+                  "photographs of the sculpture on a floor instead of its masks: the processes "
+                  "segment them (the default silhouette method)");
 }
 
 EndToEndCase endToEndCaseFromArgs(const ArgParser& parser) {
@@ -144,6 +154,7 @@ EndToEndCase endToEndCaseFromArgs(const ArgParser& parser) {
   if (end_to_end.baseline_runs < 0) {
     throw UsageError("--end-to-end-baseline-runs must not be negative");
   }
+  end_to_end.photographs = parser.flag("end-to-end-photographs");
   return end_to_end;
 }
 
@@ -157,18 +168,17 @@ EndToEndBench benchEndToEndHull(const EndToEndCase& config) {
   const fs::path directory = pattern;
   try {
     const auto start = std::chrono::steady_clock::now();
-    bench.masks_mib = writeCase(config, directory);
+    bench.files_mib = writeCase(config, directory);
     bench.write_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    const std::vector<std::string> common = {"hull",
-                                             "--calib",
-                                             (directory / "scene_par.txt").string(),
-                                             "--images",
-                                             directory.string(),
-                                             "--silhouettes",
-                                             directory.string(),
-                                             "--max-depth",
-                                             std::to_string(config.max_depth),
-                                             "--json"};
+    std::vector<std::string> common = {"hull",
+                                       "--calib",
+                                       (directory / "scene_par.txt").string(),
+                                       "--images",
+                                       directory.string(),
+                                       "--max-depth",
+                                       std::to_string(config.max_depth),
+                                       "--json"};
+    if (!config.photographs) common.insert(common.end(), {"--silhouettes", directory.string()});
     bench.reduced.setting = "reduced decoding (default)";
     bench.reduced.arguments = common;
     bench.full.setting = "full resolution (`--max-input-reduction 1`)";
@@ -193,7 +203,8 @@ nlohmann::json endToEndJson(const EndToEndBench& bench) {
                          {"max_depth", c.max_depth},
                          {"cpu", cpuModel()},
                          {"write_s", bench.write_s},
-                         {"jpeg_masks_mib", bench.masks_mib},
+                         {"input", c.photographs ? "photographs" : "masks"},
+                         {"jpeg_files_mib", bench.files_mib},
                          {"reduced", runJson(bench.reduced)}};
   nlohmann::json measurements = {{"end_to_end_wall_s", json["reduced"]["median_wall_s"]},
                                  {"end_to_end_peak_mib", json["reduced"]["median_peak_mib"]}};
@@ -210,11 +221,17 @@ nlohmann::json endToEndJson(const EndToEndBench& bench) {
 std::string endToEndMarkdown(const EndToEndBench& bench) {
   const EndToEndCase& c = bench.config;
   std::ostringstream out;
-  out << "End-to-end case: " << c.views << " JPEG masks of " << c.width_px << "x" << c.height_px
-      << " (the default sculpture, sphere layout, `renderMask` written at quality 95: "
-      << fixed(bench.masks_mib, 1) << " MiB, written in " << fixed(bench.write_s, 1)
-      << " s), `sift_hull hull --calib scene_par.txt --images DIR --silhouettes DIR --max-depth "
-      << c.max_depth << " --json` as a child process; wall time and peak resident memory "
+  out << "End-to-end case: " << c.views
+      << (c.photographs ? " JPEG photographs of " : " JPEG masks of ") << c.width_px << "x"
+      << c.height_px
+      << (c.photographs
+              ? " (the default sculpture on a floor, sphere layout, `renderView` written at "
+                "quality 92: "
+              : " (the default sculpture, sphere layout, `renderMask` written at quality 95: ")
+      << fixed(bench.files_mib, 1) << " MiB, written in " << fixed(bench.write_s, 1)
+      << " s), `sift_hull hull --calib scene_par.txt --images DIR "
+      << (c.photographs ? "" : "--silhouettes DIR ") << "--max-depth " << c.max_depth
+      << " --json` as a child process; wall time and peak resident memory "
       << "(ru_maxrss) of the whole process, medians of " << bench.reduced.wall_s.size()
       << " processes with reduced decoding and " << bench.full.wall_s.size()
       << " at full resolution, 2 cores, CPU " << cpuModel()

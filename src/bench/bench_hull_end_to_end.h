@@ -18,8 +18,11 @@ struct EndToEndCase {
   int width_px = 4000;
   int height_px = 3000;
   int max_depth = 9;
-  int runs = 3;            ///< processes per setting; wall times and peaks are their medians
-  int baseline_runs = 1;   ///< full-resolution processes (each takes tens of seconds)
+  int runs = 3;           ///< processes per setting; wall times and peaks are their medians
+  int baseline_runs = 1;  ///< full-resolution processes (each takes tens of seconds)
+  /// Photographs of the sculpture on a floor (JPEG, quality 92) instead of its masks: the
+  /// processes segment them (the default silhouette method), reading them at a reduction.
+  bool photographs = false;
   std::string executable;  ///< sift_hull; empty: the one beside this program
 };
 
@@ -34,11 +37,12 @@ struct EndToEndRun {
 struct EndToEndBench {
   EndToEndCase config;
   double write_s = 0.0;    ///< rendering and writing the masks
-  double masks_mib = 0.0;  ///< the JPEG files on disk
+  double files_mib = 0.0;  ///< the JPEG files on disk
   EndToEndRun reduced, full;
 };
 
-/// --end-to-end-views, --end-to-end-size and --end-to-end-baseline-runs, and the case they give.
+/// --end-to-end-views, --end-to-end-size, --end-to-end-baseline-runs and
+/// --end-to-end-photographs, and the case they give.
 void addEndToEndOptions(ArgParser* parser);
 EndToEndCase endToEndCaseFromArgs(const ArgParser& parser);
 

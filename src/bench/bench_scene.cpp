@@ -5,12 +5,13 @@
 namespace sift_hull {
 namespace cli {
 
-BenchScene benchScene(int views, int width_px, int height_px) {
+BenchScene benchScene(int views, int width_px, int height_px, const std::string& support) {
   SceneConfig scene;
   scene.views = views;
   scene.layout = "sphere";
   scene.width_px = width_px;
   scene.height_px = height_px;
+  scene.support = support;
   BenchScene bench{Shape::byName(scene.shape), {}, cv::Size(width_px, height_px)};
   bench.cameras = sceneCameras(scene, bench.shape);
   return bench;

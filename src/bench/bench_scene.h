@@ -12,13 +12,14 @@
 namespace sift_hull {
 namespace cli {
 
-/// The default sculpture seen by `views` cameras on the sphere layout, each image `size`.
+/// The default sculpture seen by `views` cameras on the sphere layout, each image `size`; with a
+/// `support` (SceneConfig::support), the cameras are above it.
 struct BenchScene {
   Shape shape;
   std::vector<CalibratedView> cameras;
   cv::Size size;
 };
-BenchScene benchScene(int views, int width_px, int height_px);
+BenchScene benchScene(int views, int width_px, int height_px, const std::string& support = "none");
 
 /// Adds --NAME-views N and --NAME-size WxH with these defaults, `what` naming the case in the help.
 void addSceneOptions(ArgParser* parser, const std::string& name, const std::string& what, int views,

@@ -335,7 +335,10 @@ int reportBench(const ArgParser& parser, const std::vector<DatasetRuns>& all,
     json["end_to_end"] = endToEndJson(*end_to_end);
     const std::string end_to_end_report = endToEndMarkdown(*end_to_end);
     if (parser.has("write")) {
-      replaceMarkedSection(parser.get("write"), "bench-hull-end-to-end", end_to_end_report);
+      replaceMarkedSection(parser.get("write"),
+                           end_to_end->config.photographs ? "bench-hull-end-to-end-photographs"
+                                                          : "bench-hull-end-to-end",
+                           end_to_end_report);
     }
     report += (report.empty() ? "" : "\n") + end_to_end_report;
   }
