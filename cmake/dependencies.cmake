@@ -18,3 +18,5 @@ find_library(OPENBLAS_LIBRARY openblas REQUIRED)
 # Debian ships a pkg-config file for it, no CMake one.
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(minizip REQUIRED IMPORTED_TARGET minizip)
+# SQLite (libsqlite3-dev): the colmap filter reads the database COLMAP writes.
+find_package(SQLite3 REQUIRED)

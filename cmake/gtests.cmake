@@ -26,6 +26,8 @@ set(SIFT_HULL_CORE_GTESTS
   test_filters eval
   test_local_filters eval
   test_two_view_models eval
+  test_scaled_residuals eval
+  test_colmap_verification eval
   test_vote_ransac eval
   test_filter_ranges eval
   test_densest_window core

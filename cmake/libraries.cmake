@@ -33,7 +33,7 @@ function(sift_hull_add_libraries)
     ${OPENBLAS_INCLUDE_DIR})
   target_link_libraries(${core} PUBLIC ${OpenCV_LIBS} Eigen3::Eigen ${OCTOMAP_LIBRARIES}
     Threads::Threads PRIVATE VTK::CommonCore VTK::CommonDataModel ${GLPK_LIBRARY}
-    ${OPENBLAS_LIBRARY})
+    ${OPENBLAS_LIBRARY} SQLite::SQLite3)
 
   set(io sift_hull_io${ARG_SUFFIX})
   add_library(${io} ${type} ${IO})

@@ -18,6 +18,7 @@ set(SIFT_HULL_CORE_SOURCES
   src/core/features/sift.cpp
   src/core/features/triangulation.cpp
   src/core/filters/densest_window.cpp
+  src/core/filters/colmap_verification.cpp
   src/core/filters/epipolar.cpp
   src/core/filters/filter.cpp
   src/core/filters/filter_settings.cpp
@@ -27,6 +28,7 @@ set(SIFT_HULL_CORE_SOURCES
   src/core/filters/local_consistency.cpp
   src/core/filters/ratio.cpp
   src/core/filters/robust_fit.cpp
+  src/core/filters/scaled_residuals.cpp
   src/core/filters/spatial_neighbours.cpp
   src/core/filters/two_view_fit.cpp
   src/core/filters/two_view_models.cpp
@@ -109,6 +111,7 @@ set(SIFT_HULL_EXACT_FLOAT_SOURCES
   src/core/filters/gsc.cpp
   src/core/filters/guided.cpp
   src/core/filters/local_consistency.cpp
+  src/core/filters/scaled_residuals.cpp
   src/core/filters/two_view_fit.cpp
   src/core/filters/two_view_models.cpp
   src/core/filters/vote_ransac.cpp

@@ -15,6 +15,7 @@
 #include "match_eval.h"
 #include "pair_data.h"
 #include "sift_hull/features/labelled_matches.h"
+#include "sift_hull/filters/colmap_verification.h"
 #include "sift_hull/filters/filter.h"
 #include "sift_hull/synthetic/scene.h"
 #include "sift_hull/synthetic/warped_pairs.h"
@@ -50,7 +51,7 @@ EvaluationPair warpedEvaluationPair(const std::string& name, const WarpedPair& w
 /// The filters whose answer depends on a random state.
 bool randomised(const std::string& name) {
   return name == "ransac" || name == "magsac" || name == "guided" || name == "vote_ransac" ||
-         name == "best";
+         name == "best" || name == "colmap";
 }
 
 constexpr int kSeeds = 5;
@@ -122,12 +123,56 @@ nlohmann::json summaryJson(const nlohmann::json& rows) {
     for (double v : values) sum += v;
     summary["mean_f1"][name] = {{"mean", sum / values.size()}, {"pairs", values.size()}};
   }
+  // Each pair's strongest other filter (vote_ransac is best under its own name: not a peer).
+  nlohmann::json peers = nlohmann::json::array();
+  double worst_peer_gap = INFINITY;
+  std::string worst_peer_pair;
+  for (const auto& row : rows) {
+    const auto& filters = row["filters"];
+    if (!filters.contains("best")) continue;
+    const auto f1Of = [](const nlohmann::json& run) {
+      return run["f1"].is_null() ? 0.0 : run["f1"].get<double>();
+    };
+    std::string peer;
+    double peer_f1 = -1.0;
+    for (const auto& [name, run] : filters.items()) {
+      if (name == "best" || name == "vote_ransac" || f1Of(run) <= peer_f1) continue;
+      peer = name, peer_f1 = f1Of(run);
+    }
+    if (peer.empty()) continue;
+    const double gap = f1Of(filters["best"]) - peer_f1;
+    peers.push_back({{"pair", row["pair"]},
+                     {"best_f1", f1Of(filters["best"])},
+                     {"peer", peer},
+                     {"peer_f1", peer_f1}});
+    if (gap < worst_peer_gap)
+      worst_peer_gap = gap, worst_peer_pair = row["pair"].get<std::string>();
+  }
+  summary["best_against_peers"] = peers;
   if (f1.count("best") && f1.count("magsac")) {
     const double gain = summary["mean_f1"]["best"]["mean"].get<double>() -
                         summary["mean_f1"]["magsac"]["mean"].get<double>();
     summary["measurements"] = {{"mean_f1_best_minus_magsac", gain},
                                {"worst_pair_f1_best_minus_magsac", worst},
                                {"worst_pair", worst_pair}};
+  }
+  if (!peers.empty()) {
+    double strongest_mean = -1.0;
+    std::string strongest;
+    for (const auto& [name, value] : summary["mean_f1"].items()) {
+      if (name == "best" || name == "vote_ransac") continue;
+      if (value["pairs"] != summary["mean_f1"]["best"]["pairs"]) continue;  // not on every pair
+      if (value["mean"].get<double>() > strongest_mean) {
+        strongest_mean = value["mean"].get<double>(), strongest = name;
+      }
+    }
+    summary["measurements"]["worst_pair_f1_best_minus_best_peer"] = worst_peer_gap;
+    summary["measurements"]["worst_peer_pair"] = worst_peer_pair;
+    if (!strongest.empty()) {
+      summary["measurements"]["mean_f1_best_minus_strongest_peer"] =
+          summary["mean_f1"]["best"]["mean"].get<double>() - strongest_mean;
+      summary["measurements"]["strongest_peer"] = strongest;
+    }
   }
   return summary;
 }
@@ -146,6 +191,17 @@ std::string summaryMarkdown(const nlohmann::json& summary) {
     separator = ", ";
   }
   md << ".\n\n";
+  if (summary.contains("best_against_peers") && !summary["best_against_peers"].empty()) {
+    md << "`best` against the strongest other filter of each pair (vote_ransac is `best`):\n\n"
+       << "| pair | best F1 | strongest other | its F1 | best - other |\n"
+       << "| --- | --- | --- | --- | --- |\n";
+    for (const auto& peer : summary["best_against_peers"]) {
+      md << "| " << peer["pair"].get<std::string>() << " | " << cell(peer["best_f1"]) << " | "
+         << peer["peer"].get<std::string>() << " | " << cell(peer["peer_f1"]) << " | "
+         << cell(peer["best_f1"].get<double>() - peer["peer_f1"].get<double>()) << " |\n";
+    }
+    md << "\n";
+  }
   if (summary.contains("measurements")) md << measurementsMarkdown(summary["measurements"]);
   return md.str();
 }
@@ -201,7 +257,8 @@ int runEvaluateFilters(const std::vector<std::string>& args) {
   ArgParser parser("evaluate-filters",
                    "Scores every filter against ground truth: Middlebury Teddy (ratio 0.8, 0.9,\n"
                    "1.0), Oxford graf 1-2 to 1-5 (ratio 0.8), a synthetic scene pair, a pair with\n"
-                   "two motions and one with a strong rotation and zoom.");
+                   "two motions, one with a strong rotation and zoom, and optical zooms of 2, 2.5\n"
+                   "and 3 with a rotation of 30 degrees.");
   parser.addOption("data", "DIR", "real data root", defaultDataRoot());
   parser.addOption("write", "FILE", "replace the evaluate-filters section of this Markdown file");
   parser.addOption("filters", "LIST", "comma-separated filters to score (default: all)");
@@ -210,10 +267,18 @@ int runEvaluateFilters(const std::vector<std::string>& args) {
   if (!parser.parse(args)) return 0;
   const std::string root = parser.has("data") ? parser.get("data") : "";
   const FilterConfigs configs = filterConfigsFromArgs(parser);
-  const std::vector<std::string> filters =
+  std::vector<std::string> filters =
       parser.has("filters") ? filterList(parser.get("filters")) : filterNames();
   nlohmann::json rows = nlohmann::json::array(), skipped = nlohmann::json::array();
   std::string why_not;
+  // COLMAP's own verification, the user's peer, when its program is installed.
+  if (!parser.has("filters")) {
+    if (colmapAvailable("colmap", &why_not)) {
+      filters.push_back("colmap");
+    } else {
+      skipped.push_back("the colmap filter: " + why_not);
+    }
+  }
   for (double ratio : {0.8, 0.9, 1.0}) {
     MatchOptions options;
     options.matching.ratio = ratio;
@@ -238,6 +303,13 @@ int runEvaluateFilters(const std::vector<std::string>& args) {
   rows.push_back(evaluatePair(warpedEvaluationPair("synthetic, rotation 60 deg and zoom 1.6",
                                                    rotationZoomPair(60.0, 1.6), MatchOptions()),
                               ratio, filters, configs));
+  for (double zoom : {2.0, 2.5, 3.0}) {
+    std::ostringstream name;
+    name << "synthetic, optical zoom " << zoom << " and rotation 30 deg";
+    rows.push_back(
+        evaluatePair(warpedEvaluationPair(name.str(), opticalZoomPair(30.0, zoom), MatchOptions()),
+                     ratio, filters, configs));
+  }
   const nlohmann::json summary = summaryJson(rows);
   const nlohmann::json result = {{"pairs", rows}, {"skipped", skipped}, {"summary", summary}};
   const std::string text = markdown(rows, skipped) + summaryMarkdown(summary);

@@ -50,9 +50,11 @@ class MatchFilter {
   virtual FilterResult apply(const PutativeMatches& input) const = 0;
 };
 
-/// The names makeFilter knows: ratio, epipolar, gsc, ransac, magsac, gms, lsc, local_gsc, guided,
+/// The package's filters: ratio, epipolar, gsc, ransac, magsac, gms, lsc, local_gsc, guided,
 /// vote_ransac, best. `best` is the combination measured best (docs/EVALUATION.md), the CLI's and
-/// the node's default: today `vote_ransac`.
+/// the node's default: today `vote_ransac`. makeFilter also knows `colmap`, COLMAP's own
+/// verification run by its program when installed (colmap_verification.h), a peer to compare
+/// with, which is not in this list.
 const std::vector<std::string>& filterNames();
 
 /// The filter the CLI (`match`, `hull --refine-with-matches`) and the matcher node run unless

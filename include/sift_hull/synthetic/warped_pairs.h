@@ -22,6 +22,12 @@ struct WarpedPair {
 /// The whole view turned by rotation_deg and scaled by `scale` about the image centre.
 WarpedPair rotationZoomPair(double rotation_deg, double scale);
 
+/// An optical zoom by `zoom` (1 to 12) with a turn by rotation_deg: the view rendered at `zoom`
+/// times 640x480, the left image that render reduced by area to 640x480, the right one its centre
+/// at the render's own resolution (no interpolated detail), turned about the image centre. SIFT
+/// finds a match's keypoints `zoom` times larger on the right. Renders one view of up to 7680 px.
+WarpedPair opticalZoomPair(double rotation_deg, double zoom);
+
 /// Two objects moving differently: the view's left half and right half, each moved by its own
 /// rotation, scale and shift, so that no single F or H explains the pair.
 WarpedPair twoMotionPair();

@@ -4,6 +4,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "sift_hull/filters/colmap_verification.h"
 #include "sift_hull/limits.h"
 
 namespace sift_hull {
@@ -98,8 +99,13 @@ std::unique_ptr<MatchFilter> makeSingleFilter(const std::string& name,
         name, filterVoteRansac,
         VoteRansacFilterConfig{configs.vote_ransac, configs.guided, configs.magsac});
   }
+  if (name == "colmap") {
+    return std::make_unique<FunctionFilter<ColmapConfig>>(
+        name, filterColmap, ColmapConfig{"colmap", configs.magsac.seed, 1});
+  }
   std::ostringstream known;
   for (const std::string& each : filterNames()) known << " " << each;
+  known << " colmap";
   throw std::invalid_argument("unknown filter '" + name + "' (known:" + known.str() + ")");
 }
 
@@ -114,7 +120,6 @@ size_t FilterResult::keptCount() const {
   for (uint8_t flag : keep) count += flag ? 1 : 0;
   return count;
 }
-
 
 const std::vector<std::string>& filterNames() {
   static const std::vector<std::string> names = {"ratio",  "epipolar",    "gsc", "ransac",

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "sift_hull/filters/epipolar.h"
+#include "sift_hull/filters/scaled_residuals.h"
 #include "sift_hull/geometry/camera.h"
 
 namespace sift_hull {
@@ -35,11 +36,13 @@ double residual(const Motion& motion, const cv::Point2f& a, const cv::Point2f& b
   return epipolarDistances(motion.matrix, {a.x, a.y}, {b.x, b.y}).max();
 }
 
+double thresholdOf(const Motion& motion, const GuidedFilterConfig& config) {
+  return motion.homography ? config.guided.max_transfer_px : config.magsac.max_epipolar_px;
+}
+
 bool explains(const Motion& motion, const cv::Point2f& a, const cv::Point2f& b,
               const GuidedFilterConfig& config) {
-  const double r = residual(motion, a, b);
-  return r <=
-         (motion.homography ? config.guided.max_transfer_px : config.magsac.max_epipolar_px);
+  return residual(motion, a, b) <= thresholdOf(motion, config);
 }
 
 /// The better motion (F or H) for the points, when any fits at least guided_min_model_inliers.
@@ -47,8 +50,7 @@ std::optional<Motion> fitMotion(const std::vector<cv::Point2f>& left,
                                 const std::vector<cv::Point2f>& right,
                                 const GuidedFilterConfig& config, size_t* inliers) {
   const cv::Mat F = magsacFundamentalMatrix(left, right, config.magsac);
-  const cv::Mat H =
-      magsacHomography(left, right, config.guided.max_transfer_px, config.magsac);
+  const cv::Mat H = magsacHomography(left, right, config.guided.max_transfer_px, config.magsac);
   std::optional<Motion> fundamental, homography;
   if (F.rows >= 3 && F.cols == 3) {
     fundamental = Motion{};
@@ -91,7 +93,6 @@ std::vector<Motion> fitMotions(std::vector<cv::Point2f> left, std::vector<cv::Po
 
 }  // namespace
 
-
 FilterResult filterGuided(const PutativeMatches& input, const GuidedFilterConfig& config) {
   validate(config.guided);
   const FilterResult local = filterLsc(input, config.lsc);
@@ -114,11 +115,19 @@ FilterResult filterGuided(const PutativeMatches& input, const GuidedFilterConfig
   for (size_t m = 0; m < input.matches.size(); ++m) {
     if (!input.hasFinitePositions(m)) continue;
     const cv::Point2f &a = input.left(m).pt, &b = input.right(m).pt;
+    const double left_interval = octaveInterval_px(input.left(m).size);
+    const double right_interval = octaveInterval_px(input.right(m).size);
     double best = INFINITY;
     bool explained = false;
     for (const Motion& motion : motions) {
       best = std::min(best, residual(motion, a, b));
-      explained = explained || explains(motion, a, b, config);
+      if (config.guided.scale_with_keypoints) {
+        explained = explained || scaledModelResidual({motion.homography, motion.matrix}, a.x, a.y,
+                                                     b.x, b.y, left_interval,
+                                                     right_interval) <= thresholdOf(motion, config);
+      } else {
+        explained = explained || explains(motion, a, b, config);
+      }
     }
     result.score[m] = best;
     result.keep[m] = explained && local.score[m] >= config.guided.min_support;

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "filters/densest_window.h"
+#include "sift_hull/filters/scaled_residuals.h"
 #include "sift_hull/filters/two_view_models.h"
 
 namespace sift_hull {
@@ -119,8 +120,8 @@ std::vector<int> votedPool(const FitSet& set, const VoteRansacConfig& config,
       detail::densestWindow(set.rotation_deg, voting, half, 360.0, &count);
   const double even = double(voting.size()) * std::min(1.0, 2.0 * half / 360.0);
   if (require_cluster && double(count) < 2.0 * even) return {};
-  return detail::densestWindow(set.log2_scale, turned,
-                               std::log2(config.max_scale_ratio), 0.0, &count);
+  return detail::densestWindow(set.log2_scale, turned, std::log2(config.max_scale_ratio), 0.0,
+                               &count);
 }
 
 /// A model's squared residuals of the pairs when each left point meets the right point of another
@@ -150,8 +151,7 @@ size_t countBelow(const std::vector<float>& r2, float t2) {
 /// could then explain 4 times as many), the model is compared with chance within the narrower
 /// residual where chance explains that share, since a motion's matches lie near it at any
 /// threshold and chance's do not: 0 when it explains 4 times as many there, else more than all.
-size_t neededBeyondChance(const TwoViewModel& model, const PointPairs& pairs,
-                          double threshold_px) {
+size_t neededBeyondChance(const TwoViewModel& model, const PointPairs& pairs, double threshold_px) {
   std::vector<float> chance_r2, r2;
   chanceResiduals(model, pairs, &chance_r2);
   const size_t chance = countWithin(chance_r2, static_cast<float>(threshold_px * threshold_px));
@@ -212,8 +212,8 @@ TwoViewFit fitMotion(const FitSet& set, const std::vector<int>& pool, bool furth
   const TwoViewFit F = fitTwoViewModel(set.pairs, pool, settings, random);
   const size_t pool_size = pool.empty() ? set.pairs.size() : pool.size();
   const TwoViewFit H = fitHomography(set, pool, F, settings, config, random);
-  const bool use_h = H.found && (!F.found || H.inliers.size() >=
-                                                 guided.homography_share * F.inliers.size());
+  const bool use_h =
+      H.found && (!F.found || H.inliers.size() >= guided.homography_share * F.inliers.size());
   TwoViewFit chosen = use_h ? H : F;
   const double threshold = use_h ? guided.max_transfer_px : fit.max_epipolar_px;
   size_t needed = std::max<size_t>(size_t(guided.min_model_inliers),
@@ -292,18 +292,33 @@ PointPairs finitePairs(const PutativeMatches& input, std::vector<size_t>* index)
   return all;
 }
 
-/// Every match judged against the motions (float residuals, vectorised).
-void judge(const PointPairs& all, const std::vector<size_t>& index,
+/// The octave intervals of the keypoints of the matches `index` names (octaveInterval_px).
+PairScales scalesOf(const PutativeMatches& input, const std::vector<size_t>& index) {
+  PairScales scales;
+  scales.left.reserve(index.size()), scales.right.reserve(index.size());
+  for (size_t m : index) {
+    scales.push(octaveInterval_px(input.left(m).size), octaveInterval_px(input.right(m).size));
+  }
+  return scales;
+}
+
+/// Every match judged against the motions (float residuals, vectorised): explained within each
+/// motion's threshold, in octave intervals of its keypoints when guided_scale_with_keypoints.
+void judge(const PutativeMatches& input, const PointPairs& all, const std::vector<size_t>& index,
            const std::vector<TwoViewModel>& motions, const VoteRansacFilterConfig& config,
            FilterResult* result) {
-  std::vector<float> best(all.size(), std::numeric_limits<float>::infinity()), r2;
+  std::vector<float> best(all.size(), std::numeric_limits<float>::infinity()), r2, scaled;
   std::vector<uint8_t> explained(all.size(), 0);
+  const bool by_scale = config.guided.scale_with_keypoints;
+  const PairScales scales = by_scale ? scalesOf(input, index) : PairScales();
   for (const TwoViewModel& motion : motions) {
     const float t2 = static_cast<float>(std::pow(thresholdOf(motion, config), 2));
     squaredResiduals(motion, all, &r2);
+    if (by_scale) squaredScaledResiduals(motion, all, scales, &scaled);
+    const std::vector<float>& judged = by_scale ? scaled : r2;
     for (size_t i = 0; i < r2.size(); ++i) {
       best[i] = std::min(best[i], r2[i]);
-      explained[i] |= r2[i] <= t2;
+      explained[i] |= judged[i] <= t2;
     }
   }
   for (size_t i = 0; i < index.size(); ++i) {
@@ -313,7 +328,6 @@ void judge(const PointPairs& all, const std::vector<size_t>& index,
 }
 
 }  // namespace
-
 
 namespace {
 
@@ -387,7 +401,7 @@ FilterResult filterVoteRansac(const PutativeMatches& input, const VoteRansacFilt
   std::vector<size_t> index;
   const PointPairs all = finitePairs(input, &index);
   const std::vector<TwoViewModel> motions = motionsOf(input, all, index, config);
-  if (!motions.empty()) judge(all, index, motions, config, &result);
+  if (!motions.empty()) judge(input, all, index, motions, config, &result);
   return result;
 }
 

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <opencv2/core/eigen.hpp>
 #include <opencv2/imgproc.hpp>
+#include <stdexcept>
 
 #include "sift_hull/synthetic/scene.h"
 
@@ -52,6 +53,37 @@ WarpedPair rotationZoomPair(double rotation_deg, double scale) {
   const cv::Point2d centre(left.cols / 2.0, left.rows / 2.0);
   return warpRegions(left, cv::Mat::zeros(left.size(), CV_8UC1),
                      {similarity(rotation_deg, scale, centre, {0, 0})});
+}
+
+WarpedPair opticalZoomPair(double rotation_deg, double zoom) {
+  if (!(zoom >= 1.0 && zoom <= 12.0)) {
+    throw std::invalid_argument("opticalZoomPair: the zoom must lie in [1, 12]");
+  }
+  SceneConfig scene;
+  scene.background = "textured";
+  const cv::Size size(scene.width_px, scene.height_px);
+  scene.width_px = static_cast<int>(std::lround(zoom * size.width));
+  scene.height_px = static_cast<int>(std::lround(zoom * size.height));
+  const cv::Mat fine = renderSceneView(scene, 0).image;
+  cv::Mat left;
+  cv::resize(fine, left, size, 0.0, 0.0, cv::INTER_AREA);
+  // A left pixel to the fine render's (pixel centres at integers: u' = s (u + 0.5) - 0.5).
+  Eigen::Matrix3d to_fine = Eigen::Matrix3d::Identity();
+  to_fine(0, 0) = static_cast<double>(fine.cols) / size.width;
+  to_fine(1, 1) = static_cast<double>(fine.rows) / size.height;
+  to_fine(0, 2) = 0.5 * to_fine(0, 0) - 0.5;
+  to_fine(1, 2) = 0.5 * to_fine(1, 1) - 0.5;
+  // The right image: the fine render's centre at its own resolution, turned about it.
+  const cv::Point2d fine_centre((fine.cols - 1) / 2.0, (fine.rows - 1) / 2.0);
+  const cv::Point2d centre((size.width - 1) / 2.0, (size.height - 1) / 2.0);
+  const Eigen::Matrix3d turn = similarity(rotation_deg, 1.0, fine_centre, centre - fine_centre);
+  cv::Mat H, seen;
+  cv::eigen2cv(turn, H);
+  WarpedPair pair{left, cv::Mat(), {turn * to_fine}, cv::Mat::zeros(size, CV_8UC1), cv::Mat()};
+  cv::warpPerspective(fine, pair.right, H, size, cv::INTER_LINEAR, cv::BORDER_CONSTANT);
+  cv::warpPerspective(cv::Mat(fine.size(), CV_8UC1, cv::Scalar(1)), pair.right_owner, H, size,
+                      cv::INTER_NEAREST, cv::BORDER_CONSTANT);
+  return pair;
 }
 
 WarpedPair twoMotionPair() {
