@@ -1,5 +1,7 @@
 #pragma once
 
+#include <string>
+
 #include "sift_hull/features/matching.h"
 #include "sift_hull/filters/filter_result.h"
 #include "sift_hull/filters/local_consistency.h"
@@ -15,8 +17,8 @@ namespace sift_hull {
 /// motions each with at least guided_min_model_inliers inliers (two objects moving differently).
 /// Finally every putative match, not only lsc's survivors, is judged again: kept when a model
 /// explains it (symmetric epipolar distance <= magsac_max_epipolar_px, or transfer error <=
-/// guided_max_transfer_px both ways; with guided_scale_with_keypoints, each image's distance in
-/// octave intervals of its keypoint) and its lsc support is at least guided_min_support.
+/// guided_max_transfer_px both ways, scaled in each image as guided_tolerance_scale says) and its
+/// lsc support is at least guided_min_support.
 /// Score: the smallest residual over the models, px (NaN when no model was found: none kept).
 struct GuidedConfig {
   double max_transfer_px = 3.0;
@@ -27,10 +29,11 @@ struct GuidedConfig {
   /// MAGSAC fits its models to at most this many of lsc's survivors (a random sample drawn with
   /// magsac_seed), so that its time does not grow with N; every match is judged afterwards.
   int max_fit_points = 200;
-  /// The final verdict (guided and vote_ransac) measures each image's residual in the sampling
-  /// intervals of its keypoint's SIFT octave (octaveInterval_px, scaled_residuals.h): a large
-  /// keypoint, located less well in pixels, is allowed as much more.
-  bool scale_with_keypoints = true;
+  /// What the final verdict (guided and vote_ransac) measures each image's residual in
+  /// (scaled_residuals.h): "pixels"; "model", the homography's local scale (a left point located
+  /// to a pixel lands within s pixels on the right: there the tolerance is s times as wide);
+  /// "keypoints", the sampling interval of each keypoint's SIFT octave.
+  std::string tolerance_scale = "model";
 };
 /// Its settings: names, units, ranges, help (sift_hull/settings.h).
 template <>

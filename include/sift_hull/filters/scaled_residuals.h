@@ -20,6 +20,11 @@ inline constexpr float kSiftBaseSigmaPx = 1.6f;
 /// to a pixel).
 float octaveInterval_px(float keypoint_size_px);
 
+/// How far a homography stretches the image about a left point: the square root of its
+/// Jacobian's determinant there, |det H| / |w|^3 with w = H's last row times (x, y, 1). 1 for a
+/// fundamental matrix (no scale of its own) and where undefined.
+double localScale(const TwoViewModel& model, double lx, double ly);
+
 /// The octave intervals of each pair's keypoints in the left and the right image.
 struct PairScales {
   std::vector<float> left, right;
@@ -33,6 +38,11 @@ struct PairScales {
 /// intervals are 1. Infinite when undefined.
 double scaledModelResidual(const TwoViewModel& model, double lx, double ly, double rx, double ry,
                            double left_interval, double right_interval);
+
+/// Each pair's allowance by the model's local scale s (localScale at its left point): a left point
+/// located to a pixel lands within s pixels on the right, so the right image's interval is
+/// max(1, s) and the left one's max(1, 1 / s); 1 and 1 for a fundamental matrix.
+PairScales modelScales(const TwoViewModel& model, const PointPairs& pairs);
 
 /// Squared scaledModelResidual of every pair (float), into `out`. Throws std::invalid_argument
 /// when `scales` does not hold one entry per pair.

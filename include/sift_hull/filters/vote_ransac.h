@@ -43,8 +43,8 @@ namespace sift_hull {
 ///    edge may change sides, as in the fit itself.
 /// 6. Every putative is judged: kept when a motion explains it (symmetric epipolar distance <=
 ///    magsac_max_epipolar_px, transfer error <= guided_max_transfer_px both ways), each image's
-///    distance measured in octave intervals of the match's keypoint there when
-///    guided_scale_with_keypoints (the default; scaled_residuals.h).
+///    distance scaled as guided_tolerance_scale says (by default the homography's local scale
+///    there; scaled_residuals.h).
 /// Score: the smallest residual over the motions, px (NaN when none was found: none kept).
 /// Its time hardly grows with N beyond the fit set: steps 5 and 6 are a few residuals per match.
 struct VoteRansacConfig {

@@ -173,9 +173,11 @@ const SettingTable<GuidedConfig>& settingsOf<GuidedConfig>() {
     t.add("max_fit_points", &GuidedConfig::max_fit_points, "matches",
           "guided: lsc survivors MAGSAC fits to (a random sample)")
         .range(16, kMaxSamples);
-    t.add("scale_with_keypoints", &GuidedConfig::scale_with_keypoints, "",
-          "guided and vote_ransac (best): the final verdict measures each image's residual in "
-          "sampling intervals of its keypoint's SIFT octave (size / 3.2, at least 1)")
+    t.add("tolerance_scale", &GuidedConfig::tolerance_scale, "",
+          "guided and vote_ransac (best): the final verdict's unit in each image: pixels; model, "
+          "the homography's local scale (at least 1); keypoints, the keypoint's SIFT octave "
+          "interval (size / 3.2, at least 1)")
+        .oneOf({"pixels", "model", "keypoints"})
         .tunedAtRunTime();
     return t;
   }();

@@ -264,7 +264,6 @@ std::vector<double> bestScores(const std::vector<NormalisedMatch>& matches,
   return best;
 }
 
-
 void validateImageSize(const cv::Size& size, const std::string& which) {
   if (size.width <= 0 || size.height <= 0) {
     throw std::invalid_argument("filterGms: " + which + " must be positive, got " +

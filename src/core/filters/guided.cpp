@@ -115,19 +115,24 @@ FilterResult filterGuided(const PutativeMatches& input, const GuidedFilterConfig
   for (size_t m = 0; m < input.matches.size(); ++m) {
     if (!input.hasFinitePositions(m)) continue;
     const cv::Point2f &a = input.left(m).pt, &b = input.right(m).pt;
-    const double left_interval = octaveInterval_px(input.left(m).size);
-    const double right_interval = octaveInterval_px(input.right(m).size);
+    const std::string& unit = config.guided.tolerance_scale;
     double best = INFINITY;
     bool explained = false;
     for (const Motion& motion : motions) {
       best = std::min(best, residual(motion, a, b));
-      if (config.guided.scale_with_keypoints) {
-        explained = explained || scaledModelResidual({motion.homography, motion.matrix}, a.x, a.y,
-                                                     b.x, b.y, left_interval,
-                                                     right_interval) <= thresholdOf(motion, config);
-      } else {
+      if (unit != "model" && unit != "keypoints") {
         explained = explained || explains(motion, a, b, config);
+        continue;
       }
+      const TwoViewModel model{motion.homography, motion.matrix};
+      double left_interval = octaveInterval_px(input.left(m).size);
+      double right_interval = octaveInterval_px(input.right(m).size);
+      if (unit == "model") {
+        const double s = localScale(model, a.x, a.y);
+        left_interval = std::max(1.0, 1.0 / s), right_interval = std::max(1.0, s);
+      }
+      explained = explained || scaledModelResidual(model, a.x, a.y, b.x, b.y, left_interval,
+                                                   right_interval) <= thresholdOf(motion, config);
     }
     result.score[m] = best;
     result.keep[m] = explained && local.score[m] >= config.guided.min_support;

@@ -126,8 +126,6 @@ BothNeighbours neighboursInBoth(const LocalMatches& local, size_t k) {
 
 }  // namespace
 
-
-
 FilterResult filterLsc(const PutativeMatches& input, const LscConfig& config) {
   validate(config);
   FilterResult result = FilterResult::keepingNone(input.matches.size());
@@ -145,8 +143,7 @@ FilterResult filterLocalGsc(const PutativeMatches& input, const LocalGscConfig& 
   validate(config);
   FilterResult result = FilterResult::keepingNone(input.matches.size());
   const LocalMatches local = localMatches(input);
-  const BothNeighbours near =
-      neighboursInBoth(local, static_cast<size_t>(config.neighbours));
+  const BothNeighbours near = neighboursInBoth(local, static_cast<size_t>(config.neighbours));
   for (size_t i = 0; i < local.index.size(); ++i) {
     const std::vector<int> set = unionOfNeighbours(near.left, near.right, i);
     if (set.empty()) continue;

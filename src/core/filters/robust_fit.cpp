@@ -94,7 +94,6 @@ cv::Mat magsacHomography(const std::vector<cv::Point2f>& left,
   }
 }
 
-
 FilterResult filterRansac(const PutativeMatches& input, const RobustFitConfig& config) {
   return fitFundamentalMatrix(input, cv::FM_RANSAC, config);
 }

@@ -13,6 +13,26 @@ float octaveInterval_px(float keypoint_size_px) {
   return interval > 1.0f ? interval : 1.0f;  // also for NaN and negative sizes
 }
 
+double localScale(const TwoViewModel& model, double lx, double ly) {
+  if (!model.homography) return 1.0;
+  const double w = model.matrix(2, 0) * lx + model.matrix(2, 1) * ly + model.matrix(2, 2);
+  const double scale = std::sqrt(std::abs(model.matrix.determinant()) / std::abs(w * w * w));
+  return std::isfinite(scale) && scale > 0.0 ? scale : 1.0;
+}
+
+PairScales modelScales(const TwoViewModel& model, const PointPairs& pairs) {
+  PairScales scales;
+  scales.left.assign(pairs.size(), 1.0f);
+  scales.right.assign(pairs.size(), 1.0f);
+  if (!model.homography) return scales;
+  for (size_t i = 0; i < pairs.size(); ++i) {
+    const double s = localScale(model, pairs.left_x[i], pairs.left_y[i]);
+    scales.right[i] = static_cast<float>(std::max(1.0, s));
+    scales.left[i] = static_cast<float>(std::max(1.0, 1.0 / s));
+  }
+  return scales;
+}
+
 double scaledModelResidual(const TwoViewModel& model, double lx, double ly, double rx, double ry,
                            double left_interval, double right_interval) {
   const Eigen::Matrix3d& M = model.matrix;

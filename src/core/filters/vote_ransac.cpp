@@ -303,19 +303,20 @@ PairScales scalesOf(const PutativeMatches& input, const std::vector<size_t>& ind
 }
 
 /// Every match judged against the motions (float residuals, vectorised): explained within each
-/// motion's threshold, in octave intervals of its keypoints when guided_scale_with_keypoints.
+/// motion's threshold, in the units guided_tolerance_scale names.
 void judge(const PutativeMatches& input, const PointPairs& all, const std::vector<size_t>& index,
            const std::vector<TwoViewModel>& motions, const VoteRansacFilterConfig& config,
            FilterResult* result) {
   std::vector<float> best(all.size(), std::numeric_limits<float>::infinity()), r2, scaled;
   std::vector<uint8_t> explained(all.size(), 0);
-  const bool by_scale = config.guided.scale_with_keypoints;
-  const PairScales scales = by_scale ? scalesOf(input, index) : PairScales();
+  const std::string& unit = config.guided.tolerance_scale;
+  const PairScales keypoints = unit == "keypoints" ? scalesOf(input, index) : PairScales();
   for (const TwoViewModel& motion : motions) {
     const float t2 = static_cast<float>(std::pow(thresholdOf(motion, config), 2));
     squaredResiduals(motion, all, &r2);
-    if (by_scale) squaredScaledResiduals(motion, all, scales, &scaled);
-    const std::vector<float>& judged = by_scale ? scaled : r2;
+    if (unit == "keypoints") squaredScaledResiduals(motion, all, keypoints, &scaled);
+    if (unit == "model") squaredScaledResiduals(motion, all, modelScales(motion, all), &scaled);
+    const std::vector<float>& judged = unit == "keypoints" || unit == "model" ? scaled : r2;
     for (size_t i = 0; i < r2.size(); ++i) {
       best[i] = std::min(best[i], r2[i]);
       explained[i] |= judged[i] <= t2;
