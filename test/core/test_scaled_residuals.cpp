@@ -38,6 +38,33 @@ TEST(ScaledResiduals, EachImagesResidualIsMeasuredInItsOwnIntervals) {
               std::max(d.in_a_px / 2.0, d.in_b_px / 5.0), 1e-9 * (1 + d.max()));
 }
 
+TEST(ScaledResiduals, TheModelsLocalScaleIsItsJacobiansStretch) {
+  // A similarity stretches by its scale everywhere; a homography by its Jacobian at the point.
+  const TwoViewModel zoom{true, Eigen::Vector3d(2.5, 2.5, 1.0).asDiagonal()};
+  EXPECT_NEAR(localScale(zoom, 100, 50), 2.5, 1e-12);
+  TwoViewModel h{true, Eigen::Matrix3d::Identity()};
+  h.matrix << 1.2, 0.1, 4, -0.05, 0.95, -3, 1e-3, 0, 1;
+  const double x = 200, y = 100, step = 1e-4;
+  const auto map = [&](double u, double v) -> Eigen::Vector2d {
+    return (h.matrix * Eigen::Vector3d(u, v, 1.0)).hnormalized();
+  };
+  Eigen::Matrix2d J;
+  J.col(0) = (map(x + step, y) - map(x - step, y)) / (2 * step);
+  J.col(1) = (map(x, y + step) - map(x, y - step)) / (2 * step);
+  EXPECT_NEAR(localScale(h, x, y), std::sqrt(std::abs(J.determinant())), 1e-6);
+  EXPECT_DOUBLE_EQ(localScale(TwoViewModel{false, test::twoCameras().F()}, x, y), 1.0);
+  // The allowances: the stretched side gets the scale, the other side 1 (and the reverse).
+  PointPairs pairs;
+  pairs.push(100, 50, 250, 125);
+  const PairScales scales = modelScales(zoom, pairs);
+  EXPECT_FLOAT_EQ(scales.right[0], 2.5f);
+  EXPECT_FLOAT_EQ(scales.left[0], 1.0f);
+  const PairScales shrunk =
+      modelScales(TwoViewModel{true, Eigen::Vector3d(0.5, 0.5, 1.0).asDiagonal()}, pairs);
+  EXPECT_FLOAT_EQ(shrunk.right[0], 1.0f);
+  EXPECT_FLOAT_EQ(shrunk.left[0], 2.0f);
+}
+
 TEST(ScaledResiduals, TheFloatKernelAgreesWithTheDefinition) {
   const test::TwoCameras c = test::twoCameras();
   TwoViewModel f{false, c.F()}, h{true, Eigen::Matrix3d::Identity()};

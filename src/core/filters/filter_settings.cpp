@@ -177,8 +177,7 @@ const SettingTable<GuidedConfig>& settingsOf<GuidedConfig>() {
           "guided and vote_ransac (best): the final verdict's unit in each image: pixels; model, "
           "the homography's local scale (at least 1); keypoints, the keypoint's SIFT octave "
           "interval (size / 3.2, at least 1)")
-        .oneOf({"pixels", "model", "keypoints"})
-        .tunedAtRunTime();
+        .oneOf({"pixels", "model", "keypoints"});
     return t;
   }();
   return table;
