@@ -138,20 +138,28 @@ nlohmann::json sampledGsc(const LabelledMatches& input) {
   return cells;
 }
 
+/// The baseline of best's scaled verdict, timed in the same run: best judging in pixels.
+constexpr const char* kBestInPixels = "best (guided_tolerance_scale pixels)";
+
 nlohmann::json sweepRow(const LabelledMatches& input) {
   FilterConfigs configs;
   nlohmann::json row = {{"n", input.truth.size()}, {"filters", nlohmann::json::object()}};
-  for (const std::string& name : filterNames()) {
+  std::vector<std::string> names = filterNames();
+  names.push_back(kBestInPixels);
+  for (const std::string& name : names) {
     nlohmann::json timings;
+    configs.guided.tolerance_scale =
+        name == kBestInPixels ? "pixels" : GuidedConfig().tolerance_scale;
     for (const int threads : {1, 0}) {
       cv::setNumThreads(threads == 1 ? 1 : -1);
       configs.gsc.threads = threads;
-      const auto filter = makeFilter(name, configs);
+      const auto filter = makeFilter(name == kBestInPixels ? "best" : name, configs);
       timings[threads == 1 ? "one_thread_ms" : "all_threads_ms"] =
           medianMs([&] { filter->apply(input.putative); }, 1500.0);
     }
-    const FilterScores scores =
-        scoreFilter(input.truth, makeFilter(name, configs)->apply(input.putative));
+    const FilterScores scores = scoreFilter(
+        input.truth,
+        makeFilter(name == kBestInPixels ? "best" : name, configs)->apply(input.putative));
     timings["mismatches_removed_share"] =
         numberOrNull(share(scores.mismatchesRemoved(), scores.wrong_putative));
     timings["correct_kept_share"] =
@@ -187,6 +195,9 @@ nlohmann::json measurements(const nlohmann::json& sweep) {
     if (n == "2000") result["magsac_over_gsc_2000"] = magsac / gsc;
     if (row["n"].get<size_t>() >= 1000) {
       result["best_over_magsac_" + n] = filters["best"]["all_threads_ms"].get<double>() / magsac;
+      result["best_over_best_in_pixels_" + n] =
+          filters["best"]["all_threads_ms"].get<double>() /
+          filters[kBestInPixels]["all_threads_ms"].get<double>();
     }
   }
   return result;

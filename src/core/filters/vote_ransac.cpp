@@ -314,9 +314,11 @@ void judge(const PutativeMatches& input, const PointPairs& all, const std::vecto
   for (const TwoViewModel& motion : motions) {
     const float t2 = static_cast<float>(std::pow(thresholdOf(motion, config), 2));
     squaredResiduals(motion, all, &r2);
+    // A fundamental matrix has no scale of its own: in the model's units its residuals are r2.
+    const bool by_model = unit == "model" && motion.homography;
     if (unit == "keypoints") squaredScaledResiduals(motion, all, keypoints, &scaled);
-    if (unit == "model") squaredScaledResiduals(motion, all, modelScales(motion, all), &scaled);
-    const std::vector<float>& judged = unit == "keypoints" || unit == "model" ? scaled : r2;
+    if (by_model) squaredScaledResiduals(motion, all, modelScales(motion, all), &scaled);
+    const std::vector<float>& judged = unit == "keypoints" || by_model ? scaled : r2;
     for (size_t i = 0; i < r2.size(); ++i) {
       best[i] = std::min(best[i], r2[i]);
       explained[i] |= judged[i] <= t2;
