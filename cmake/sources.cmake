@@ -6,6 +6,7 @@
 # Included by the package's CMakeLists.txt and by test/sanitize/CMakeLists.txt, so that both build
 # the libraries from the same lists (docs/ARCHITECTURE.md).
 set(SIFT_HULL_CORE_SOURCES
+  src/core/common/process.cpp
   src/core/common/settings.cpp
   src/core/geometry/camera.cpp
   src/core/geometry/camera_set.cpp

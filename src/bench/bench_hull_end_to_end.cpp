@@ -3,8 +3,6 @@
 
 #include "bench_hull_end_to_end.h"
 
-#include <fcntl.h>
-#include <spawn.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -24,10 +22,9 @@
 #include "bench_scene.h"
 #include "commands.h"
 #include "sift_hull/io/calibration.h"
+#include "sift_hull/process.h"
 #include "sift_hull/synthetic/mask_render.h"
 #include "sift_hull/synthetic/scene.h"
-
-extern char** environ;
 
 namespace sift_hull {
 namespace cli {
@@ -63,20 +60,11 @@ double writeCase(const EndToEndCase& config, const fs::path& directory) {
 /// peak resident memory in MiB. Throws std::runtime_error when it cannot start or fails.
 void runProcess(const std::string& executable, const std::vector<std::string>& arguments,
                 const fs::path& output, double* wall_s, double* peak_mib) {
-  std::vector<char*> argv;
-  argv.push_back(const_cast<char*>(executable.c_str()));
-  for (const std::string& argument : arguments) argv.push_back(const_cast<char*>(argument.c_str()));
-  argv.push_back(nullptr);
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, output.c_str(),
-                                   O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  std::vector<std::string> command = {executable};
+  command.insert(command.end(), arguments.begin(), arguments.end());
   const auto start = std::chrono::steady_clock::now();
-  pid_t child = 0;
-  const int spawned =
-      posix_spawn(&child, executable.c_str(), &actions, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  if (spawned != 0) throw std::runtime_error(executable + ": cannot start it");
+  const pid_t child = startProgram(command, output.string(), ProgramOutput::kStdoutToFile);
+  if (child < 0) throw std::runtime_error(executable + ": cannot start it");
   int status = 0;
   rusage usage{};
   if (wait4(child, &status, 0, &usage) != child) throw std::runtime_error("wait4 failed");

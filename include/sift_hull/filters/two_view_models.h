@@ -31,6 +31,10 @@ struct TwoViewModel {
 /// directions. Infinite when undefined.
 double modelResidual(const TwoViewModel& model, double lx, double ly, double rx, double ry);
 
+/// The model's matrix (`matrix`) and, for a homography, its inverse (`inverse`; zeros for F) as
+/// row-major floats: what the float residual kernels take.
+void modelFloats(const TwoViewModel& model, float matrix[9], float inverse[9]);
+
 /// Squared residuals of every pair (float, as modelResidual squared), into `out`.
 void squaredResiduals(const TwoViewModel& model, const PointPairs& pairs, std::vector<float>* out);
 /// The same for the pairs [begin, end) only, written to out[begin, end).

@@ -59,12 +59,7 @@ void squaredScaledResiduals(const TwoViewModel& model, const PointPairs& pairs,
   }
   out->resize(pairs.size());
   float m[9], g[9];
-  const Eigen::Matrix3d inverse =
-      model.homography ? Eigen::Matrix3d(model.matrix.inverse()) : Eigen::Matrix3d::Zero();
-  for (int k = 0; k < 9; ++k) {
-    m[k] = static_cast<float>(model.matrix(k / 3, k % 3));
-    g[k] = static_cast<float>(inverse(k / 3, k % 3));
-  }
+  modelFloats(model, m, g);
   const float inf = std::numeric_limits<float>::infinity();
   for (size_t i = 0; i < pairs.size(); ++i) {
     const float lx = pairs.left_x[i], ly = pairs.left_y[i];

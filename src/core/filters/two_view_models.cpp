@@ -307,6 +307,15 @@ double modelResidual(const TwoViewModel& model, double lx, double ly, double rx,
                                               : std::numeric_limits<double>::infinity();
 }
 
+void modelFloats(const TwoViewModel& model, float matrix[9], float inverse[9]) {
+  const Eigen::Matrix3d inverted =
+      model.homography ? Eigen::Matrix3d(model.matrix.inverse()) : Eigen::Matrix3d::Zero();
+  for (int k = 0; k < 9; ++k) {
+    matrix[k] = static_cast<float>(model.matrix(k / 3, k % 3));
+    inverse[k] = static_cast<float>(inverted(k / 3, k % 3));
+  }
+}
+
 void squaredResiduals(const TwoViewModel& model, const PointPairs& pairs, std::vector<float>* out) {
   out->resize(pairs.size());
   squaredResiduals(model, pairs, 0, pairs.size(), out->data());
@@ -317,12 +326,7 @@ void squaredResiduals(const TwoViewModel& model, const PointPairs& pairs, size_t
   end = std::min(end, pairs.size());
   if (begin >= end) return;
   float m[9], g[9];
-  const Eigen::Matrix3d inverse =
-      model.homography ? Eigen::Matrix3d(model.matrix.inverse()) : Eigen::Matrix3d::Zero();
-  for (int k = 0; k < 9; ++k) {
-    m[k] = static_cast<float>(model.matrix(k / 3, k % 3));
-    g[k] = static_cast<float>(inverse(k / 3, k % 3));
-  }
+  modelFloats(model, m, g);
   const size_t n = end - begin;
   const float *lx = pairs.left_x.data() + begin, *ly = pairs.left_y.data() + begin;
   const float *rx = pairs.right_x.data() + begin, *ry = pairs.right_y.data() + begin;

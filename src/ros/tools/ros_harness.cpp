@@ -1,10 +1,8 @@
 #include "ros_harness.h"
 
 #include <arpa/inet.h>
-#include <fcntl.h>
 #include <netinet/in.h>
 #include <signal.h>
-#include <spawn.h>
 #include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -18,8 +16,7 @@
 #include <thread>
 
 #include "free_port.h"
-
-extern char** environ;
+#include "sift_hull/process.h"
 
 namespace sift_hull {
 namespace cli {
@@ -27,18 +24,8 @@ namespace {
 
 /// Starts `command` with its stdout and stderr appended to `log_path`.
 pid_t spawn(const std::vector<std::string>& command, const std::string& log_path) {
-  std::vector<char*> argv;
-  for (const std::string& word : command) argv.push_back(const_cast<char*>(word.c_str()));
-  argv.push_back(nullptr);
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log_path.c_str(),
-                                   O_WRONLY | O_CREAT | O_APPEND, 0644);
-  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
-  pid_t pid = -1;
-  const int failed = posix_spawnp(&pid, argv[0], &actions, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  if (failed != 0) throw std::runtime_error("cannot start " + command.front());
+  const pid_t pid = startProgram(command, log_path, ProgramOutput::kBothAppendedToFile);
+  if (pid < 0) throw std::runtime_error("cannot start " + command.front());
   return pid;
 }
 
