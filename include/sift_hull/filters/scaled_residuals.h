@@ -5,6 +5,8 @@
 // pixels than a fine corner. A tolerance fixed in pixels then drops correct matches of large
 // keypoints; measured in octave intervals, one tolerance serves every scale.
 
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "sift_hull/filters/two_view_models.h"
@@ -43,6 +45,13 @@ double scaledModelResidual(const TwoViewModel& model, double lx, double ly, doub
 /// located to a pixel lands within s pixels on the right, so the right image's interval is
 /// max(1, s) and the left one's max(1, 1 / s); 1 and 1 for a fundamental matrix.
 PairScales modelScales(const TwoViewModel& model, const PointPairs& pairs);
+
+/// One pair's intervals (left, right) in the units `unit` names (GuidedConfig::tolerance_scale):
+/// "model", as modelScales() gives them; "keypoints", octaveInterval_px of each keypoint's size;
+/// anything else, pixels (1, 1).
+std::pair<double, double> pairIntervals(const std::string& unit, const TwoViewModel& model,
+                                        double lx, double ly, float left_size_px,
+                                        float right_size_px);
 
 /// Squared scaledModelResidual of every pair (float), into `out`. Throws std::invalid_argument
 /// when `scales` does not hold one entry per pair.

@@ -120,17 +120,9 @@ FilterResult filterGuided(const PutativeMatches& input, const GuidedFilterConfig
     bool explained = false;
     for (const Motion& motion : motions) {
       best = std::min(best, residual(motion, a, b));
-      if (unit != "model" && unit != "keypoints") {
-        explained = explained || explains(motion, a, b, config);
-        continue;
-      }
       const TwoViewModel model{motion.homography, motion.matrix};
-      double left_interval = octaveInterval_px(input.left(m).size);
-      double right_interval = octaveInterval_px(input.right(m).size);
-      if (unit == "model") {
-        const double s = localScale(model, a.x, a.y);
-        left_interval = std::max(1.0, 1.0 / s), right_interval = std::max(1.0, s);
-      }
+      const auto [left_interval, right_interval] =
+          pairIntervals(unit, model, a.x, a.y, input.left(m).size, input.right(m).size);
       explained = explained || scaledModelResidual(model, a.x, a.y, b.x, b.y, left_interval,
                                                    right_interval) <= thresholdOf(motion, config);
     }

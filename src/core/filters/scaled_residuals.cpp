@@ -20,17 +20,36 @@ double localScale(const TwoViewModel& model, double lx, double ly) {
   return std::isfinite(scale) && scale > 0.0 ? scale : 1.0;
 }
 
+namespace {
+
+/// The model's allowance at a left point: (max(1, 1 / s), max(1, s)), s its local scale there.
+std::pair<double, double> modelIntervals(const TwoViewModel& model, double lx, double ly) {
+  const double s = localScale(model, lx, ly);
+  return {std::max(1.0, 1.0 / s), std::max(1.0, s)};
+}
+
+}  // namespace
+
 PairScales modelScales(const TwoViewModel& model, const PointPairs& pairs) {
   PairScales scales;
   scales.left.assign(pairs.size(), 1.0f);
   scales.right.assign(pairs.size(), 1.0f);
   if (!model.homography) return scales;
   for (size_t i = 0; i < pairs.size(); ++i) {
-    const double s = localScale(model, pairs.left_x[i], pairs.left_y[i]);
-    scales.right[i] = static_cast<float>(std::max(1.0, s));
-    scales.left[i] = static_cast<float>(std::max(1.0, 1.0 / s));
+    const auto [left, right] = modelIntervals(model, pairs.left_x[i], pairs.left_y[i]);
+    scales.left[i] = static_cast<float>(left);
+    scales.right[i] = static_cast<float>(right);
   }
   return scales;
+}
+
+std::pair<double, double> pairIntervals(const std::string& unit, const TwoViewModel& model,
+                                        double lx, double ly, float left_size_px,
+                                        float right_size_px) {
+  if (unit == "model") return modelIntervals(model, lx, ly);
+  if (unit == "keypoints")
+    return {octaveInterval_px(left_size_px), octaveInterval_px(right_size_px)};
+  return {1.0, 1.0};
 }
 
 double scaledModelResidual(const TwoViewModel& model, double lx, double ly, double rx, double ry,
