@@ -27,6 +27,7 @@ set(SIFT_HULL_CORE_SOURCES
   src/core/filters/gsc.cpp
   src/core/filters/guided.cpp
   src/core/filters/local_consistency.cpp
+  src/core/filters/motion_frame.cpp
   src/core/filters/ratio.cpp
   src/core/filters/robust_fit.cpp
   src/core/filters/scaled_residuals.cpp
@@ -112,6 +113,7 @@ set(SIFT_HULL_EXACT_FLOAT_SOURCES
   src/core/filters/gsc.cpp
   src/core/filters/guided.cpp
   src/core/filters/local_consistency.cpp
+  src/core/filters/motion_frame.cpp
   src/core/filters/scaled_residuals.cpp
   src/core/filters/two_view_fit.cpp
   src/core/filters/two_view_models.cpp

@@ -10,6 +10,7 @@
 #include <iostream>
 #include <random>
 
+#include "filters/motion_frame.h"
 #include "sift_hull/eval/match_evaluation.h"
 #include "sift_hull/features/labelled_matches.h"
 #include "sift_hull/filters/filter.h"
@@ -83,30 +84,107 @@ TEST(VoteRansac, ASimilarityPairIsFittedByTheHomography) {
   }
 }
 
+/// How far a match's SIFT frame lies within a motion's bounds (motion_frame.h): the smaller of
+/// its turn's margin to kMaxTurnFromMotionDeg (deg) and its scale's to kMaxOctavesFromMotion
+/// (octaves, counted as 10 deg each); negative beyond a bound. `signed_margin` false: its
+/// absolute value, the distance to the nearer bound.
+double frameEdgeDistance(const detail::MotionFrame& frame, const cv::KeyPoint& l,
+                         const cv::KeyPoint& r, bool signed_margin = false) {
+  double turn = std::fmod(double(r.angle) - double(l.angle) - frame.turn_deg + 720.0, 360.0);
+  turn = std::min(turn, 360.0 - turn);
+  const double octaves = std::abs(std::log2(double(r.size) / double(l.size)) - frame.log2_scale);
+  const double margin = std::min(detail::kMaxTurnFromMotionDeg - turn,
+                                 10.0 * (detail::kMaxOctavesFromMotion - octaves));
+  return signed_margin ? margin : std::abs(margin);
+}
+
 TEST(VoteRansac, KeepsWhatThePlainReferenceKeepsUnderItsMotions) {
+  // The reference: a match is kept when a motion explains it within its threshold and, for a
+  // fundamental matrix, its SIFT frame agrees with the scene's true one (the cameras' roll, the
+  // median scale change of the true matches). The filter estimates that frame from its inliers,
+  // so a match may differ only at a threshold's or a frame bound's edge.
   const LabelledMatches input = sceneMatches(500, 0.4, 43, 0.3);
   const FilterConfigs c;
   const std::vector<TwoViewModel> motions =
       voteRansacMotions(input.putative, {c.vote_ransac, c.guided, c.magsac});
   const FilterResult result = makeFilter("vote_ransac", c)->apply(input.putative);
   ASSERT_FALSE(motions.empty());
-  size_t borderline = 0;
+  std::vector<double> true_scales;
   for (size_t m = 0; m < input.truth.size(); ++m) {
-    const cv::Point2f &a = input.putative.left(m).pt, &b = input.putative.right(m).pt;
+    if (input.truth[m] != MatchTruth::kCorrect) continue;
+    true_scales.push_back(
+        std::log2(double(input.putative.right(m).size) / double(input.putative.left(m).size)));
+  }
+  std::nth_element(true_scales.begin(), true_scales.begin() + long(true_scales.size() / 2),
+                   true_scales.end());
+  detail::MotionFrame truth;
+  truth.turn_deg = float(0.25 * 180.0 / M_PI);  // the roll of two_view_scene.h's cameras
+  truth.log2_scale = float(true_scales[true_scales.size() / 2]);
+  size_t borderline = 0, turned_away = 0;
+  for (size_t m = 0; m < input.truth.size(); ++m) {
+    const cv::KeyPoint &l = input.putative.left(m), &r = input.putative.right(m);
+    const cv::Point2f &a = l.pt, &b = r.pt;
     bool keep = false;
     double nearest_edge = INFINITY;
     for (const TwoViewModel& motion : motions) {
       const double limit = motion.homography ? c.guided.max_transfer_px : c.magsac.max_epipolar_px;
-      const double r = modelResidual(motion, a.x, a.y, b.x, b.y);
-      keep = keep || r <= limit;
-      nearest_edge = std::min(nearest_edge, std::abs(r - limit));
+      const double rad = modelResidual(motion, a.x, a.y, b.x, b.y);
+      const bool agrees = motion.homography || frameEdgeDistance(truth, l, r, true) >= 0.0;
+      keep = keep || (rad <= limit && agrees);
+      turned_away += rad <= limit && !agrees;
+      nearest_edge = std::min(nearest_edge, std::abs(rad - limit));
     }
     if (bool(result.keep[m]) != keep) {
       ++borderline;
-      EXPECT_LT(nearest_edge, 1e-3) << "match " << m << " differs away from its threshold";
+      EXPECT_TRUE(nearest_edge < 1e-3 || frameEdgeDistance(truth, l, r) < 5.0)
+          << "match " << m << " differs away from its threshold and the frame's bounds";
     }
   }
-  EXPECT_LE(borderline, 1u);  // float against double residuals, at the threshold only
+  EXPECT_GT(turned_away, 0u);  // the mismatches' random frames: some lie on the epipolar band
+  EXPECT_LE(borderline, 2u);   // float against double residuals, an estimated frame
+}
+
+TEST(VoteRansac, DropsMismatchesOnTheEpipolarLinesWhoseFrameDisagrees) {
+  // Mismatches placed on their epipolar lines: F explains each; the ones whose SIFT patch turns a
+  // half turn against the scene's, or changes scale eightfold, are dropped, the ones whose frame
+  // agrees are kept (nothing but the frame tells them from correct matches), and every correct
+  // match, turned by up to 60 degrees against the rest, is kept.
+  LabelledMatches input = sceneMatches(400, 0.0, 53, 0.0);
+  const Eigen::Matrix3d F = twoCameras().F();
+  std::mt19937 random(54);
+  std::uniform_real_distribution<double> along(20.0, 620.0), turn(-60.0, 60.0);
+  PutativeMatches& p = input.putative;
+  for (size_t m = 0; m < 400; m += 4)
+    p.right_keypoints[m].angle =  // correct, turned by perspective
+        std::fmod(float(p.right_keypoints[m].angle + turn(random) + 360.0), 360.f);
+  const size_t correct = p.matches.size();
+  for (size_t k = 0; k < 120; ++k) {  // a right point elsewhere on the left point's epipolar line
+    const cv::KeyPoint l = p.left_keypoints[k];
+    const Eigen::Vector3d line = F * Eigen::Vector3d(l.pt.x, l.pt.y, 1.0);
+    const double x = along(random), y = -(line.x() * x + line.z()) / line.y();
+    cv::KeyPoint r = p.right_keypoints[k];
+    r.pt = cv::Point2f(float(x), float(y));
+    if (k % 3 == 1) r.angle = std::fmod(r.angle + 180.f, 360.f);  // turned a half turn
+    if (k % 3 == 2) r.size = r.size * 8.f;                        // three octaves larger
+    p.left_keypoints.push_back(l), p.right_keypoints.push_back(r);
+    p.matches.emplace_back(int(p.left_keypoints.size() - 1), int(p.right_keypoints.size() - 1),
+                           0.f);
+    input.truth.push_back(MatchTruth::kWrong);
+  }
+  const FilterResult result = makeFilter("best", FilterConfigs())->apply(p);
+  size_t kept_correct = 0, kept_agreeing = 0, kept_disagreeing = 0;
+  for (size_t m = 0; m < p.matches.size(); ++m) {
+    if (m < correct) {
+      kept_correct += result.keep[m];
+    } else if ((m - correct) % 3 == 0) {
+      kept_agreeing += result.keep[m];
+    } else {
+      kept_disagreeing += result.keep[m];
+    }
+  }
+  EXPECT_EQ(kept_correct, correct);
+  EXPECT_GE(kept_agreeing, 36u);  // of 40: F explains them, their frame agrees
+  EXPECT_EQ(kept_disagreeing, 0u);
 }
 
 TEST(VoteRansac, SameDecisionsAfterRotatingTheRightImage) {

@@ -44,7 +44,9 @@ namespace sift_hull {
 /// 6. Every putative is judged: kept when a motion explains it (symmetric epipolar distance <=
 ///    magsac_max_epipolar_px, transfer error <= guided_max_transfer_px both ways), each image's
 ///    distance scaled as guided_tolerance_scale says (by default the homography's local scale
-///    there; scaled_residuals.h).
+///    there; scaled_residuals.h). A fundamental matrix places the right point only on a line: a
+///    match it explains is kept only when its SIFT rotation and scale ratio also lie within a
+///    quarter turn and two octaves of the ones its motion's inliers share (motion_frame.h).
 /// Score: the smallest residual over the motions, px (NaN when none was found: none kept).
 /// Its time hardly grows with N beyond the fit set: steps 5 and 6 are a few residuals per match.
 struct VoteRansacConfig {

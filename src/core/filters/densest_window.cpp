@@ -57,7 +57,7 @@ double separation(double a, double b, double period) {
 }  // namespace
 
 std::vector<int> densestWindow(const std::vector<float>& values, const std::vector<int>& candidates,
-                               double half, double period, size_t* count) {
+                               double half, double period, size_t* count, float* centre_out) {
   const std::vector<std::pair<float, int>> sorted = sortedByValue(values, candidates);
   const size_t n = sorted.size();
   std::vector<double> extended;  // circular: the values once below and once above the circle
@@ -82,6 +82,7 @@ std::vector<int> densestWindow(const std::vector<float>& values, const std::vect
     }
   }
   *count = best;
+  if (centre_out) *centre_out = n == 0 ? NAN : static_cast<float>(centre_value);
   std::vector<int> members;
   for (int i : candidates) {
     if (separation(values[i], centre_value, period) <= half) members.push_back(i);

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "filters/densest_window.h"
+#include "filters/motion_frame.h"
 #include "sift_hull/filters/scaled_residuals.h"
 #include "sift_hull/filters/two_view_models.h"
 
@@ -105,8 +106,9 @@ FitSet subsetOf(const FitSet& set, const std::vector<int>& members) {
 
 /// The matches the vote chooses to sample from; empty when the rotations do not cluster enough
 /// (`require_cluster`: at least twice what evenly spread rotations would put in the window).
-std::vector<int> votedPool(const FitSet& set, const VoteRansacConfig& config,
-                           bool require_cluster) {
+/// `frame`: the centres of the two windows, the turn and scale change the pool shares.
+std::vector<int> votedPool(const FitSet& set, const VoteRansacConfig& config, bool require_cluster,
+                           detail::MotionFrame* frame) {
   std::vector<int> voting;
   for (size_t i = 0; i < set.pairs.size(); ++i) {
     if (std::isfinite(set.rotation_deg[i]) && std::isfinite(set.log2_scale[i])) {
@@ -116,12 +118,15 @@ std::vector<int> votedPool(const FitSet& set, const VoteRansacConfig& config,
   if (voting.empty()) return {};
   size_t count = 0;
   const double half = config.max_angle_deg;
+  float turn = NAN, log2_scale = NAN;
   const std::vector<int> turned =
-      detail::densestWindow(set.rotation_deg, voting, half, 360.0, &count);
+      detail::densestWindow(set.rotation_deg, voting, half, 360.0, &count, &turn);
   const double even = double(voting.size()) * std::min(1.0, 2.0 * half / 360.0);
   if (require_cluster && double(count) < 2.0 * even) return {};
-  return detail::densestWindow(set.log2_scale, turned, std::log2(config.max_scale_ratio), 0.0,
-                               &count);
+  std::vector<int> pool = detail::densestWindow(
+      set.log2_scale, turned, std::log2(config.max_scale_ratio), 0.0, &count, &log2_scale);
+  *frame = detail::motionFrame(turn, log2_scale);
+  return pool;
 }
 
 /// A model's squared residuals of the pairs when each left point meets the right point of another
@@ -259,36 +264,49 @@ bool leftoverOf(const std::vector<TwoViewModel>& earlier, const FitSet& set,
   return 2 * size_t(std::count(near.begin(), near.end(), 1)) >= near.size();
 }
 
-/// Up to guided_max_models motions, each fitted to what the earlier ones leave unexplained.
-std::vector<TwoViewModel> fitMotions(FitSet set, const VoteRansacFilterConfig& config) {
+/// Up to guided_max_models motions, each fitted to what the earlier ones leave unexplained, with
+/// the SIFT frame the vote found for each (`frames`, in the same order; unknown where it sampled
+/// from all).
+std::vector<TwoViewModel> fitMotions(FitSet set, const VoteRansacFilterConfig& config,
+                                     std::vector<detail::MotionFrame>* frames) {
   std::mt19937 random(static_cast<unsigned>(config.magsac.seed));
   std::vector<TwoViewModel> motions;
   while (static_cast<int>(motions.size()) < config.guided.max_models &&
          set.pairs.size() >= static_cast<size_t>(config.guided.min_model_inliers)) {
     const bool further = !motions.empty();
-    std::vector<int> pool = votedPool(set, config.vote_ransac, further);
+    detail::MotionFrame frame;  // unknown unless the vote chooses the pool
+    std::vector<int> pool = votedPool(set, config.vote_ransac, further, &frame);
     const size_t least = 2 * static_cast<size_t>(config.guided.min_model_inliers);
     if (further && pool.size() < least) break;  // no cluster that could hold a further motion
-    if (pool.size() < 16) pool.clear();         // too few votes to sample from: sample from all
+    if (pool.size() < 16) {                     // too few votes to sample from: sample from all
+      pool.clear();
+      frame = detail::MotionFrame();
+    }
     const TwoViewFit motion = fitMotion(set, pool, further, config, &random);
     if (!motion.found || leftoverOf(motions, set, motion.inliers, config)) break;
     motions.push_back(motion.model);
+    frames->push_back(frame);
     set = subsetOf(set, unexplained(set, motion.inliers));
   }
   return motions;
 }
 
 /// The matches with finite positions, as pairs, with their indices into input.matches.
-PointPairs finitePairs(const PutativeMatches& input, std::vector<size_t>* index) {
+PointPairs finitePairs(const PutativeMatches& input, std::vector<size_t>* index,
+                       detail::MatchFrames* frames = nullptr) {
   PointPairs all;
   all.reserve(input.matches.size());
   index->reserve(input.matches.size());
+  if (frames) frames->resize(input.matches.size());
+  size_t k = 0;
   for (size_t m = 0; m < input.matches.size(); ++m) {
     if (!input.hasFinitePositions(m)) continue;
-    const cv::Point2f &a = input.left(m).pt, &b = input.right(m).pt;
-    all.push(a.x, a.y, b.x, b.y);
+    const cv::KeyPoint &l = input.left(m), &r = input.right(m);
+    all.push(l.pt.x, l.pt.y, r.pt.x, r.pt.y);
     index->push_back(m);
+    if (frames) frames->set(k++, l.angle, l.size, r.angle, r.size);
   }
+  if (frames) frames->resize(k);
   return all;
 }
 
@@ -303,15 +321,19 @@ PairScales scalesOf(const PutativeMatches& input, const std::vector<size_t>& ind
 }
 
 /// Every match judged against the motions (float residuals, vectorised): explained within each
-/// motion's threshold, in the units guided_tolerance_scale names.
+/// motion's threshold, in the units guided_tolerance_scale names; for a fundamental matrix, which
+/// places the right point only on a line, also when its SIFT frame agrees with the motion's
+/// (motion_frame.h).
 void judge(const PutativeMatches& input, const PointPairs& all, const std::vector<size_t>& index,
-           const std::vector<TwoViewModel>& motions, const VoteRansacFilterConfig& config,
+           const std::vector<TwoViewModel>& motions, const std::vector<detail::MotionFrame>& frames,
+           const detail::MatchFrames& match_frames, const VoteRansacFilterConfig& config,
            FilterResult* result) {
   std::vector<float> best(all.size(), std::numeric_limits<float>::infinity()), r2, scaled;
   std::vector<uint8_t> explained(all.size(), 0);
   const std::string& unit = config.guided.tolerance_scale;
   const PairScales keypoints = unit == "keypoints" ? scalesOf(input, index) : PairScales();
-  for (const TwoViewModel& motion : motions) {
+  for (size_t k = 0; k < motions.size(); ++k) {
+    const TwoViewModel& motion = motions[k];
     const float t2 = static_cast<float>(std::pow(thresholdOf(motion, config), 2));
     squaredResiduals(motion, all, &r2);
     // A fundamental matrix has no scale of its own: in the model's units its residuals are r2.
@@ -319,9 +341,13 @@ void judge(const PutativeMatches& input, const PointPairs& all, const std::vecto
     if (unit == "keypoints") squaredScaledResiduals(motion, all, keypoints, &scaled);
     if (by_model) squaredScaledResiduals(motion, all, modelScales(motion, all), &scaled);
     const std::vector<float>& judged = unit == "keypoints" || by_model ? scaled : r2;
-    for (size_t i = 0; i < r2.size(); ++i) {
+    const uint8_t any_frame = motion.homography ? 1 : 0;  // H places the point itself
+    const detail::MotionFrame& frame = frames[k];
+    for (size_t i = 0; i < r2.size(); ++i) {  // branch-free, so that it vectorises
       best[i] = std::min(best[i], r2[i]);
-      explained[i] |= judged[i] <= t2;
+      const uint8_t agrees =
+          detail::frameAgrees(frame, match_frames.turn_deg[i], match_frames.scale_ratio[i]);
+      explained[i] |= uint8_t(judged[i] <= t2) & (any_frame | agrees);
     }
   }
   for (size_t i = 0; i < index.size(); ++i) {
@@ -368,13 +394,15 @@ TwoViewModel polished(const PointPairs& all, const std::vector<uint8_t>& taken,
 /// matches near it that the motions before it do not explain.
 std::vector<TwoViewModel> motionsOf(const PutativeMatches& input, const PointPairs& all,
                                     const std::vector<size_t>& index,
-                                    const VoteRansacFilterConfig& config) {
+                                    const VoteRansacFilterConfig& config,
+                                    std::vector<detail::MotionFrame>* frames) {
   validate(config.vote_ransac);
   validate(config.guided);
   validate(config.magsac, "magsac");
   const size_t max_points = size_t(config.vote_ransac.max_fit_points);
-  std::vector<TwoViewModel> motions = fitMotions(
-      fitSetOf(input, index, max_points, static_cast<unsigned>(config.magsac.seed)), config);
+  std::vector<TwoViewModel> motions =
+      fitMotions(fitSetOf(input, index, max_points, static_cast<unsigned>(config.magsac.seed)),
+                 config, frames);
   if (all.size() > max_points) {
     std::vector<uint8_t> taken(all.size(), 0);
     std::vector<float> r2;
@@ -396,15 +424,18 @@ std::vector<TwoViewModel> voteRansacMotions(const PutativeMatches& input,
                                             const VoteRansacFilterConfig& config) {
   std::vector<size_t> index;
   const PointPairs all = finitePairs(input, &index);
-  return motionsOf(input, all, index, config);
+  std::vector<detail::MotionFrame> frames;
+  return motionsOf(input, all, index, config, &frames);
 }
 
 FilterResult filterVoteRansac(const PutativeMatches& input, const VoteRansacFilterConfig& config) {
   FilterResult result = FilterResult::keepingNone(input.matches.size());
   std::vector<size_t> index;
-  const PointPairs all = finitePairs(input, &index);
-  const std::vector<TwoViewModel> motions = motionsOf(input, all, index, config);
-  if (!motions.empty()) judge(input, all, index, motions, config, &result);
+  detail::MatchFrames match_frames;
+  const PointPairs all = finitePairs(input, &index, &match_frames);
+  std::vector<detail::MotionFrame> frames;
+  const std::vector<TwoViewModel> motions = motionsOf(input, all, index, config, &frames);
+  if (!motions.empty()) judge(input, all, index, motions, frames, match_frames, config, &result);
   return result;
 }
 
