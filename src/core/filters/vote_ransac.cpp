@@ -294,18 +294,28 @@ std::vector<TwoViewModel> fitMotions(FitSet set, const VoteRansacFilterConfig& c
 /// The matches with finite positions, as pairs, with their indices into input.matches.
 PointPairs finitePairs(const PutativeMatches& input, std::vector<size_t>* index,
                        detail::MatchFrames* frames = nullptr) {
+  // Written in place rather than pushed: this gather is a quarter of the filter's time at 10,000
+  // matches.
+  const size_t n = input.matches.size();
   PointPairs all;
-  all.reserve(input.matches.size());
-  index->reserve(input.matches.size());
-  if (frames) frames->resize(input.matches.size());
+  all.left_x.resize(n), all.left_y.resize(n), all.right_x.resize(n), all.right_y.resize(n);
+  index->resize(n);
+  if (frames) frames->resize(n);
   size_t k = 0;
-  for (size_t m = 0; m < input.matches.size(); ++m) {
-    if (!input.hasFinitePositions(m)) continue;
+  for (size_t m = 0; m < n; ++m) {
     const cv::KeyPoint &l = input.left(m), &r = input.right(m);
-    all.push(l.pt.x, l.pt.y, r.pt.x, r.pt.y);
-    index->push_back(m);
-    if (frames) frames->set(k++, l.angle, l.size, r.angle, r.size);
+    if (!(std::isfinite(l.pt.x) && std::isfinite(l.pt.y) && std::isfinite(r.pt.x) &&
+          std::isfinite(r.pt.y))) {
+      continue;  // as input.hasFinitePositions(m)
+    }
+    all.left_x[k] = l.pt.x, all.left_y[k] = l.pt.y, all.right_x[k] = r.pt.x,
+    all.right_y[k] = r.pt.y;
+    (*index)[k] = m;
+    if (frames) frames->set(k, l.angle, l.size, r.angle, r.size);
+    ++k;
   }
+  all.left_x.resize(k), all.left_y.resize(k), all.right_x.resize(k), all.right_y.resize(k);
+  index->resize(k);
   if (frames) frames->resize(k);
   return all;
 }
