@@ -345,5 +345,28 @@ TEST(VoteRansac, RejectsInvalidConfigs) {
   for (const FilterConfigs& configs : bad) EXPECT_THROW(validate(configs), std::invalid_argument);
 }
 
+TEST(MotionFrame, TurnsWrapAroundTheCircleAndUnknownsAgree) {
+  const detail::MotionFrame frame = detail::motionFrame(350.f, 0.f);  // turned by -10 deg
+  detail::MatchFrames m;
+  m.resize(9);
+  m.set(0, 10.f, 4.f, 359.f, 4.f);     // turn -11 deg: 1 deg from the motion's
+  m.set(1, 350.f, 4.f, 60.f, 4.f);     // turn +70 deg across 0: 80 deg from it
+  m.set(2, 0.f, 4.f, 200.f, 4.f);      // a half turn: 150 deg from it
+  m.set(3, 10.f, 4.f, 0.f, 17.f);      // scale 4.25: beyond two octaves
+  m.set(4, 10.f, 4.f, 0.f, 0.9f);      // scale 0.225: beyond two octaves below
+  m.set(5, -1.f, 4.f, 200.f, 4.f);     // no orientation (OpenCV's -1): the turn is unknown
+  m.set(6, NAN, 4.f, 0.f, 0.f);        // NaN angle, no size: nothing known
+  m.set(7, 10.f, 0.f, 0.f, 1e30f);     // no left size: the scale is unknown
+  m.set(8, 10.f, 1e-30f, 0.f, 1e30f);  // an infinite ratio: beyond any bound
+  const bool expected[] = {true, true, false, false, false, true, true, true, false};
+  for (size_t k = 0; k < 9; ++k) {
+    EXPECT_EQ(detail::frameAgrees(frame, m.turn_deg[k], m.scale_ratio[k]), expected[k]) << k;
+  }
+  // An unknown frame (the vote sampled from all): every match agrees.
+  for (size_t k = 0; k < 9; ++k) {
+    EXPECT_TRUE(detail::frameAgrees(detail::MotionFrame(), m.turn_deg[k], m.scale_ratio[k])) << k;
+  }
+}
+
 }  // namespace
 }  // namespace sift_hull
