@@ -35,6 +35,7 @@ set(SIFT_HULL_CORE_SOURCES
   src/core/filters/two_view_fit.cpp
   src/core/filters/two_view_models.cpp
   src/core/filters/vote_ransac.cpp
+  src/core/filters/vote_verdict.cpp
   src/core/hull/bounding_box.cpp
   src/core/hull/distance_kernel.cpp
   src/core/hull/distance_map.cpp
@@ -118,5 +119,6 @@ set(SIFT_HULL_EXACT_FLOAT_SOURCES
   src/core/filters/two_view_fit.cpp
   src/core/filters/two_view_models.cpp
   src/core/filters/vote_ransac.cpp
+  src/core/filters/vote_verdict.cpp
   src/core/hull/distance_kernel.cpp
 )

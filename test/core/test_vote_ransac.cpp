@@ -187,6 +187,54 @@ TEST(VoteRansac, DropsMismatchesOnTheEpipolarLinesWhoseFrameDisagrees) {
   EXPECT_EQ(kept_disagreeing, 0u);
 }
 
+TEST(VoteRansac, KeepsOnePlaceOnTheLineForEachRightKeypoint) {
+  // A right keypoint is the image of one place. Left points elsewhere on the epipolar line of a
+  // correct match's right keypoint, matched to that keypoint with the same frame: F explains
+  // both, so the smaller descriptor distance decides. A second orientation at the correct left
+  // point's place (as SIFT makes them) is the same place and stays beside it.
+  LabelledMatches input = sceneMatches(400, 0.0, 57, 0.0);
+  PutativeMatches& p = input.putative;
+  for (cv::DMatch& match : p.matches) match.distance = 100.f;
+  const Eigen::Matrix3d F = twoCameras().F();
+  std::mt19937 random(58);
+  std::uniform_real_distribution<double> along(20.0, 620.0);
+  const size_t correct = p.matches.size(), shared = 60;
+  for (size_t k = 0; k < shared; ++k) {  // match k pairs left and right keypoint k
+    const cv::KeyPoint& q = p.right_keypoints[k];
+    cv::KeyPoint l = p.left_keypoints[k];
+    float distance = 120.f;
+    if (k % 3 == 2) {
+      l.angle = std::fmod(l.angle + 40.f, 360.f);  // another orientation at the same place
+    } else {
+      const Eigen::Vector3d line = F.transpose() * Eigen::Vector3d(q.pt.x, q.pt.y, 1.0);
+      double x = along(random);
+      while (std::abs(x - l.pt.x) < 40.0) x = along(random);
+      l.pt = cv::Point2f(float(x), float(-(line.x() * x + line.z()) / line.y()));
+      distance = k % 3 == 0 ? 200.f : 50.f;  // farther than the correct match, or closer
+    }
+    p.left_keypoints.push_back(l);
+    p.matches.emplace_back(int(p.left_keypoints.size() - 1), int(k), distance);
+    input.truth.push_back(k % 3 == 2 ? MatchTruth::kCorrect : MatchTruth::kWrong);
+  }
+  const FilterResult result = makeFilter("best", FilterConfigs())->apply(p);
+  for (size_t k = 0; k < shared; ++k) {
+    const size_t added = correct + k;
+    if (k % 3 == 0) {
+      EXPECT_FALSE(result.keep[added]) << k;
+      EXPECT_TRUE(result.keep[k]) << k;
+    } else if (k % 3 == 1) {  // the closer descriptor wins, even against the true place
+      EXPECT_TRUE(result.keep[added]) << k;
+      EXPECT_FALSE(result.keep[k]) << k;
+    } else {
+      EXPECT_TRUE(result.keep[added]) << k;
+      EXPECT_TRUE(result.keep[k]) << k;
+    }
+  }
+  size_t kept_rest = 0;
+  for (size_t m = shared; m < correct; ++m) kept_rest += result.keep[m];
+  EXPECT_EQ(kept_rest, correct - shared);
+}
+
 TEST(VoteRansac, SameDecisionsAfterRotatingTheRightImage) {
   // The votes are found from the data, so a rotation moves nothing the residuals see.
   const LabelledMatches input = sceneMatches(600, 0.3, 47, 0.3);

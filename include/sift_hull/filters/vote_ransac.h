@@ -46,7 +46,9 @@ namespace sift_hull {
 ///    distance scaled as guided_tolerance_scale says (by default the homography's local scale
 ///    there; scaled_residuals.h). A fundamental matrix places the right point only on a line: a
 ///    match it explains is kept only when its SIFT rotation and scale ratio also lie within a
-///    quarter turn and two octaves of the ones its motion's inliers share (motion_frame.h).
+///    quarter turn and two octaves of the ones the vote found for its motion (motion_frame.h),
+///    and when no match from a left point elsewhere with a smaller descriptor distance shares
+///    its right keypoint (vote_verdict.h).
 /// Score: the smallest residual over the motions, px (NaN when none was found: none kept).
 /// Its time hardly grows with N beyond the fit set: steps 5 and 6 are a few residuals per match.
 struct VoteRansacConfig {

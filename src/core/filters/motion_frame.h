@@ -51,14 +51,15 @@ struct MatchFrames {
 
 /// Whether a match's frame (MatchFrames' turn and scale ratio) lies within kMaxTurnFromMotionDeg
 /// and kMaxOctavesFromMotion of the motion's; true where the match's or the frame's value is
-/// unknown. A few comparisons: no logarithm, no remainder.
+/// unknown. Comparisons only, combined with & rather than && (no logarithm, no remainder, no
+/// branch), so that a loop over the matches vectorises.
 inline bool frameAgrees(const MotionFrame& frame, float turn_deg, float scale_ratio) {
-  float d = turn_deg - frame.turn_deg;                                       // in (-720, 360)
-  d += d < -540.f ? 720.f : d < -180.f ? 360.f : d >= 180.f ? -360.f : 0.f;  // in [-180, 180)
-  // NaN (either turn unknown) fails both comparisons; a huge right size gives an infinite ratio.
-  // & rather than &&: no branches, so that a loop over the matches vectorises.
-  return !(std::abs(d) > float(kMaxTurnFromMotionDeg)) & !(scale_ratio < frame.min_scale_ratio) &
-         !(scale_ratio > frame.max_scale_ratio);
+  constexpr float q = static_cast<float>(kMaxTurnFromMotionDeg);
+  const float d = turn_deg - frame.turn_deg;  // in (-720, 360): away in three intervals
+  const bool away = ((d > q) & (d < 360.f - q)) | ((d > q - 360.f) & (d < -q)) |
+                    ((d > q - 720.f) & (d < -360.f - q));
+  // NaN (either turn unknown) fails every comparison; a huge right size gives an infinite ratio.
+  return !away & !(scale_ratio < frame.min_scale_ratio) & !(scale_ratio > frame.max_scale_ratio);
 }
 
 }  // namespace detail

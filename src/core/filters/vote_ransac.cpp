@@ -3,16 +3,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <limits>
 #include <numeric>
 #include <random>
 #include <stdexcept>
-#include <string>
 #include <vector>
 
 #include "filters/densest_window.h"
 #include "filters/motion_frame.h"
-#include "sift_hull/filters/scaled_residuals.h"
+#include "filters/vote_verdict.h"
 #include "sift_hull/filters/two_view_models.h"
 
 namespace sift_hull {
@@ -243,11 +241,6 @@ std::vector<int> unexplained(const FitSet& set, const std::vector<int>& inliers)
   return rest;
 }
 
-/// The residual threshold of a motion, px.
-double thresholdOf(const TwoViewModel& motion, const VoteRansacFilterConfig& config) {
-  return motion.homography ? config.guided.max_transfer_px : config.magsac.max_epipolar_px;
-}
-
 /// Whether most inliers of a further motion lie within twice the threshold of an earlier motion:
 /// then they are what the earlier one left at its threshold's edge, not a motion of their own.
 bool leftoverOf(const std::vector<TwoViewModel>& earlier, const FitSet& set,
@@ -258,7 +251,7 @@ bool leftoverOf(const std::vector<TwoViewModel>& earlier, const FitSet& set,
   std::vector<float> r2;
   for (const TwoViewModel& motion : earlier) {
     squaredResiduals(motion, found.pairs, &r2);
-    const float t2 = static_cast<float>(4.0 * std::pow(thresholdOf(motion, config), 2));
+    const float t2 = static_cast<float>(4.0 * std::pow(detail::motionThreshold(motion, config), 2));
     for (size_t i = 0; i < r2.size(); ++i) near[i] |= r2[i] <= t2;
   }
   return 2 * size_t(std::count(near.begin(), near.end(), 1)) >= near.size();
@@ -320,52 +313,6 @@ PointPairs finitePairs(const PutativeMatches& input, std::vector<size_t>* index,
   return all;
 }
 
-/// The octave intervals of the keypoints of the matches `index` names (octaveInterval_px).
-PairScales scalesOf(const PutativeMatches& input, const std::vector<size_t>& index) {
-  PairScales scales;
-  scales.left.reserve(index.size()), scales.right.reserve(index.size());
-  for (size_t m : index) {
-    scales.push(octaveInterval_px(input.left(m).size), octaveInterval_px(input.right(m).size));
-  }
-  return scales;
-}
-
-/// Every match judged against the motions (float residuals, vectorised): explained within each
-/// motion's threshold, in the units guided_tolerance_scale names; for a fundamental matrix, which
-/// places the right point only on a line, also when its SIFT frame agrees with the motion's
-/// (motion_frame.h).
-void judge(const PutativeMatches& input, const PointPairs& all, const std::vector<size_t>& index,
-           const std::vector<TwoViewModel>& motions, const std::vector<detail::MotionFrame>& frames,
-           const detail::MatchFrames& match_frames, const VoteRansacFilterConfig& config,
-           FilterResult* result) {
-  std::vector<float> best(all.size(), std::numeric_limits<float>::infinity()), r2, scaled;
-  std::vector<uint8_t> explained(all.size(), 0);
-  const std::string& unit = config.guided.tolerance_scale;
-  const PairScales keypoints = unit == "keypoints" ? scalesOf(input, index) : PairScales();
-  for (size_t k = 0; k < motions.size(); ++k) {
-    const TwoViewModel& motion = motions[k];
-    const float t2 = static_cast<float>(std::pow(thresholdOf(motion, config), 2));
-    squaredResiduals(motion, all, &r2);
-    // A fundamental matrix has no scale of its own: in the model's units its residuals are r2.
-    const bool by_model = unit == "model" && motion.homography;
-    if (unit == "keypoints") squaredScaledResiduals(motion, all, keypoints, &scaled);
-    if (by_model) squaredScaledResiduals(motion, all, modelScales(motion, all), &scaled);
-    const std::vector<float>& judged = unit == "keypoints" || by_model ? scaled : r2;
-    const uint8_t any_frame = motion.homography ? 1 : 0;  // H places the point itself
-    const detail::MotionFrame& frame = frames[k];
-    for (size_t i = 0; i < r2.size(); ++i) {  // branch-free, so that it vectorises
-      best[i] = std::min(best[i], r2[i]);
-      const uint8_t agrees =
-          detail::frameAgrees(frame, match_frames.turn_deg[i], match_frames.scale_ratio[i]);
-      explained[i] |= uint8_t(judged[i] <= t2) & (any_frame | agrees);
-    }
-  }
-  for (size_t i = 0; i < index.size(); ++i) {
-    result->score[index[i]] = std::sqrt(double(best[i]));
-    result->keep[index[i]] = explained[i];
-  }
-}
-
 }  // namespace
 
 namespace {
@@ -417,7 +364,7 @@ std::vector<TwoViewModel> motionsOf(const PutativeMatches& input, const PointPai
     std::vector<uint8_t> taken(all.size(), 0);
     std::vector<float> r2;
     for (size_t k = 0; k < motions.size(); ++k) {
-      const double threshold = thresholdOf(motions[k], config);
+      const double threshold = detail::motionThreshold(motions[k], config);
       motions[k] = polished(all, taken, motions[k], threshold);
       if (k + 1 == motions.size()) break;
       squaredResiduals(motions[k], all, &r2);
@@ -445,7 +392,8 @@ FilterResult filterVoteRansac(const PutativeMatches& input, const VoteRansacFilt
   const PointPairs all = finitePairs(input, &index, &match_frames);
   std::vector<detail::MotionFrame> frames;
   const std::vector<TwoViewModel> motions = motionsOf(input, all, index, config, &frames);
-  if (!motions.empty()) judge(input, all, index, motions, frames, match_frames, config, &result);
+  if (!motions.empty())
+    detail::judgeMatches(input, all, index, motions, frames, match_frames, config, &result);
   return result;
 }
 
