@@ -101,8 +101,10 @@ double frameEdgeDistance(const detail::MotionFrame& frame, const cv::KeyPoint& l
 TEST(VoteRansac, KeepsWhatThePlainReferenceKeepsUnderItsMotions) {
   // The reference: a match is kept when a motion explains it within its threshold and, for a
   // fundamental matrix, its SIFT frame agrees with the scene's true one (the cameras' roll, the
-  // median scale change of the true matches). The filter estimates that frame from its inliers,
-  // so a match may differ only at a threshold's or a frame bound's edge.
+  // median scale change of the true matches). The filter estimates that frame from its vote
+  // (the medians of its windows), so a match may differ only at a threshold's or a frame bound's
+  // edge. Whether a mismatch of a random frame falls in the epipolar band here is chance; the
+  // next case places them there.
   const LabelledMatches input = sceneMatches(500, 0.4, 43, 0.3);
   const FilterConfigs c;
   const std::vector<TwoViewModel> motions =
@@ -120,7 +122,7 @@ TEST(VoteRansac, KeepsWhatThePlainReferenceKeepsUnderItsMotions) {
   detail::MotionFrame truth;
   truth.turn_deg = float(0.25 * 180.0 / M_PI);  // the roll of two_view_scene.h's cameras
   truth.log2_scale = float(true_scales[true_scales.size() / 2]);
-  size_t borderline = 0, turned_away = 0;
+  size_t borderline = 0;
   for (size_t m = 0; m < input.truth.size(); ++m) {
     const cv::KeyPoint &l = input.putative.left(m), &r = input.putative.right(m);
     const cv::Point2f &a = l.pt, &b = r.pt;
@@ -131,7 +133,6 @@ TEST(VoteRansac, KeepsWhatThePlainReferenceKeepsUnderItsMotions) {
       const double rad = modelResidual(motion, a.x, a.y, b.x, b.y);
       const bool agrees = motion.homography || frameEdgeDistance(truth, l, r, true) >= 0.0;
       keep = keep || (rad <= limit && agrees);
-      turned_away += rad <= limit && !agrees;
       nearest_edge = std::min(nearest_edge, std::abs(rad - limit));
     }
     if (bool(result.keep[m]) != keep) {
@@ -140,8 +141,7 @@ TEST(VoteRansac, KeepsWhatThePlainReferenceKeepsUnderItsMotions) {
           << "match " << m << " differs away from its threshold and the frame's bounds";
     }
   }
-  EXPECT_GT(turned_away, 0u);  // the mismatches' random frames: some lie on the epipolar band
-  EXPECT_LE(borderline, 2u);   // float against double residuals, an estimated frame
+  EXPECT_LE(borderline, 2u);  // float against double residuals, an estimated frame
 }
 
 TEST(VoteRansac, DropsMismatchesOnTheEpipolarLinesWhoseFrameDisagrees) {

@@ -57,7 +57,7 @@ double separation(double a, double b, double period) {
 }  // namespace
 
 std::vector<int> densestWindow(const std::vector<float>& values, const std::vector<int>& candidates,
-                               double half, double period, size_t* count, float* centre_out) {
+                               double half, double period, size_t* count, float* median_out) {
   const std::vector<std::pair<float, int>> sorted = sortedByValue(values, candidates);
   const size_t n = sorted.size();
   std::vector<double> extended;  // circular: the values once below and once above the circle
@@ -69,7 +69,7 @@ std::vector<int> densestWindow(const std::vector<float>& values, const std::vect
   if (period > 0.0) {
     for (const auto& each : sorted) extended.push_back(each.first + period);
   }
-  size_t lo = 0, hi = 0, best = 0;
+  size_t lo = 0, hi = 0, best = 0, best_lo = 0;
   int centre = -1;
   double centre_value = 0.0;
   for (size_t k = 0; k < n; ++k) {
@@ -78,11 +78,16 @@ std::vector<int> densestWindow(const std::vector<float>& values, const std::vect
     while (hi < extended.size() && extended[hi] <= v + half) ++hi;
     const size_t within = std::min(hi - lo, n);
     if (within > best || (within == best && sorted[k].second < centre)) {
-      best = within, centre = sorted[k].second, centre_value = v;
+      best = within, centre = sorted[k].second, centre_value = v, best_lo = lo;
     }
   }
   *count = best;
-  if (centre_out) *centre_out = n == 0 ? NAN : static_cast<float>(centre_value);
+  if (median_out) {  // the window's values lie in order from extended[best_lo]
+    double median = n == 0 ? NAN : extended[best_lo + (best - 1) / 2];
+    if (period > 0.0 && median < 0.0) median += period;
+    if (period > 0.0 && median >= period) median -= period;
+    *median_out = static_cast<float>(median);
+  }
   std::vector<int> members;
   for (int i : candidates) {
     if (separation(values[i], centre_value, period) <= half) members.push_back(i);

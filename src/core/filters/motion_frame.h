@@ -1,6 +1,6 @@
 #pragma once
 
-// The SIFT frame a motion's matches share (vote_ransac.cpp: the centres of the vote that chose
+// The SIFT frame a motion's matches share (vote_ransac.cpp: the medians of the vote that chose
 // where its samples were drawn), against which a match that only a fundamental matrix explains
 // is checked.
 

@@ -104,7 +104,7 @@ FitSet subsetOf(const FitSet& set, const std::vector<int>& members) {
 
 /// The matches the vote chooses to sample from; empty when the rotations do not cluster enough
 /// (`require_cluster`: at least twice what evenly spread rotations would put in the window).
-/// `frame`: the centres of the two windows, the turn and scale change the pool shares.
+/// `frame`: the medians of the two windows, the turn and scale change the pool shares.
 std::vector<int> votedPool(const FitSet& set, const VoteRansacConfig& config, bool require_cluster,
                            detail::MotionFrame* frame) {
   std::vector<int> voting;
